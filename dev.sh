@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# One entry point for a new user: sets up .venv (and, as root, the Debian
+# packages) on first use, then runs what was asked.
+#   ./dev.sh demo [args]   headless simulator + controller, summary and video
+#   ./dev.sh test [args]   the test suite (pytest)
+#   ./dev.sh bench         simulator, detection and scenario benchmarks
+#   ./dev.sh setup         only the set-up
+set -euo pipefail
+cd "$(dirname "$0")"
+VENV=${VENV:-.venv}
+PY="$VENV/bin/python"
+
+say() { printf '[dev.sh] %s\n' "$*" >&2; }
+
+have_egl() { ldconfig -p 2>/dev/null | grep -q 'libEGL.so.1' && ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1; }
+
+system_packages() {
+  local want=()
+  python3 -c 'import ensurepip' 2>/dev/null || want+=(python3-venv)
+  have_egl || want+=(libegl1 libgl1-mesa-dri)
+  [ ${#want[@]} -eq 0 ] && return 0
+  local sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    if sudo -n true 2>/dev/null; then sudo="sudo"; else
+      say "missing Debian packages: ${want[*]}"
+      say "install them with: sudo apt-get install -y --no-install-recommends ${want[*]}"
+      say "(without libegl1/libgl1-mesa-dri the simulator falls back to the slower TinyRenderer)"
+      return 0
+    fi
+  fi
+  say "installing Debian packages: ${want[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${want[@]}" >/dev/null
+}
+
+setup() {
+  system_packages
+  local stamp="$VENV/.installed"
+  if [ ! -f "$stamp" ] || [ setup.py -nt "$stamp" ]; then
+    say "creating $VENV and installing miro_ball with ROS 2 Jazzy wheels"
+    python3 -m venv "$VENV"
+    "$PY" -m pip install -q --upgrade pip
+    "$PY" -m pip install -q -e '.[ros,test]'
+    touch "$stamp"
+  fi
+}
+
+cmd=${1:-help}
+[ $# -gt 0 ] && shift
+case "$cmd" in
+  setup) setup ;;
+  demo) setup; exec "$PY" -m miro_ball.demo "$@" ;;
+  test) setup; exec "$PY" -m pytest "$@" ;;
+  bench) setup; exec "$PY" -m miro_sim_bullet.bench "$@" ;;
+  *) sed -n '2,8p' "$0"; exit 2 ;;
+esac

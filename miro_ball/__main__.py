@@ -1,0 +1,3 @@
+from miro_ball.node import main
+
+main()

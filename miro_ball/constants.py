@@ -1,0 +1,50 @@
+"""MiRo-E numbers shared by the simulator and the controller.
+
+Every value comes from the MDK (constants.py / miro_software_constants.h of
+R191016-R200720) as collected in shared/reference/miro_facts.md.
+"""
+import math
+
+# Drive (section 1.2)
+WHEEL_RADIUS_M = 0.045
+WHEEL_TRACK_M = 0.164
+WHEEL_MAX_SPEED_M_PER_S = 0.4
+PLATFORM_TICK_S = 0.02  # 50 Hz sensor and control tick
+
+# Kinematic chain (section 1.4); index order of every kinematic_joints message.
+JOINT_NAMES = ('tilt', 'lift', 'yaw', 'pitch')
+TILT, LIFT, YAW, PITCH = range(4)
+TILT_RAD = math.radians(-6.0)  # fixed pseudo-joint: the body rests tilted back
+JOINT_LIMITS_RAD = (
+    (TILT_RAD, TILT_RAD),
+    (math.radians(8.0), math.radians(60.0)),
+    (math.radians(-55.0), math.radians(55.0)),
+    (math.radians(-22.0), math.radians(8.0)),
+)
+LIFT_RAD_CALIB = math.radians(34.0)
+KIN_CALIB_RAD = (TILT_RAD, LIFT_RAD_CALIB, 0.0, 0.0)
+
+# Cosmetic joints (section 1.5): droop, wag, eyelid l/r, ear l/r, each 0..1.
+COSMETIC_NAMES = ('droop', 'wag', 'eye_l', 'eye_r', 'ear_l', 'ear_r')
+COSMETIC_CALIB = (0.0, 0.5, 0.0, 0.0, 1.0 / 3.0, 1.0 / 3.0)
+
+# Cameras (section 2)
+CAM_ELEVATION_RAD = math.radians(45.0)
+CAM_DIVERGENCE_RAD = math.radians(27.0)
+CAM_HFOV_DEG_SIM = 120.0
+FRAME_SIZES = ((1280, 720), (640, 360), (320, 240))
+
+# Cliff (section 4): a value below this is a drop.
+CLIFF_THRESHOLD = 0.7
+
+# Flags (section 3.3)
+UPSTREAM_FLAG_SIMULATOR = 1 << 15
+DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX = 1 << 21
+
+# Toy ball (section 6)
+BALL_RADIUS_M = 0.1
+
+
+def topic(robot_name: str, name: str) -> str:
+    """Absolute MiRo topic, e.g. topic('miro', 'sensors/caml') -> '/miro/sensors/caml'."""
+    return '/' + robot_name.strip('/') + '/' + name

@@ -1,0 +1,29 @@
+"""MiRo's differential-drive formula (MDK wheel_speed2cmd_vel and its inverse)."""
+import math
+
+from miro_ball.constants import WHEEL_MAX_SPEED_M_PER_S, WHEEL_TRACK_M
+
+
+def wheel_speed2cmd_vel(wheel_speed, track=WHEEL_TRACK_M):
+    """[left, right] wheel speeds in m/s -> (forward m/s, turn rate rad/s, CCW +)."""
+    left, right = wheel_speed
+    return (left + right) / 2.0, (right - left) / track
+
+
+def cmd_vel2wheel_speed(linear, angular, track=WHEEL_TRACK_M):
+    """(forward m/s, turn rate rad/s) -> (left, right) wheel speeds in m/s."""
+    half = angular * track / 2.0
+    return linear - half, linear + half
+
+
+def clamp_wheel_speeds(left, right, limit=WHEEL_MAX_SPEED_M_PER_S):
+    """Clamp each wheel to +-limit; each wheel independently, like the platform."""
+    return (max(-limit, min(limit, left)), max(-limit, min(limit, right)))
+
+
+def finite(*values):
+    """True when every value is a finite real number."""
+    try:
+        return all(math.isfinite(v) for v in values)
+    except TypeError:
+        return False

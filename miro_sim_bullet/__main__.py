@@ -1,0 +1,3 @@
+from miro_sim_bullet.node import main
+
+main()

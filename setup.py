@@ -1,0 +1,43 @@
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = 'miro_ball'
+
+setup(
+    name=PACKAGE,
+    version='0.1.0',
+    packages=find_packages(exclude=['test', 'worlds']) + ['miro_sim_bullet.worlds'],
+    # worlds/ is installed as the package miro_sim_bullet.worlds, so installed
+    # code finds the bundled worlds with importlib.resources, whatever the prefix.
+    package_dir={'miro_sim_bullet.worlds': 'worlds'},
+    package_data={'miro_sim_bullet.worlds': ['*.toml']},
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
+        ('share/' + PACKAGE, ['package.xml']),
+        ('share/' + PACKAGE + '/worlds', glob('worlds/*.toml')),
+    ],
+    python_requires='>=3.10',
+    install_requires=[
+        'setuptools',
+        'numpy',
+        'opencv-python-headless',
+        'pybullet',
+    ],
+    extras_require={
+        # Left out for users whose ROS 2 Jazzy is installed and sourced.
+        'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
+        'test': ['pytest'],
+    },
+    zip_safe=False,
+    maintainer='miro_ball developers',
+    maintainer_email='miro-ball@example.org',
+    description='MiRo-E PyBullet simulator and kick_blue_ball controller for ROS 2 Jazzy',
+    license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'miro_sim = miro_sim_bullet.node:main',
+            'kick_blue_ball = miro_ball.node:main',
+        ],
+    },
+)

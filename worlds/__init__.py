@@ -1,0 +1,1 @@
+"""Bundled world descriptions (TOML); see README "Worlds"."""
