@@ -1,0 +1,142 @@
+"""MiroSim without ROS: driving, head, cliff reflex, kicking and reset, in simulated time."""
+import math
+
+import pytest
+
+from miro_ball.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD
+from miro_sim_bullet.sim import MiroSim
+
+
+@pytest.fixture
+def empty():
+    sim = MiroSim('empty')
+    sim.place(ball_xy=(5.0, 5.0))  # out of the way
+    yield sim
+    sim.close()
+
+
+def drive(sim, linear, angular, seconds):
+    """Command at the controller's 50 Hz for the given simulated time."""
+    for _ in range(round(seconds / 0.02)):
+        sim.set_cmd_vel(linear, angular)
+        sim.run(0.02)
+
+
+def test_mass_and_resting_tilt(empty):
+    import pybullet as pb
+    body = empty.robot_id
+    total = sum(pb.getDynamicsInfo(body, link, physicsClientId=empty.client)[0]
+                for link in range(-1, pb.getNumJoints(body, physicsClientId=empty.client)))
+    assert 2.4 <= total <= 3.3
+    empty.run(1.0)
+    orn = pb.getBasePositionAndOrientation(body, physicsClientId=empty.client)[1]
+    assert math.degrees(pb.getEulerFromQuaternion(orn)[1]) == pytest.approx(-6.0, abs=1.0)
+    assert empty.robot_height() == pytest.approx(0.045, abs=0.003)
+
+
+def test_forward_0_2_m_s_for_2_s_moves_0_4_m(empty):
+    drive(empty, 0.2, 0.0, 2.0)
+    x, y, yaw = empty.robot_pose()
+    assert x == pytest.approx(0.4, abs=0.03) and abs(y) < 0.01 and abs(yaw) < 0.02
+    sensors = empty.read_sensors()
+    assert sensors.pose[0] == pytest.approx(x)
+    assert sensors.velocity[0] == pytest.approx(0.2, abs=0.01)
+    assert sensors.wheel_speed_opto == pytest.approx((0.2, 0.2), abs=0.01)
+
+
+def test_pure_turn_turns_at_the_commanded_rate(empty):
+    drive(empty, 0.0, 1.0, 0.5)  # spin up
+    start = empty.robot_pose()
+    drive(empty, 0.0, 1.0, 1.0)
+    x, y, yaw = empty.robot_pose()
+    turned = (yaw - start[2] + math.pi) % (2 * math.pi) - math.pi
+    assert turned == pytest.approx(1.0, abs=0.05)
+    assert math.hypot(x - start[0], y - start[1]) < 0.02
+    assert empty.read_sensors().velocity[1] == pytest.approx(1.0, abs=0.05)
+
+
+def test_wheel_speeds_are_clamped_to_0_4(empty):
+    empty.set_cmd_vel(5.0, 0.0)
+    empty.run(0.04)
+    assert empty.read_sensors().wheel_speed_cmd == (0.4, 0.4)
+
+
+def test_timeout_stops_the_robot(empty):
+    empty.set_cmd_vel(0.2, 0.0)
+    empty.run(0.4)
+    assert empty.read_sensors().wheel_speed_cmd == (0.2, 0.2)
+    empty.run(0.2)  # 0.6 s since the only command
+    assert empty.read_sensors().wheel_speed_cmd == (0.0, 0.0)
+    empty.run(0.5)
+    parked = empty.robot_pose()
+    empty.run(1.0)
+    assert empty.robot_pose()[0] == pytest.approx(parked[0], abs=0.002)
+    assert parked[0] < 0.15
+
+
+def test_head_reaches_the_commanded_pose(empty):
+    target = [0.0, math.radians(50), math.radians(30), math.radians(-10)]
+    empty.set_kinematic_targets(target)
+    empty.run(1.5)
+    reached = empty.read_sensors().kinematic_positions
+    for got, want in zip(reached[1:], target[1:]):
+        assert got == pytest.approx(want, abs=math.radians(1.0))
+
+
+def test_out_of_range_head_targets_are_clamped(empty):
+    applied = empty.set_kinematic_targets([0.3, math.radians(90), -3.0, 1.0])
+    assert applied[1:] == tuple(lim for lim in (JOINT_LIMITS_RAD[1][1], JOINT_LIMITS_RAD[2][0],
+                                                JOINT_LIMITS_RAD[3][1]))
+    assert applied[0] == JOINT_LIMITS_RAD[0][0]  # tilt is fixed
+    empty.run(2.0)
+    reached = empty.read_sensors().kinematic_positions
+    assert reached[1] == pytest.approx(JOINT_LIMITS_RAD[1][1], abs=math.radians(1.5))
+    assert reached[2] == pytest.approx(JOINT_LIMITS_RAD[2][0], abs=math.radians(1.5))
+
+
+def test_cliff_reflex_stops_at_the_table_edge():
+    sim = MiroSim('table')  # table top 1.5 m long: edge at x = 0.75
+    assert sim.cliff == (1.0, 1.0)
+    drive(sim, 0.3, 0.0, 5.0)
+    x = sim.robot_pose()[0]
+    assert sim.robot_height() == pytest.approx(0.045, abs=0.005)
+    assert 0.4 < x < 0.75
+    assert min(sim.cliff) < 0.7
+    assert sim.read_sensors().wheel_speed_cmd == (0.0, 0.0)
+    drive(sim, -0.2, 0.0, 1.0)  # backing away is allowed
+    assert sim.robot_pose()[0] < x - 0.1
+    sim.close()
+
+
+def test_robot_falls_off_the_table_with_the_reflex_disabled():
+    sim = MiroSim('table')
+    sim.flags = DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
+    drive(sim, 0.3, 0.0, 5.0)
+    assert sim.robot_height() < -0.5
+    sim.close()
+
+
+def test_driving_into_the_ball_kicks_it():
+    sim = MiroSim('miro')
+    start = sim.ball_position()
+    drive(sim, 0.0, 0.0, 0.2)
+    sim.place(robot_pose=(0.0, -0.3, 0.0))  # facing the ball 0.6 m ahead
+    drive(sim, 0.4, 0.0, 2.0)
+    moved = math.dist(sim.ball_position()[:2], start[:2])
+    assert moved > 0.3
+    sim.close()
+
+
+def test_reset_restores_the_initial_state():
+    sim = MiroSim('miro')
+    initial = (sim.robot_pose(), sim.ball_position())
+    sim.set_kinematic_targets([0, 1.0, 0.5, 0])
+    drive(sim, 0.3, 0.5, 2.0)
+    assert sim.robot_pose() != initial[0]
+    sim.reset()
+    assert sim.time == 0.0
+    assert sim.robot_pose() == pytest.approx(initial[0])
+    assert sim.ball_position() == pytest.approx(initial[1])
+    sim.run(0.5)
+    assert sim.read_sensors().kinematic_positions[1] == pytest.approx(math.radians(34), abs=0.02)
+    sim.close()
