@@ -26,6 +26,7 @@ CLIFF_PITCH_DOWN = 0.52  # rad, the sensors look forward and down
 CLIFF_RANGE = 0.5
 SONAR_RANGE = (0.03, 1.0)
 SONAR_HALF_CONE = math.atan(0.309)  # cone radius 0.309 m at 1 m
+BODY_COM = (-0.060, 0.0, 0.050 - AXLE_HEIGHT)
 IMU_BODY = (-0.095, 0.048, 0.010 - AXLE_HEIGHT)
 TAIL_JOINT_IN_BODY = (-0.143, 0.0, 0.085 - AXLE_HEIGHT)
 EAR_IN_HEAD = (-0.0474, 0.0519, 0.0827)
@@ -160,7 +161,7 @@ class MiroModel:
         body = pb.createMultiBody(
             baseMass=1.570796, baseCollisionShapeIndex=body_collision,
             baseVisualShapeIndex=body_visual, basePosition=(0, 0, 1.0),
-            baseInertialFramePosition=(-0.060, 0.0, 0.050 - AXLE_HEIGHT),
+            baseInertialFramePosition=BODY_COM,
             linkMasses=[lk.mass for lk in links],
             linkCollisionShapeIndices=[lk.collision for lk in links],
             linkVisualShapeIndices=[lk.visual for lk in links],
@@ -182,10 +183,21 @@ class MiroModel:
             pb.changeDynamics(body, link, jointLowerLimit=lo, jointUpperLimit=hi, **kw)
         return body
 
+    def body_frame(self):
+        """World (position, rotation matrix) of the BODY frame (the axle midpoint).
+
+        PyBullet reports and sets a base by its centre of mass, which for MiRo
+        sits 6 cm behind the axle.
+        """
+        com, orn = pb.getBasePositionAndOrientation(self.body_id, physicsClientId=self.client)
+        rot = np.array(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
+        return np.array(com) - rot @ np.array(BODY_COM), rot
+
     def place(self, x, y, yaw):
         """Put the robot at rest on flat floor at z = 0 (FOOT pose x, y, yaw)."""
         orientation = pb.getQuaternionFromEuler((0.0, TILT_RAD, yaw))
-        pb.resetBasePositionAndOrientation(self.body_id, (x, y, AXLE_HEIGHT), orientation,
+        rot = np.array(pb.getMatrixFromQuaternion(orientation)).reshape(3, 3)
+        com = np.array((x, y, AXLE_HEIGHT)) + rot @ np.array(BODY_COM)
+        pb.resetBasePositionAndOrientation(self.body_id, com, orientation,
                                            physicsClientId=self.client)
         pb.resetBaseVelocity(self.body_id, (0, 0, 0), (0, 0, 0), physicsClientId=self.client)
-

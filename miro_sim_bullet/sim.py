@@ -246,12 +246,12 @@ class MiroSim:
     # -- ground truth -----------------------------------------------------------------------
     def robot_pose(self):
         """(x, y, yaw) of the point on the floor under the wheel axle."""
-        pos, orn = pb.getBasePositionAndOrientation(self.robot_id, **self._kw())
-        return pos[0], pos[1], pb.getEulerFromQuaternion(orn)[2]
+        pos, rot = self.model.body_frame()
+        return pos[0], pos[1], math.atan2(rot[1, 0], rot[0, 0])
 
     def robot_height(self):
         """Height of the wheel axle: about 0.045 on the floor, far less after a fall."""
-        return pb.getBasePositionAndOrientation(self.robot_id, **self._kw())[0][2]
+        return self.model.body_frame()[0][2]
 
     def ball_position(self):
         if self.ball_id is None:
@@ -262,11 +262,9 @@ class MiroSim:
     def _link_frame(self, link):
         kw = self._kw()
         if link < 0:
-            pos, orn = pb.getBasePositionAndOrientation(self.robot_id, **kw)
-        else:
-            state = pb.getLinkState(self.robot_id, link, computeForwardKinematics=1, **kw)
-            pos, orn = state[4], state[5]
-        return np.array(pos), np.array(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
+            return self.model.body_frame()
+        state = pb.getLinkState(self.robot_id, link, computeForwardKinematics=1, **kw)
+        return np.array(state[4]), np.array(pb.getMatrixFromQuaternion(state[5])).reshape(3, 3)
 
     def _cliff_rays(self):
         pos, rot = self._link_frame(-1)
