@@ -127,7 +127,7 @@ class SimNode(Node):
             sub(UInt16MultiArray, 'control/tone', self._on_tone),
             sub(UInt32, 'control/flags', self._on_flags),
         ]
-        self.services = [
+        self.srvs = [
             self.create_service(Trigger, '~/reset', self._on_reset),
             self.create_service(SetBool, '~/pause', self._on_pause),
             self.create_service(Trigger, '~/step', self._on_step),

@@ -53,14 +53,15 @@ class Sensors:
 class MiroSim:
     """One PyBullet world with MiRo in it."""
 
-    def __init__(self, world='miro', physics_dt=0.001, renderer='auto', log=print):
+    def __init__(self, world='miro', physics_dt=0.001, renderer=None, log=print):
+        """renderer: None (no cameras), 'auto', 'tiny' or 'egl'."""
         self.world = world if isinstance(world, World) else load_world(world)
         self.dt = physics_dt
         self.ticks_per_platform_tick = max(1, round(PLATFORM_TICK_S / physics_dt))
-        self.log = log
-        self.renderer_kind = renderer
-        self._renderer = None
         self.client = pb.connect(pb.DIRECT)
+        # Before any body exists: the EGL plugin only sees bodies created after it.
+        self.renderer = None if renderer is None else Renderer(self.client, kind=renderer,
+                                                               log=log)
         self._build()
 
     # -- world ------------------------------------------------------------------------------
@@ -159,9 +160,9 @@ class MiroSim:
         self.cliff = self._read_cliff()
 
     def close(self):
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
+        if self.renderer is not None:
+            self.renderer.close()
+            self.renderer = None
         if self.client is not None and pb.isConnected(self.client):
             pb.disconnect(self.client)
         self.client = None
@@ -345,12 +346,6 @@ class MiroSim:
         head_pos, head_rot = self._link_frame(rb.HEAD)
         eye_pos, eye_rot = rb.eye_in_head(side)
         return head_pos + head_rot @ eye_pos, head_rot @ eye_rot
-
-    @property
-    def renderer(self):
-        if self._renderer is None:
-            self._renderer = Renderer(self.client, kind=self.renderer_kind, log=self.log)
-        return self._renderer
 
     def render_eye(self, side, intrinsics):
         """RGB image (h, w, 3) of one eye now."""

@@ -1,0 +1,44 @@
+"""Helpers for in-process ROS tests: collect messages, spin until something holds."""
+import time
+
+import rclpy
+
+
+def spin_until(executor, predicate, timeout_s=10.0):
+    """Spin until predicate() holds; the wall-clock limit only guards against a hang."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            return False
+        executor.spin_once(timeout_sec=0.01)
+    return True
+
+
+def drain(executor, rounds=50):
+    """Deliver what is already queued (no waiting beyond a few empty spins)."""
+    for _ in range(rounds):
+        executor.spin_once(timeout_sec=0)
+
+
+class Probe:
+    """A node that records every message on the topics it is asked to watch."""
+
+    def __init__(self, context, executor, name='probe'):
+        self.node = rclpy.create_node(name, context=context)
+        executor.add_node(self.node)
+        self.messages = {}
+
+    def watch(self, msg_type, topic, qos=1000):
+        self.messages[topic] = []
+        self.node.create_subscription(msg_type, topic, self.messages[topic].append, qos)
+        return self.messages[topic]
+
+    def publisher(self, msg_type, topic):
+        return self.node.create_publisher(msg_type, topic, 10)
+
+    def call(self, executor, srv_type, name, request):
+        client = self.node.create_client(srv_type, name)
+        assert client.wait_for_service(timeout_sec=5.0), f'no service {name}'
+        future = client.call_async(request)
+        executor.spin_until_future_complete(future, timeout_sec=10.0)
+        return future.result()

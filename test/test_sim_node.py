@@ -1,0 +1,169 @@
+"""The simulator node in-process: MiRo's topics, simulated time, bad input, services.
+
+The world is stepped by the test (the node starts paused), never by wall-clock time.
+"""
+import math
+
+import cv2
+import numpy as np
+import pytest
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image, JointState
+from std_msgs.msg import Float32MultiArray, UInt16MultiArray, UInt32, UInt32MultiArray
+from std_srvs.srv import SetBool, Trigger
+
+from miro_ball.constants import UPSTREAM_FLAG_SIMULATOR
+from miro_sim_bullet.node import SimNode
+from rostools import Probe, drain, spin_until
+
+
+@pytest.fixture
+def sim_node(ros_context, executor):
+    node = SimNode(context=ros_context, parameter_overrides=[
+        Parameter('paused', value=True), Parameter('world', value='miro')])
+    executor.add_node(node)
+    yield node
+    executor.remove_node(node)
+    node.destroy_node()
+
+
+@pytest.fixture
+def probe(ros_context, executor):
+    return Probe(ros_context, executor)
+
+
+def seconds(stamp):
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def run(node, executor, sim_seconds, each_tick=None):
+    """Advance the world tick by tick, letting messages flow in between."""
+    for _ in range(round(sim_seconds / 0.02)):
+        if each_tick:
+            each_tick()
+        drain(executor, rounds=30)
+        node.advance(node.sim.ticks_per_platform_tick)
+
+
+def test_sensors_and_clock_follow_simulated_time(sim_node, probe, executor):
+    clock = probe.watch(Clock, '/clock')
+    odom = probe.watch(Odometry, '/miro/sensors/odom')
+    flags = probe.watch(UInt32, '/miro/sensors/flags')
+    cliff = probe.watch(Float32MultiArray, '/miro/sensors/cliff')
+    kin = probe.watch(JointState, '/miro/sensors/kinematic_joints')
+    spin_until(executor, lambda: sim_node.pub_odom.get_subscription_count() > 0)
+    run(sim_node, executor, 1.0)
+    assert spin_until(executor, lambda: len(odom) >= 50)
+    assert len(odom) == 50  # 50 Hz for 1 s of simulated time
+    times = [seconds(m.clock) for m in clock]
+    assert times == sorted(times) and times[-1] == pytest.approx(1.0)
+    assert seconds(odom[-1].header.stamp) == pytest.approx(1.0)
+    assert odom[-1].header.frame_id == 'odom' and odom[-1].child_frame_id == 'base_link'
+    assert flags[-1].data & UPSTREAM_FLAG_SIMULATOR
+    assert list(cliff[-1].data) == [1.0, 1.0]
+    assert list(kin[-1].name) == ['tilt', 'lift', 'yaw', 'pitch']
+    assert kin[-1].position[1] == pytest.approx(math.radians(34), abs=0.01)
+
+
+def test_cmd_vel_drives_the_robot(sim_node, probe, executor):
+    odom = probe.watch(Odometry, '/miro/sensors/odom')
+    cmd = probe.publisher(TwistStamped, '/miro/control/cmd_vel')
+    spin_until(executor, lambda: cmd.get_subscription_count() > 0)
+    twist = TwistStamped()
+    twist.twist.linear.x = 0.2
+    run(sim_node, executor, 2.0, each_tick=lambda: cmd.publish(twist))
+    spin_until(executor, lambda: odom and seconds(odom[-1].header.stamp) >= 2.0)
+    x = odom[-1].pose.pose.position.x
+    assert x == pytest.approx(0.4, abs=0.04)
+    assert sim_node.sim.robot_pose()[0] == pytest.approx(x, abs=1e-6)
+
+
+def test_bad_control_messages_are_ignored_with_rate_limited_warnings(sim_node, probe, executor):
+    warnings = []
+    sim_node.warn.log = warnings.append
+    publishers = {
+        'cmd': probe.publisher(TwistStamped, '/miro/control/cmd_vel'),
+        'kin': probe.publisher(JointState, '/miro/control/kinematic_joints'),
+        'cos': probe.publisher(Float32MultiArray, '/miro/control/cosmetic_joints'),
+        'illum': probe.publisher(UInt32MultiArray, '/miro/control/illum'),
+        'tone': probe.publisher(UInt16MultiArray, '/miro/control/tone'),
+    }
+    spin_until(executor, lambda: all(p.get_subscription_count() for p in publishers.values()))
+    before = (sim_node.sim.wheel_cmd, list(sim_node.sim.kin_targets), list(sim_node.sim.cosmetic))
+    nan_twist = TwistStamped()
+    nan_twist.twist.linear.x = float('nan')
+    inf_twist = TwistStamped()
+    inf_twist.twist.angular.z = float('inf')
+    garbage = [
+        ('cmd', nan_twist), ('cmd', inf_twist),
+        ('kin', JointState(position=[0.0, 0.5])), ('kin', JointState(position=[0.0] * 7)),
+        ('kin', JointState(position=[0.0, float('nan'), 0.0, 0.0])),
+        ('cos', Float32MultiArray(data=[0.5] * 5)),
+        ('cos', Float32MultiArray(data=[float('inf')] * 6)),
+        ('illum', UInt32MultiArray(data=[1, 2, 3])), ('tone', UInt16MultiArray(data=[440])),
+    ]
+    for _ in range(20):  # a flood
+        for key, msg in garbage:
+            publishers[key].publish(msg)
+    drain(executor, rounds=400)
+    assert (sim_node.sim.wheel_cmd, sim_node.sim.kin_targets, sim_node.sim.cosmetic) == before
+    assert 5 <= len(warnings) <= len(garbage)  # one line per kind, not one per message
+    # Finite out-of-range values are clamped, and the node keeps working.
+    huge = TwistStamped()
+    huge.twist.linear.x = 1e9
+    publishers['cmd'].publish(huge)
+    publishers['kin'].publish(JointState(position=[0.0, 10.0, -10.0, 0.0]))
+    spin_until(executor, lambda: sim_node.sim.wheel_cmd == (0.4, 0.4))
+    spin_until(executor, lambda: sim_node.sim.kin_targets[1] == pytest.approx(math.radians(60)))
+    assert sim_node.sim.kin_targets[2] == pytest.approx(math.radians(-55))
+    run(sim_node, executor, 0.2)
+    assert sim_node.sim.robot_pose()[0] > 0.02
+
+
+def test_reset_pause_and_step_services(sim_node, probe, executor):
+    initial = sim_node.sim.robot_pose()
+    sim_node.sim.set_cmd_vel(0.3, 0.5)
+    run(sim_node, executor, 1.0)
+    assert sim_node.sim.robot_pose() != pytest.approx(initial)
+    result = probe.call(executor, Trigger, '/miro_sim/reset', Trigger.Request())
+    assert result.success and sim_node.sim.time == 0.0
+    assert sim_node.sim.robot_pose() == pytest.approx(initial)
+    result = probe.call(executor, Trigger, '/miro_sim/step', Trigger.Request())
+    assert result.success and sim_node.sim.step_index == 20
+    result = probe.call(executor, SetBool, '/miro_sim/pause', SetBool.Request(data=False))
+    assert result.success and not sim_node.paused
+    refused = probe.call(executor, Trigger, '/miro_sim/step', Trigger.Request())
+    assert not refused.success
+
+
+def test_eye_cameras_publish_matching_stereo_frames(sim_node, probe, executor):
+    frames = {eye: probe.watch(CompressedImage, f'/miro/sensors/{eye}/compressed')
+              for eye in ('caml', 'camr')}
+    raw = probe.watch(Image, '/miro/sensors/caml')
+    info = probe.watch(CameraInfo, '/miro/sensors/camr/camera_info')
+    spin_until(executor, lambda: sim_node.pub_eyes['camr'][0].get_subscription_count() > 0
+               and sim_node.pub_eyes['caml'][1].get_subscription_count() > 0)
+    run(sim_node, executor, 1.0)
+    spin_until(executor, lambda: len(frames['camr']) >= 15 and len(raw) >= 15)
+    assert len(frames['caml']) == len(frames['camr']) == 15  # 15 Hz of simulated time
+    for left, right in zip(frames['caml'], frames['camr']):
+        assert left.header.stamp == right.header.stamp
+    image = cv2.imdecode(np.frombuffer(bytes(frames['camr'][-1].data), np.uint8),
+                         cv2.IMREAD_COLOR)
+    assert image.shape == (360, 640, 3)
+    last = raw[-1]
+    assert (last.encoding, last.width, last.height, last.step) == ('rgb8', 640, 360, 1920)
+    k = np.array(info[-1].k).reshape(3, 3)
+    assert k[0, 0] == pytest.approx(320 / math.tan(math.radians(60)))
+    assert k[0, 2] == pytest.approx(319.5) and k[1, 2] == pytest.approx(179.5)
+    # The ball at (0.6, -0.3) is to MiRo's right: blue in the right eye's JPEG.
+    blue = (image[:, :, 0] > 120) & (image[:, :, 1] < 80) & (image[:, :, 2] < 80)
+    assert blue.sum() > 200
+
+
+def test_cameras_render_only_while_subscribed(sim_node, executor):
+    run(sim_node, executor, 1.0)
+    assert sim_node.frames_published == 0
