@@ -1,0 +1,86 @@
+"""The eye images show the ball where MiRo's geometry and camera_info say they should."""
+import math
+
+import cv2
+import numpy as np
+import pytest
+
+from miro_ball.constants import LIFT_RAD_CALIB
+from miro_sim_bullet.rendering import Intrinsics, probe_egl
+from miro_sim_bullet.sim import MiroSim, project
+from miro_sim_bullet.world_file import load_world
+
+RENDERERS = ['tiny', pytest.param('egl', marks=pytest.mark.skipif(
+    not probe_egl()[0], reason='EGL unavailable: ' + probe_egl()[1]))]
+SMALL_BALL = 0.03  # small enough that its image centroid is its projected centre
+
+
+@pytest.fixture(params=RENDERERS)
+def sim(request, tmp_path):
+    path = tmp_path / 'small_ball.toml'
+    path.write_text(f'[ball]\nradius = {SMALL_BALL}\n[ground]\nheight = 0.0\n'
+                    'colour = [0.6, 0.6, 0.58]\n')
+    world = MiroSim(load_world(str(path)), renderer=request.param)
+    yield world
+    world.close()
+
+
+def test_eyes_sit_where_the_mdk_puts_them():
+    world = MiroSim('empty')
+    world.run(0.5)
+    pos, rot = world.eye_pose(+1)
+    assert pos == pytest.approx((0.115, 0.043, 0.219), abs=0.004)
+    axis = rot[:, 0]
+    assert math.degrees(math.asin(axis[2])) == pytest.approx(15.0, abs=1.0)
+    assert math.degrees(math.atan2(axis[1], axis[0])) == pytest.approx(28.0, abs=1.0)
+    assert world.read_sensors().kinematic_positions[1] == pytest.approx(LIFT_RAD_CALIB, abs=0.01)
+    world.close()
+
+
+def blue_centroid(rgb):
+    r, g, b = (rgb[:, :, i].astype(int) for i in range(3))
+    mask = (b > 100) & (r < 60) & (g < 60)
+    if mask.sum() < 5:
+        return None
+    v, u = np.nonzero(mask)
+    return u.mean(), v.mean()
+
+
+@pytest.mark.parametrize('size', [(640, 360), (320, 240), (1280, 720)])
+@pytest.mark.parametrize('ball_xy, seen_by', [
+    ((1.0, 0.0), {+1, -1}),   # dead ahead: both eyes
+    ((0.7, 0.7), {+1}),       # well to the left: left eye only
+    ((0.7, -0.7), {-1}),      # well to the right: right eye only
+    ((1.2, 0.3), {+1, -1}),
+])
+def test_ball_appears_where_the_pinhole_model_predicts(sim, size, ball_xy, seen_by):
+    intrinsics = Intrinsics.from_hfov(*size, 120.0)
+    sim.place(ball_xy=ball_xy)
+    sim.run(0.3)
+    centre = sim.ball_position()
+    for side in (+1, -1):
+        rgb = sim.render_eye(side, intrinsics)
+        assert rgb.shape == (size[1], size[0], 3)
+        found = blue_centroid(rgb)
+        pos, rot = sim.eye_pose(side)
+        predicted = project(intrinsics, pos, rot, centre)
+        inside = predicted is not None and 0 <= predicted[0] < size[0] and \
+            0 <= predicted[1] < size[1]
+        assert inside == (side in seen_by)
+        if side in seen_by:
+            assert found is not None
+            assert math.dist(found, predicted) < 2.0 * max(1.0, size[0] / 640)
+        else:
+            assert found is None
+
+
+def test_ball_is_blue_after_jpeg(sim):
+    intrinsics = Intrinsics.from_hfov(640, 360, 120.0)
+    sim.place(ball_xy=(1.0, 0.2))
+    sim.run(0.2)
+    rgb = sim.render_eye(+1, intrinsics)
+    ok, jpeg = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    bgr = cv2.imdecode(jpeg, cv2.IMREAD_COLOR)
+    u, v = (int(round(c)) for c in blue_centroid(rgb))
+    b, g, r = bgr[v, u]
+    assert b > 150 and g < 60 and r < 60
