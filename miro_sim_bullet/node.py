@@ -84,6 +84,7 @@ class SimNode(Node):
             f'{p["real_time_factor"]:g}')
         self.paused = p['paused']
         self.frames_published = 0
+        self.render_seconds = []  # wall time of each camera instant (both eyes)
         self._make_interface(p['robot_name'])
         self._restart_schedule()
         self._progress = (time.monotonic(), 0.0)
@@ -312,6 +313,8 @@ class SimNode(Node):
     def _publish_cameras(self):
         stamp = _stamp(self.sim.time)
         self.pub_clock.publish(ClockMsg(clock=stamp))
+        started = time.perf_counter()
+        rendered = 0
         for eye, side in EYES:
             compressed, raw, info = self.pub_eyes[eye]
             if not any(p.get_subscription_count() for p in (compressed, raw, info)):
@@ -331,7 +334,10 @@ class SimNode(Node):
                 msg.header.stamp, msg.header.frame_id = stamp, frame_id
                 raw.publish(msg)
             info.publish(self._camera_info(stamp, frame_id))
-            self.frames_published += 1
+            rendered += 1
+        if rendered:
+            self.frames_published += rendered
+            self.render_seconds.append(time.perf_counter() - started)
 
     def destroy_node(self):
         self.sim.close()

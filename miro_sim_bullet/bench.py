@@ -1,0 +1,114 @@
+"""Simulator benchmark: real-time factor, camera frames and render cost per renderer.
+
+Each renderer runs in its own process (so peak memory is its own) with the
+node free-running (as fast as possible) and a subscriber on both eyes' JPEG
+topics, as the controller would have. Figures are medians where it matters.
+"""
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import time
+
+from miro_sim_bullet.rendering import probe_egl
+
+
+def measure(renderer, sim_seconds, width, height, rate):
+    """Runs in the child process; returns a dict of figures."""
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import CompressedImage
+
+    from miro_sim_bullet.node import SimNode
+
+    context = Context()
+    rclpy.init(context=context, domain_id=int(os.environ.get('ROS_DOMAIN_ID', '0')))
+    node = SimNode(context=context, parameter_overrides=[
+        Parameter('paused', value=True), Parameter('renderer', value=renderer),
+        Parameter('frame_width', value=width), Parameter('frame_height', value=height),
+        Parameter('camera_rate', value=rate)])
+    listener = rclpy.create_node('bench_listener', context=context)
+    received = []
+    for eye in ('caml', 'camr'):
+        listener.create_subscription(CompressedImage, f'/miro/sensors/{eye}/compressed',
+                                     received.append, 10)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    executor.add_node(listener)
+    deadline = time.monotonic() + 10
+    while node.pub_eyes['camr'][0].get_subscription_count() == 0 and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.01)
+    node.advance(200)  # warm up
+    frames0, renders0 = len(received), len(node.render_seconds)
+    sim0, wall0 = node.sim.time, time.perf_counter()
+    while node.sim.time - sim0 < sim_seconds:
+        node.advance(node.sim.ticks_per_platform_tick)
+        for _ in range(10):
+            executor.spin_once(timeout_sec=0)
+    wall = time.perf_counter() - wall0
+    figures = {
+        'renderer': node.sim.renderer.name,
+        'real_time_factor': (node.sim.time - sim0) / wall,
+        'frames_per_wall_s': (len(received) - frames0) / wall,
+        'frames_per_sim_s': (len(received) - frames0) / (node.sim.time - sim0),
+        'ms_per_stereo_frame': 1000 * statistics.median(node.render_seconds[renders0:]),
+        'peak_rss_mb': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+    }
+    node.destroy_node()
+    listener.destroy_node()
+    rclpy.try_shutdown(context=context)
+    return figures
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog='python -m miro_sim_bullet.bench', description=__doc__)
+    parser.add_argument('--seconds', type=float, default=10.0, help='simulated seconds per run')
+    parser.add_argument('--runs', type=int, default=3, help='runs per renderer (median shown)')
+    parser.add_argument('--size', default='640x360', help='eye frame size (default 640x360)')
+    parser.add_argument('--rate', type=float, default=15.0, help='camera rate (default 15 Hz)')
+    parser.add_argument('--one', help=argparse.SUPPRESS)  # child process: one renderer
+    args = parser.parse_args(argv)
+    try:
+        width, height = (int(v) for v in args.size.lower().split('x'))
+    except ValueError:
+        parser.error(f'--size must look like 640x360, got {args.size!r}')
+    if args.one:
+        print(json.dumps(measure(args.one, args.seconds, width, height, args.rate)))
+        return
+    renderers = ['tiny'] + (['egl'] if probe_egl()[0] else [])
+    if 'egl' not in renderers:
+        print(f'EGL unavailable ({probe_egl()[1]}): measuring TinyRenderer only')
+    env = dict(os.environ, ROS_DOMAIN_ID=str(1 + os.getpid() % 100),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    print(f'simulator benchmark: {width}x{height} @ {args.rate:g} Hz, both eyes subscribed, '
+          f'{args.seconds:g} simulated s x {args.runs} runs per renderer, free-running')
+    header = (f'{"renderer":<34} {"real-time factor":>16} {"frames/s (wall)":>15} '
+              f'{"ms/stereo frame":>15} {"peak MB":>8}')
+    print(header)
+    print('-' * len(header))
+    for renderer in renderers:
+        runs = []
+        for _ in range(args.runs):
+            out = subprocess.run(
+                [sys.executable, '-m', 'miro_sim_bullet.bench', '--one', renderer,
+                 '--seconds', str(args.seconds), '--size', args.size, '--rate', str(args.rate)],
+                env=env, capture_output=True, text=True, check=False)
+            lines = [ln for ln in out.stdout.splitlines() if ln.startswith('{')]
+            if out.returncode or not lines:
+                print(f'{renderer}: run failed: {out.stderr.strip().splitlines()[-1:]}')
+                break
+            runs.append(json.loads(lines[-1]))
+        if runs:
+            med = {k: statistics.median(r[k] for r in runs) for k in runs[0] if k != 'renderer'}
+            print(f'{runs[0]["renderer"]:<34} {med["real_time_factor"]:>16.2f} '
+                  f'{med["frames_per_wall_s"]:>15.1f} {med["ms_per_stereo_frame"]:>15.1f} '
+                  f'{med["peak_rss_mb"]:>8.0f}')
+
+
+if __name__ == '__main__':
+    main()
