@@ -12,9 +12,10 @@ import sys
 import time
 
 import cv2
+import numpy as np
 import rclpy
 from builtin_interfaces.msg import Time
-from geometry_msgs.msg import Pose2D, Twist, TwistStamped
+from geometry_msgs.msg import PointStamped, Pose2D, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
@@ -48,7 +49,12 @@ PARAMETERS = (
     ('hfov_deg', 120.0, 'eye camera horizontal field of view (pinhole)'),
     ('renderer', 'auto', 'auto | tiny | egl'),
     ('jpeg_quality', 80, 'JPEG quality of sensors/cam?/compressed'),
+    ('overhead_rate', 0.0, 'frames per simulated second of ~/overhead/compressed; 0 = off'),
 )
+OVERHEAD = Intrinsics.from_hfov(480, 480, 50.0)
+# Looking straight down from 3 m: image up is world +x, image left is world +y.
+OVERHEAD_POSE = (np.array([0.0, 0.0, 3.0]),
+                 np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]))
 
 
 def _stamp(seconds):
@@ -120,6 +126,9 @@ class SimNode(Node):
         self.pub_light = pub(Float32MultiArray, 'sensors/light')
         self.pub_touch = (pub(UInt16, 'sensors/touch_head'), pub(UInt16, 'sensors/touch_body'))
         self.pub_flags = pub(UInt32, 'sensors/flags')
+        # Ground truth and the overhead view belong to the simulator, not to MiRo.
+        self.pub_ball = self.create_publisher(PointStamped, '~/ball', 10)
+        self.pub_overhead = self.create_publisher(CompressedImage, '~/overhead/compressed', 2)
         self.subs = [
             sub(TwistStamped, 'control/cmd_vel', self._on_cmd_vel),
             sub(JointState, 'control/kinematic_joints', self._on_kinematic),
@@ -213,6 +222,7 @@ class SimNode(Node):
         self._anchor = (time.monotonic(), self.sim.time)
         if not keep_time:
             self._next_frame = 0
+            self._next_overhead = 0.0
 
     def _frame_step(self, index):
         return round(index / self.params['camera_rate'] / self.sim.dt)
@@ -255,6 +265,10 @@ class SimNode(Node):
                 self._publish_cameras()
                 while self._frame_step(self._next_frame) <= sim.step_index:
                     self._next_frame += 1
+            rate = self.params['overhead_rate']
+            if rate > 0 and sim.time >= self._next_overhead:
+                self._publish_overhead()
+                self._next_overhead += 1.0 / rate
 
     # -- publishing -------------------------------------------------------------------------
     def _publish_tick(self):
@@ -300,6 +314,12 @@ class SimNode(Node):
         for pub in self.pub_touch:
             pub.publish(UInt16(data=0))
         self.pub_flags.publish(UInt32(data=UPSTREAM_FLAG_SIMULATOR))
+        ball = self.sim.ball_position()
+        if ball is not None:
+            point = PointStamped()
+            point.header.stamp, point.header.frame_id = stamp, 'world'
+            point.point.x, point.point.y, point.point.z = ball
+            self.pub_ball.publish(point)
 
     def _camera_info(self, stamp, frame_id):
         k = self.intrinsics
@@ -309,6 +329,18 @@ class SimNode(Node):
                           p=[v for row in k.P() for v in row])
         info.header.stamp, info.header.frame_id = stamp, frame_id
         return info
+
+    def _jpeg(self, rgb, stamp, frame_id):
+        ok, jpeg = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR),
+                                [cv2.IMWRITE_JPEG_QUALITY, self.params['jpeg_quality']])
+        msg = CompressedImage(format='rgb8; jpeg compressed bgr8', data=jpeg.tobytes())
+        msg.header.stamp, msg.header.frame_id = stamp, frame_id
+        return msg
+
+    def _publish_overhead(self):
+        if self.pub_overhead.get_subscription_count():
+            rgb = self.sim.render_view(*OVERHEAD_POSE, OVERHEAD)
+            self.pub_overhead.publish(self._jpeg(rgb, _stamp(self.sim.time), 'overhead'))
 
     def _publish_cameras(self):
         stamp = _stamp(self.sim.time)
@@ -322,11 +354,7 @@ class SimNode(Node):
             frame_id = f'{eye}_optical_frame'
             rgb = self.sim.render_eye(side, self.intrinsics)
             if compressed.get_subscription_count():
-                ok, jpeg = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR),
-                                        [cv2.IMWRITE_JPEG_QUALITY, self.params['jpeg_quality']])
-                msg = CompressedImage(format='rgb8; jpeg compressed bgr8', data=jpeg.tobytes())
-                msg.header.stamp, msg.header.frame_id = stamp, frame_id
-                compressed.publish(msg)
+                compressed.publish(self._jpeg(rgb, stamp, frame_id))
             if raw.get_subscription_count():
                 h, w = rgb.shape[:2]
                 msg = Image(height=h, width=w, encoding='rgb8', is_bigendian=0, step=3 * w,

@@ -349,8 +349,11 @@ class MiroSim:
 
     def render_eye(self, side, intrinsics):
         """RGB image (h, w, 3) of one eye now."""
-        pos, rot = self.eye_pose(side)
-        return self.renderer.render(view_matrix_from_pose(pos, rot), intrinsics)
+        return self.render_view(*self.eye_pose(side), intrinsics)
+
+    def render_view(self, position, rotation, intrinsics):
+        """RGB image from any camera pose (x forward, y left, z up)."""
+        return self.renderer.render(view_matrix_from_pose(position, rotation), intrinsics)
 
 
 def project(intrinsics: Intrinsics, cam_pos, cam_rot, point):

@@ -1,0 +1,335 @@
+"""Kick-the-ball behaviours as pure state machines (no rclpy).
+
+Each tick the controller calls ``step(t, left, right, cliff)`` with the time in
+seconds (monotonic), the latest fresh detection of each eye (a detection.Ball or
+None) and the latest fresh cliff reading ([left, right], 1 = floor, or None when
+unknown). It gets back a Command: wheel speeds in m/s, the state name and the
+messages to log for behaviour changes that happened during the tick.
+"""
+import math
+import random
+from dataclasses import dataclass, field
+from typing import NamedTuple, Optional, Sequence, Tuple
+
+from miro_ball.constants import (CAM_DIVERGENCE_RAD, CAM_HFOV_DEG_SIM, CLIFF_THRESHOLD,
+                                 WHEEL_MAX_SPEED_M_PER_S)
+from miro_ball.kinematics import cmd_vel2wheel_speed, wheel_speed2cmd_vel
+
+SEARCH, LOCK_ON, KICK = 'search', 'lock_on', 'kick'
+APPROACH, EXPLORE, AVOID = 'approach', 'explore', 'avoid_cliff'
+
+MESSAGES = {
+    SEARCH: 'looking for the ball',
+    LOCK_ON: 'locking on to the ball',
+    APPROACH: 'ball seen, approaching it',
+    KICK: 'kicking the ball',
+    EXPLORE: 'nothing in a full turn, exploring',
+    AVOID: 'edge ahead, backing away from it',
+}
+LOST = 'lost the ball'
+
+_TAN_HALF_HFOV = math.tan(math.radians(CAM_HFOV_DEG_SIM) / 2)
+
+
+@dataclass(frozen=True)
+class BehaviourParams:
+    """Tutorial numbers first; the rest tune the improved mode."""
+
+    slow: float = field(default=0.1, metadata={'help': 'wheel speed for turning on the spot, m/s'})
+    fast: float = field(default=0.4, metadata={'help': 'wheel speed of the kick, m/s'})
+    fine: float = field(default=0.03, metadata={'help': 'wheel speed of fine centring, m/s'})
+    centre_error: float = field(
+        default=0.05, metadata={'help': 'tutorial: centred when ||left x| - |right x|| <= this'})
+    kick_duration: float = field(default=2.0, metadata={'help': 'length of a kick, s'})
+    cliff_threshold: float = field(
+        default=CLIFF_THRESHOLD, metadata={'help': 'improved: cliff reading below this = drop'})
+    seed: int = field(default=0, metadata={'help': 'improved: seed of the exploration RNG'})
+    approach_speed: float = field(
+        default=0.2, metadata={'help': 'improved: forward speed while approaching, m/s'})
+    steer_gain: float = field(
+        default=3.0, metadata={'help': 'improved: turn rate per rad of ball bearing, 1/s'})
+    turn_only_deg: float = field(
+        default=45.0, metadata={'help': 'improved: turn on the spot beyond this bearing, deg'})
+    kick_bearing_deg: float = field(
+        default=5.0, metadata={'help': 'improved: kick when the bearing is within this, deg'})
+    kick_radius: float = field(
+        default=0.05, metadata={'help': 'improved: kick when ball r / width reaches this'})
+    search_turn_deg: float = field(
+        default=360.0, metadata={'help': 'improved: turn this far before exploring, deg'})
+    explore_distance: float = field(
+        default=0.3, metadata={'help': 'improved: longest exploratory drive, m'})
+    backoff_s: float = field(
+        default=1.0, metadata={'help': 'improved: reverse this long away from an edge, s'})
+
+    def __post_init__(self):
+        speeds = (self.slow, self.fast, self.fine, self.approach_speed)
+        if not all(0 < v <= WHEEL_MAX_SPEED_M_PER_S for v in speeds):
+            raise ValueError('slow, fast, fine and approach_speed must be in (0, %g] m/s'
+                             % WHEEL_MAX_SPEED_M_PER_S)
+        positive = (self.centre_error, self.kick_duration, self.steer_gain, self.turn_only_deg,
+                    self.kick_bearing_deg, self.kick_radius, self.search_turn_deg,
+                    self.explore_distance, self.backoff_s)
+        if not all(v > 0 for v in positive):
+            raise ValueError('durations, distances, angles, gains and thresholds must be > 0')
+
+
+class Command(NamedTuple):
+    left: float  # wheel speeds, m/s
+    right: float
+    state: str
+    messages: Tuple[str, ...] = ()
+
+
+def eye_bearing(x, eye_azimuth):
+    """Bearing (rad, + = left of the robot) of an image column x (+ = right, /width).
+
+    The simulator's eyes are pinhole cameras, so the angle off the optical axis
+    is atan(2 x tan(hfov / 2)); the eye's own azimuth (+27 deg left, -27 right)
+    is added. Elevation and the eyes' lateral offset are ignored: the error is a
+    few degrees and the steering closes the loop anyway.
+    """
+    return eye_azimuth - math.atan(2.0 * x * _TAN_HALF_HFOV)
+
+
+def ball_bearing(left, right) -> Optional[float]:
+    """Mean bearing from the eyes that see the ball, or None if neither does."""
+    bearings = []
+    if left is not None:
+        bearings.append(eye_bearing(left.x, CAM_DIVERGENCE_RAD))
+    if right is not None:
+        bearings.append(eye_bearing(right.x, -CAM_DIVERGENCE_RAD))
+    return sum(bearings) / len(bearings) if bearings else None
+
+
+def fit_to_limit(left, right, limit=WHEEL_MAX_SPEED_M_PER_S):
+    """Scale both wheels down together so neither exceeds the limit (keeps the curve)."""
+    top = max(abs(left), abs(right))
+    if top <= limit:
+        return left, right
+    return left * limit / top, right * limit / top
+
+
+def spin(direction, speed):
+    """Wheel speeds to turn on the spot: direction +1 = counter-clockwise (left)."""
+    return -direction * speed, direction * speed
+
+
+class _Machine:
+    """Shared bookkeeping: the state name and the messages of this tick."""
+
+    def __init__(self, params: BehaviourParams):
+        self.params = params
+        self.state = None
+        self._said = []
+
+    def _go(self, state, *extra):
+        self._said.extend(extra)
+        self._said.append(MESSAGES[state])
+        self.state = state
+
+    def step(self, t, left, right, cliff=None) -> Command:
+        self._said = []
+        if self.state is None:
+            self._go(SEARCH)
+        wheels = self._decide(t, left, right, cliff)
+        return Command(wheels[0], wheels[1], self.state, tuple(self._said))
+
+    def _decide(self, t, left, right, cliff):
+        raise NotImplementedError
+
+
+class TutorialBehaviour(_Machine):
+    """search -> lock_on -> kick as taught; blind to cliffs.
+
+    Every tick yields a command: a state change takes effect in the same tick
+    rather than skipping one, and the kick is timed in seconds, not loop counts.
+    """
+
+    def _decide(self, t, left, right, cliff):
+        p = self.params
+        if self.state == SEARCH:
+            if left is None and right is None:
+                return p.slow, -p.slow
+            self._go(LOCK_ON)
+        if self.state == LOCK_ON:
+            wheels = self._lock_on(t, left, right)
+            if wheels is not None:
+                return wheels
+        if self.state == KICK:
+            if t - self._kick_start < p.kick_duration:
+                return p.fast, p.fast
+            self._go(SEARCH)
+        return p.slow, -p.slow
+
+    def _lock_on(self, t, left, right):
+        """Turn to centre the ball; None once the state has moved on."""
+        p = self.params
+        if left is None and right is None:
+            self._go(SEARCH, LOST)
+            return None
+        if left is None:
+            return spin(-1, p.slow)
+        if right is None:
+            return spin(1, p.slow)
+        error = abs(left.x) - abs(right.x)
+        if error > p.centre_error:
+            return spin(-1, p.fine)
+        if error < -p.centre_error:
+            return spin(1, p.fine)
+        self._kick_start = t
+        self._go(KICK)
+        return None
+
+
+class Manoeuvre:
+    """Open-loop wheel-speed segments (left, right, seconds) played back to back."""
+
+    def __init__(self, t, segments):
+        self.segments = []
+        for left, right, seconds in segments:
+            self.segments.append((t, t + seconds, left, right))
+            t += seconds
+
+    def at(self, t):
+        """(left, right) for time t, or None when the manoeuvre is over."""
+        for start, end, left, right in self.segments:
+            if t < end:
+                return left, right
+        return None
+
+
+class ImprovedBehaviour(_Machine):
+    """The tutorial's three exercises.
+
+    1. The side the ball was last seen on sets the search direction.
+    2. After a full fruitless turn, a random turn and short drive for a new view;
+       never forward over an edge (a cliff reading is required to explore, and a
+       drop seen while moving forward triggers back-off-and-turn-away).
+    3. One approach that steers by the ball's bearing while driving, speeding up
+       into the kick once the ball is centred and close.
+    """
+
+    def __init__(self, params: BehaviourParams):
+        super().__init__(params)
+        self.rng = random.Random(params.seed)
+        self.side = -1  # -1 right, +1 left; the tutorial's default search is clockwise
+        self.turned = 0.0
+        self._last_t = None
+        self._manoeuvre = None
+        self._kick_start = None
+
+    @property
+    def _spin_rate(self):
+        return wheel_speed2cmd_vel(spin(1, self.params.slow))[1]
+
+    def _decide(self, t, left, right, cliff):
+        dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
+        self._last_t = t
+        bearing = ball_bearing(left, right)
+        if bearing is not None:
+            self.side = 1 if bearing > 0 else -1
+        closest = max((b.r for b in (left, right) if b is not None), default=0.0)
+        wheels = self._by_state(t, dt, bearing, closest, cliff)
+        drops = self._drops(cliff)
+        if any(drops) and sum(wheels) > 0:
+            wheels = self._avoid(t, drops)
+        return fit_to_limit(*wheels)
+
+    def _by_state(self, t, dt, bearing, closest, cliff):
+        if self.state == AVOID:  # the ball waits until we are clear of the edge
+            wheels = self._manoeuvre.at(t)
+            if wheels is not None:
+                return wheels
+            self._start_search()
+        if self.state == KICK:
+            if t - self._kick_start < self.params.kick_duration:
+                return self._kick(bearing)
+            self._start_search()
+        if self.state in (SEARCH, EXPLORE) and bearing is not None:
+            self._go(APPROACH)
+        if self.state == APPROACH:
+            if bearing is None:
+                self._start_search(LOST)
+            elif (closest >= self.params.kick_radius
+                  and abs(bearing) <= math.radians(self.params.kick_bearing_deg)):
+                self._kick_start = t
+                self._go(KICK)
+                return self._kick(bearing)
+            else:
+                return self._steer(self.params.approach_speed, bearing, taper=True)
+        if self.state == EXPLORE:
+            wheels = self._manoeuvre.at(t)
+            if wheels is not None and sum(wheels) > 0 and cliff is None:
+                wheels = None  # no cliff reading: never drive blind
+            if wheels is not None:
+                return wheels
+            self._start_search()
+        return self._search(dt)
+
+    def _kick(self, bearing):
+        """Full speed, still steering while the ball is in view."""
+        return self._steer(self.params.fast, 0.0 if bearing is None else bearing, taper=False)
+
+    def _search(self, dt):
+        self.turned += abs(self._spin_rate) * dt
+        if self.turned >= math.radians(self.params.search_turn_deg):
+            return self._explore()
+        return spin(self.side, self.params.slow)
+
+    def _start_search(self, *extra):
+        self.turned = 0.0
+        self._go(SEARCH, *extra)
+
+    def _steer(self, speed, bearing, taper):
+        """Drive at speed while turning towards the bearing.
+
+        With taper, forward speed falls to zero as the bearing grows to
+        turn_only_deg, so a ball far to the side is faced before it is chased.
+        """
+        p = self.params
+        rate_limit = abs(self._spin_rate)
+        rate = max(-rate_limit, min(rate_limit, p.steer_gain * bearing))
+        if taper:
+            speed *= max(0.0, 1.0 - abs(bearing) / math.radians(p.turn_only_deg))
+        return cmd_vel2wheel_speed(speed, rate)
+
+    def _turn_for(self, direction, angle):
+        """A spin segment turning `angle` rad towards direction at the search speed."""
+        return spin(direction, self.params.slow) + (angle / abs(self._spin_rate),)
+
+    def _explore(self):
+        p = self.params
+        t = self._last_t
+        turn = self._turn_for(self.rng.choice((-1, 1)), self.rng.uniform(math.pi / 4, math.pi))
+        distance = self.rng.uniform(0.5, 1.0) * p.explore_distance
+        drive = (p.approach_speed, p.approach_speed, distance / p.approach_speed)
+        self._manoeuvre = Manoeuvre(t, [turn, drive])
+        self._go(EXPLORE)
+        return self._manoeuvre.at(t)
+
+    def _avoid(self, t, drops):
+        """Back off, then turn away from the side that saw the drop."""
+        p = self.params
+        if drops[0] and drops[1]:
+            away = self.rng.choice((-1, 1))
+        else:
+            away = -1 if drops[0] else 1
+        back = (-p.slow, -p.slow, p.backoff_s)
+        turn = self._turn_for(away, self.rng.uniform(math.pi / 2, math.pi))
+        self._manoeuvre = Manoeuvre(t, [back, turn])
+        self._go(AVOID)
+        return self._manoeuvre.at(t)
+
+    def _drops(self, cliff: Optional[Sequence[float]]):
+        if cliff is None:
+            return (False, False)
+        return tuple(v < self.params.cliff_threshold for v in cliff)
+
+
+MODES = {'tutorial': TutorialBehaviour, 'improved': ImprovedBehaviour}
+
+
+def make_behaviour(mode: str, params: BehaviourParams):
+    if mode not in MODES:
+        raise ValueError("mode must be one of %s, not '%s'" % (', '.join(MODES), mode))
+    return MODES[mode](params)

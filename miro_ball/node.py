@@ -1,0 +1,354 @@
+"""kick_blue_ball for ROS 2: find the blue ball with both eyes and kick it.
+
+The node decodes each eye's JPEG itself, runs the detector on it, and on every
+control tick (node clock, so simulated time when use_sim_time is set) feeds the
+freshest detections and cliff reading to the chosen behaviour, publishing the
+resulting wheel speeds as a TwistStamped.
+"""
+import argparse
+import math
+import os
+import signal
+import sys
+import time
+from collections import Counter
+from functools import partial
+
+import cv2
+import numpy as np
+import rclpy
+from geometry_msgs.msg import TwistStamped
+from rclpy.clock import JumpThreshold
+from rclpy.duration import Duration
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
+from rclpy.utilities import remove_ros_args
+from sensor_msgs.msg import CompressedImage, JointState
+from std_msgs.msg import Float32MultiArray
+
+from miro_ball import params
+from miro_ball.behaviour import BehaviourParams, make_behaviour
+from miro_ball.constants import FRAME_SIZES, JOINT_NAMES, topic
+from miro_ball.detection import annotate, BallDetector, DetectionParams
+from miro_ball.kinematics import clamp_wheel_speeds, finite, wheel_speed2cmd_vel
+
+NODE_NAME = 'kick_blue_ball'
+EYES = ('caml', 'camr')  # index 0 is the left eye, as the MDK's CAM_L
+STARTUP = 'startup'
+WARN_EVERY_S = 5.0
+
+# Newest frame only: a late frame is worth less than none (like queue_size=1).
+# Best effort matches both reliable and best-effort publishers.
+SENSOR_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+DEBUG_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+
+
+def topics(robot_name):
+    """(topic, type, direction, purpose) of everything the node uses."""
+    def t(name):
+        return topic(robot_name, name)
+    return [
+        (t('sensors/caml/compressed'), 'sensor_msgs/CompressedImage', 'in', 'left eye, JPEG'),
+        (t('sensors/camr/compressed'), 'sensor_msgs/CompressedImage', 'in', 'right eye, JPEG'),
+        (t('sensors/cliff'), 'std_msgs/Float32MultiArray', 'in', '[L, R], 1 floor, <0.7 drop'),
+        (t('control/cmd_vel'), 'geometry_msgs/TwistStamped', 'out', 'every tick'),
+        (t('control/kinematic_joints'), 'sensor_msgs/JointState', 'out', 'head pose at start'),
+        (t(NODE_NAME + '/debug/caml/compressed'), 'sensor_msgs/CompressedImage', 'out',
+         'annotated, only while subscribed'),
+        (t(NODE_NAME + '/debug/camr/compressed'), 'sensor_msgs/CompressedImage', 'out',
+         'annotated, only while subscribed'),
+    ]
+
+
+class Latest:
+    """The newest value of one input and the node time it arrived."""
+
+    def __init__(self):
+        self.clear()
+
+    def clear(self):
+        self.value, self.stamp = None, None
+
+    def set(self, stamp, value):
+        self.value, self.stamp = value, stamp
+
+    def fresh(self, now, max_age):
+        """The value if it is at most max_age old, else None."""
+        if self.stamp is None or now - self.stamp > max_age:
+            return None
+        return self.value
+
+
+class Warnings:
+    """Warnings rate-limited per kind (rclpy's throttle is per call site, not per kind)."""
+
+    def __init__(self, logger, period_s):
+        self.logger, self.period_s = logger, period_s
+        self._last = {}
+        self._skipped = Counter()
+
+    def __call__(self, kind, text):
+        now = time.monotonic()
+        if kind in self._last and now - self._last[kind] < self.period_s:
+            self._skipped[kind] += 1
+            return
+        if self._skipped[kind]:
+            text += ' (%d more like this since the last report)' % self._skipped.pop(kind)
+        self._last[kind] = now
+        self.logger.warning(text)
+
+
+class KickBlueBall(Node):
+    """The controller. Attributes for tests and embedding:
+
+    state             behaviour state name ('startup' while holding the head)
+    frames_processed  camera frames decoded and run through the detector
+    rejected          Counter of ignored inputs by kind (empty, corrupt, size, cliff)
+    last_command      (left, right) wheel speeds of the latest twist, m/s
+    detector, behaviour, config (ControllerParams)
+    """
+
+    def __init__(self, *, context=None, parameter_overrides=None, save_debug=None):
+        super().__init__(NODE_NAME, context=context,
+                         parameter_overrides=list(parameter_overrides or []))
+        self.config = params.declare(self, params.ControllerParams)
+        self.detector = BallDetector(params.declare(self, DetectionParams))
+        self._behaviour_params = params.declare(self, BehaviourParams)
+        self.save_debug = save_debug
+        self.frames_processed = 0
+        self.rejected = Counter()
+        self.last_command = None
+        self.state = STARTUP
+        self._warn = Warnings(self.get_logger(), WARN_EVERY_S)
+        self.balls = [Latest() for _ in EYES]
+        self.cliff = Latest()
+        self._restart()
+
+        name = self.config.robot_name
+        for eye, cam in enumerate(EYES):
+            self.create_subscription(CompressedImage, topic(name, 'sensors/%s/compressed' % cam),
+                                     partial(self._on_image, eye), SENSOR_QOS)
+        self.create_subscription(Float32MultiArray, topic(name, 'sensors/cliff'),
+                                 self._on_cliff, SENSOR_QOS)
+        self.pub_twist = self.create_publisher(TwistStamped, topic(name, 'control/cmd_vel'), 10)
+        self.pub_joints = self.create_publisher(
+            JointState, topic(name, 'control/kinematic_joints'), 10)
+        self.pub_debug = [
+            self.create_publisher(CompressedImage,
+                                  topic(name, '%s/debug/%s/compressed' % (NODE_NAME, cam)),
+                                  DEBUG_QOS)
+            for cam in EYES]
+        self.timer = self.create_timer(self.config.tick, self._on_tick)
+        # A restarted simulator sends /clock backwards; rcl versions differ in
+        # whether a ROS-time timer then waits for the old timeline to come back.
+        self._jump_handle = self.get_clock().create_jump_callback(
+            JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-1),
+                          on_clock_change=False),
+            post_callback=lambda jump: self.timer.reset())
+        self.get_logger().info("mode '%s', robot '%s', tick %g s"
+                               % (self.config.mode, name, self.config.tick))
+
+    def _restart(self):
+        """Start afresh: new behaviour, head hold, no percepts (also after time went back)."""
+        self.behaviour = make_behaviour(self.config.mode, self._behaviour_params)
+        self._started = None
+        self._last_tick = None
+        for latest in self.balls + [self.cliff]:
+            latest.clear()
+
+    def _seconds(self):
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    # Inputs ----------------------------------------------------------------
+
+    def _reject(self, kind, text):
+        self.rejected[kind] += 1
+        self._warn(kind, text + ', ignored')
+
+    def _decode(self, cam, msg):
+        """BGR frame of a CompressedImage, or None (and a warning) if unusable."""
+        if len(msg.data) == 0:
+            return self._reject('empty', '%s: empty image message' % cam)
+        try:
+            frame = cv2.imdecode(np.frombuffer(msg.data, np.uint8), cv2.IMREAD_COLOR)
+        except cv2.error:
+            frame = None
+        if frame is None:
+            return self._reject('corrupt', '%s: undecodable image (%d bytes, format %r)'
+                                % (cam, len(msg.data), msg.format))
+        height, width = frame.shape[:2]
+        if (width, height) not in FRAME_SIZES:
+            return self._reject('size', '%s: frame %dx%d is not a MiRo frame size (%s)' % (
+                cam, width, height, ', '.join('%dx%d' % s for s in FRAME_SIZES)))
+        return frame
+
+    def _on_image(self, eye, msg):
+        now = self._seconds()
+        frame = self._decode(EYES[eye], msg)
+        if frame is None:
+            return
+        ball = self.detector.detect(frame)
+        self.frames_processed += 1
+        self.balls[eye].set(now, ball)
+        self._debug_image(eye, msg.header, frame, ball)
+
+    def _on_cliff(self, msg):
+        data = tuple(msg.data)
+        if len(data) != 2 or not finite(*data) or not all(0.0 <= v <= 1.0 for v in data):
+            shown = data if len(data) <= 4 else '%d values' % len(data)
+            return self._reject('cliff', 'cliff reading %s is not [left, right] in 0..1'
+                                % (shown,))
+        self.cliff.set(self._seconds(), data)
+
+    def _debug_image(self, eye, header, frame, ball):
+        """Annotated frame to the debug topic (if anyone listens) and to --save-debug."""
+        pub = self.pub_debug[eye]
+        listened = pub.get_subscription_count() > 0
+        if not (listened or self.save_debug):
+            return
+        ok, jpeg = cv2.imencode('.jpg', annotate(frame, ball))
+        if not ok:
+            return self._warn('debug', 'could not encode a debug image')
+        if listened:
+            pub.publish(CompressedImage(header=header, format='jpeg', data=jpeg.tobytes()))
+        if self.save_debug:
+            path = os.path.join(self.save_debug,
+                                '%s_%06d.jpg' % (EYES[eye], self.frames_processed))
+            try:
+                with open(path, 'wb') as out:
+                    out.write(jpeg.tobytes())
+            except OSError as err:
+                self._warn('save', 'cannot save debug image: %s' % err)
+
+    # Control ---------------------------------------------------------------
+
+    def _on_tick(self):
+        now = self._seconds()
+        if self._last_tick is not None and now < self._last_tick:
+            self.get_logger().warning('clock went back %.3f s (simulator restart?): starting over'
+                                      % (self._last_tick - now))
+            self._restart()
+        self._last_tick = now
+        if self._started is None:
+            self._started = now
+            self.get_logger().info('holding the head pose for %g s' % self.config.head_hold_s)
+        if now - self._started < self.config.head_hold_s:
+            self.state = STARTUP
+            self._publish_head()
+            self.drive(0.0, 0.0)
+            return
+        self._check_silence(now)
+        stale = self.config.stale_s
+        left, right = (latest.fresh(now, stale) for latest in self.balls)
+        command = self.behaviour.step(now, left, right, self.cliff.fresh(now, stale))
+        for message in command.messages:
+            self.get_logger().info(message)
+        self.state = command.state
+        self.drive(command.left, command.right)
+
+    def _check_silence(self, now):
+        """Warn about inputs that stopped (or never started) arriving."""
+        stale = self.config.stale_s
+        for kind, latest in list(zip(EYES, self.balls)) + [('cliff', self.cliff)]:
+            since = latest.stamp if latest.stamp is not None else self._started
+            if now - since > stale:
+                self._warn('silent ' + kind, 'nothing on %s for %.1f s%s' % (
+                    kind, now - since, '' if kind in EYES else ' (exploration stays on the spot)'))
+
+    def _publish_head(self):
+        msg = JointState(name=list(JOINT_NAMES),
+                         position=[0.0, math.radians(self.config.head_lift_deg), 0.0, 0.0])
+        msg.header.stamp = self.get_clock().now().to_msg()
+        self.pub_joints.publish(msg)
+
+    def drive(self, left, right):
+        """Publish wheel speeds (m/s) as a TwistStamped through the MDK's formula."""
+        left, right = clamp_wheel_speeds(left, right)
+        linear, angular = wheel_speed2cmd_vel((left, right))
+        msg = TwistStamped()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = 'base_link'
+        msg.twist.linear.x = float(linear)
+        msg.twist.angular.z = float(angular)
+        self.pub_twist.publish(msg)
+        self.last_command = (left, right)
+
+    def stop(self, timeout_s=0.5):
+        """Send a zero twist and give it a moment to leave (used on shutdown)."""
+        self.drive(0.0, 0.0)
+        self.pub_twist.wait_for_all_acked(Duration(seconds=timeout_s))
+
+
+# Command line --------------------------------------------------------------
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        self.exit(2, '%s: error: %s (try --help)\n' % (self.prog, message))
+
+
+def build_parser():
+    rows = params.table()
+    width = max(len(name) for name, _, _ in rows)
+    lines = ['parameters (--ros-args -p name:=value):']
+    lines += ['  %-*s  %-14s %s' % (width, name, default, text) for name, default, text in rows]
+    lines += ['', 'topics (robot_name %s):' % params.ControllerParams().robot_name]
+    lines += ['  %-3s %s  [%s] %s' % (way, name, kind, what)
+              for name, kind, way, what in topics(params.ControllerParams().robot_name)]
+    parser = _Parser(
+        prog='kick_blue_ball',
+        description='MiRo-E kick_blue_ball controller for ROS 2: finds the blue ball with '
+                    'both eyes and kicks it. Ctrl+C stops it with a zero twist.',
+        epilog='\n'.join(lines), formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('--save-debug', metavar='DIR',
+                        help='write every annotated camera frame to DIR as JPEG')
+    return parser
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def _fail(parser, err):
+    """Exit 2 with the first line of an error: no traceback for bad user input."""
+    first_line = (str(err).strip().splitlines() or [type(err).__name__])[0]
+    parser.exit(2, '%s: error: %s\n' % (parser.prog, first_line))
+
+
+def main(argv=None):
+    argv = list(sys.argv if argv is None else argv)
+    parser = build_parser()
+    try:
+        cli_args = remove_ros_args(argv)[1:]
+    except Exception as err:  # rclpy's malformed --ros-args error has no public class
+        _fail(parser, err)
+    options = parser.parse_args(cli_args)
+    if options.save_debug:
+        try:
+            os.makedirs(options.save_debug, exist_ok=True)
+        except OSError as err:
+            parser.error('--save-debug: %s' % err)
+    # Our own SIGINT/SIGTERM handling, so the context is still up to send the zero twist.
+    signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+        node = KickBlueBall(save_debug=options.save_debug)
+    except KeyboardInterrupt:
+        rclpy.try_shutdown()
+        return 130
+    except Exception as err:  # a bad parameter or topic name: say so in one line
+        rclpy.try_shutdown()
+        _fail(parser, err)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if rclpy.ok():
+            node.stop()
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0

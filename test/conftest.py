@@ -1,0 +1,32 @@
+"""Shared fixtures. ROS tests run in their own rclpy Context on a ROS domain
+chosen per test process, discovery limited to this host, so parallel runs and
+other ROS processes on the machine never see each other's topics."""
+import os
+
+import pytest
+
+os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+# Domains 1..100; the process id spreads concurrent pytest runs apart.
+os.environ['ROS_DOMAIN_ID'] = str(1 + os.getpid() % 100)
+
+
+@pytest.fixture
+def ros_context():
+    """A fresh, initialised rclpy Context (never the global one)."""
+    rclpy = pytest.importorskip('rclpy')
+    from rclpy.context import Context
+
+    context = Context()
+    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
+    yield context
+    rclpy.try_shutdown(context=context)
+
+
+@pytest.fixture
+def executor(ros_context):
+    """A SingleThreadedExecutor on the test's own context."""
+    from rclpy.executors import SingleThreadedExecutor
+
+    ex = SingleThreadedExecutor(context=ros_context)
+    yield ex
+    ex.shutdown(timeout_sec=1.0)
