@@ -10,9 +10,10 @@ Facts about the EGL plugin that shape this module (pybullet 3.2.7, measured):
 
 * It calls ``exit(1)`` inside ``loadPlugin`` when EGL is unusable, so it is probed in a
   child process first (:func:`probe_egl`).
-* It binds its GL context to the thread that loaded it and never re-binds it. Any GL work
-  from another thread (render, body creation, reset, disconnect) segfaults, so a Renderer
-  only renders from the thread that created it and raises otherwise.
+* It makes its GL context current in the thread that loads it and never re-binds it:
+  rendering from another thread segfaults, and bodies created from another thread are
+  invisible to it. So a Renderer renders only in the thread that created it (and raises
+  elsewhere); build the world in that thread too.
 * It only sees bodies created after it was loaded, so a Renderer must be created on an empty
   client (``resetSimulation`` afterwards is fine).
 * Several live instances in one process share one current context and clobber each other
@@ -416,20 +417,20 @@ class _EglBackend:
 
     @classmethod
     def busy(cls):
-        """Whether another EGL back end still holds the plugin in this process."""
-        owner = cls.owner
-        if owner is None:
-            return False
-        if owner.thread == threading.get_ident():
-            # Unloading or disconnecting destroys the plugin's context, even without close().
-            return _current_egl_context() == owner.context
-        return bool(p.getConnectionInfo(owner.client_id)['isConnected'])
+        """Whether an EGL back end still holds the plugin in this process."""
+        return cls.owner is not None and cls.owner._plugin_alive()
+
+    def _plugin_alive(self):
+        if self.thread == threading.get_ident():
+            # Unloading or disconnecting destroys the plugin's context, even without close(),
+            # and a client id can be reused after a disconnect, so the context is the test.
+            return _current_egl_context() == self.context
+        return bool(p.getConnectionInfo(self.client_id)['isConnected'])
 
     def _check_context(self):
-        if _current_egl_context() != self.context:
-            raise RuntimeError(
-                'EGL renderer used from another thread or after its client was disconnected;'
-                ' create, render and close it from one thread')
+        if _EglBackend.owner is not self or _current_egl_context() != self.context:
+            raise RuntimeError('EGL renderer used outside the thread that created it, or after'
+                               ' it was closed or its client disconnected')
 
     def shot(self, width, height, view, projection):
         self._check_context()
@@ -438,15 +439,11 @@ class _EglBackend:
             renderer=p.ER_BULLET_HARDWARE_OPENGL, physicsClientId=self.client_id)[2]
 
     def close(self):
-        if _current_egl_context() == self.context:
+        if _EglBackend.owner is not self:
+            return  # closed before, or superseded after its client was disconnected
+        _EglBackend.owner = None
+        if self._plugin_alive():
             p.unloadPlugin(self.plugin_id, physicsClientId=self.client_id)
-        elif (self.thread != threading.get_ident()
-              and p.getConnectionInfo(self.client_id)['isConnected']):
-            # Unloading here would run the plugin's GL clean-up without its context.
-            raise RuntimeError('close the EGL renderer from the thread that created it')
-        # Otherwise the plugin is already gone: closed before, or its client disconnected.
-        if _EglBackend.owner is self:
-            _EglBackend.owner = None
 
 
 # -------------------------------------------------------------------------- Renderer
@@ -454,8 +451,8 @@ class _EglBackend:
 @functools.lru_cache(maxsize=32)
 def _tile_plan(intrinsics, max_size, pixel_shift):
     """((x0, y0, width, height, projection), ...) covering the image in tiles no larger
-    than ``max_size`` (None: one tile), as even as possible. ``pixel_shift`` moves the
-    rendered content by (du, dv) pixels to undo a rasterizer's sampling offset."""
+    than ``max_size`` (None: one tile), as even as possible. ``pixel_shift`` is how far
+    (du, dv) the rasterizer draws everything from where OpenGL would; it is undone."""
     max_w, max_h = max_size or (intrinsics.width, intrinsics.height)
     columns = _split(intrinsics.width, math.ceil(intrinsics.width / max_w))
     rows = _split(intrinsics.height, math.ceil(intrinsics.height / max_h))

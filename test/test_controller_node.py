@@ -1,0 +1,309 @@
+"""The controller node in an in-process executor, driven by a fake /clock and fake sensors."""
+import math
+import os
+import subprocess
+import sys
+
+import cv2
+import numpy as np
+import pytest
+
+rclpy = pytest.importorskip('rclpy')
+
+from builtin_interfaces.msg import Time  # noqa: E402
+from geometry_msgs.msg import TwistStamped  # noqa: E402
+from rclpy.parameter import Parameter  # noqa: E402
+from rosgraph_msgs.msg import Clock  # noqa: E402
+from sensor_msgs.msg import CompressedImage, JointState  # noqa: E402
+from std_msgs.msg import Float32MultiArray  # noqa: E402
+
+from miro_ball.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES  # noqa: E402
+from miro_ball.node import build_parser, KickBlueBall, main  # noqa: E402
+from miro_ball.synthetic import Disc, jpeg, render  # noqa: E402
+
+TICK = 0.02
+SEARCH_SPIN = -2 * 0.1 / 0.164  # rad/s, clockwise
+# Column where a ball straight ahead appears in each eye (the eyes look 27 deg outwards).
+AHEAD_X = math.tan(CAM_DIVERGENCE_RAD) / (2 * math.tan(math.radians(60)))
+
+
+def ball_frame(x=None, r=0.04, width=640, height=360):
+    """JPEG of a frame with the ball at normalised column x (None: no ball)."""
+    discs = [] if x is None else [Disc(width / 2 + x * width, 0.6 * height, r * width)]
+    return jpeg(render(width, height, discs, seed=1))
+
+
+class Rig:
+    """The node under test plus a probe node that plays simulator."""
+
+    def __init__(self, context, executor, overrides=(), robot='miro', **kwargs):
+        params = [Parameter('use_sim_time', value=True), Parameter('robot_name', value=robot)]
+        self.node = KickBlueBall(context=context, parameter_overrides=params + list(overrides),
+                                 **kwargs)
+        self.probe = rclpy.create_node('fake_sim', context=context)
+        self.executor = executor
+        self.twists, self.joints = [], []
+        p = self.probe
+
+        def t(name):
+            return '/%s/%s' % (robot, name)
+        self.pub_clock = p.create_publisher(Clock, '/clock', 10)
+        self.pub_cam = [p.create_publisher(CompressedImage, t('sensors/%s/compressed' % cam), 2)
+                        for cam in ('caml', 'camr')]
+        self.pub_cliff = p.create_publisher(Float32MultiArray, t('sensors/cliff'), 2)
+        p.create_subscription(TwistStamped, t('control/cmd_vel'), self.twists.append, 100)
+        p.create_subscription(JointState, t('control/kinematic_joints'), self.joints.append, 100)
+        executor.add_node(self.node)
+        executor.add_node(p)
+        self.now = 10.0
+        self.wait_until(lambda: all(pub.get_subscription_count() > 0 for pub in
+                                    self.pub_cam + [self.pub_cliff, self.pub_clock]),
+                        'discovery')
+
+    def close(self):
+        for node in (self.node, self.probe):
+            self.executor.remove_node(node)
+            node.destroy_node()
+
+    def spin(self, times=3, timeout=0.005):
+        for _ in range(times):
+            self.executor.spin_once(timeout_sec=timeout)
+
+    def wait_until(self, predicate, what, spins=400):
+        for _ in range(spins):
+            if predicate():
+                return
+            self.executor.spin_once(timeout_sec=0.01)
+        raise AssertionError('timed out waiting for ' + what)
+
+    def set_clock(self, t):
+        self.now = t
+        ns = int(round(t * 1e9))
+        msg = Clock(clock=Time(sec=ns // 1000000000, nanosec=ns % 1000000000))
+        self.pub_clock.publish(msg)
+        self.wait_until(lambda: abs(self.node.get_clock().now().nanoseconds * 1e-9 - t) < 1e-6,
+                        'the clock to reach %.2f' % t)
+        self.spin()
+
+    def advance(self, seconds):
+        """Move simulated time on tick by tick, letting the node's timer fire."""
+        for _ in range(int(round(seconds / TICK))):
+            self.set_clock(self.now + TICK)
+
+    def image(self, eye, data):
+        """Publish raw bytes on an eye's topic and wait for the node to take it."""
+        before = self.node.frames_processed + sum(self.node.rejected.values())
+        msg = CompressedImage(format='jpeg', data=data)
+        msg.header.stamp = Time(sec=int(self.now))
+        self.pub_cam[eye].publish(msg)
+        self.wait_until(lambda: self.node.frames_processed + sum(self.node.rejected.values())
+                        > before, 'the node to take an image')
+
+    def both_eyes(self, left_x, right_x, r=0.04):
+        self.image(0, ball_frame(left_x, r))
+        self.image(1, ball_frame(right_x, r))
+
+    def cliff(self, values):
+        before = self.node.cliff.stamp, sum(self.node.rejected.values())
+        self.pub_cliff.publish(Float32MultiArray(data=list(values)))
+        self.wait_until(lambda: (self.node.cliff.stamp, sum(self.node.rejected.values()))
+                        != before, 'the node to take a cliff reading')
+
+    def last_twist(self):
+        self.spin()
+        msg = self.twists[-1]
+        return msg.twist.linear.x, msg.twist.angular.z
+
+
+@pytest.fixture
+def make_rig(ros_context, executor):
+    rigs = []
+
+    def make(*overrides, **kwargs):
+        rig = Rig(ros_context, executor, overrides, **kwargs)
+        rigs.append(rig)
+        return rig
+    yield make
+    for rig in rigs:
+        rig.close()
+
+
+def short_hold(*more):
+    return [Parameter('head_hold_s', value=0.1)] + list(more)
+
+
+def test_holds_the_head_then_searches(make_rig):
+    rig = make_rig()
+    rig.set_clock(10.0)
+    rig.advance(0.5)
+    assert rig.node.state == 'startup'
+    assert rig.joints, 'no head pose published'
+    head = rig.joints[-1]
+    assert list(head.name) == list(JOINT_NAMES)
+    assert list(head.position) == pytest.approx([0.0, math.radians(34.0), 0.0, 0.0])
+    assert rig.last_twist() == (0.0, 0.0)
+    rig.advance(0.8)
+    assert rig.node.state == 'search'
+    joints_after_hold = len(rig.joints)
+    rig.advance(0.3)
+    assert len(rig.joints) == joints_after_hold, 'head pose still published after the hold'
+    linear, angular = rig.last_twist()
+    assert linear == pytest.approx(0.0) and angular == pytest.approx(SEARCH_SPIN)
+    twist = rig.twists[-1]
+    assert twist.header.frame_id == 'base_link'
+    stamp = twist.header.stamp.sec + twist.header.stamp.nanosec * 1e-9
+    assert 11.0 < stamp <= rig.now + 1e-6  # stamped with simulated time
+
+
+@pytest.mark.parametrize('mode,speed', [('tutorial', 0.4), ('improved', 0.2)])
+def test_drives_forward_at_a_ball_centred_in_both_eyes(make_rig, mode, speed):
+    rig = make_rig(*short_hold(Parameter('mode', value=mode)))
+    rig.set_clock(10.0)
+    rig.advance(0.2)
+    rig.cliff([1.0, 1.0])
+    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    assert rig.node.frames_processed == 2
+    rig.advance(0.1)
+    assert rig.node.state == {'tutorial': 'kick', 'improved': 'approach'}[mode]
+    linear, angular = rig.last_twist()
+    assert linear == pytest.approx(speed, rel=0.02) and angular == pytest.approx(0.0, abs=0.05)
+
+
+def test_turns_towards_a_ball_in_the_left_eye(make_rig):
+    rig = make_rig(*short_hold())
+    rig.set_clock(10.0)
+    rig.advance(0.2)
+    rig.image(0, ball_frame(-0.3))  # well left of the left eye's axis
+    rig.advance(0.1)
+    linear, angular = rig.last_twist()
+    assert rig.node.state == 'approach'
+    assert angular == pytest.approx(-SEARCH_SPIN) and linear == pytest.approx(0.0, abs=1e-6)
+
+
+def test_tutorial_fine_turn_when_off_centre(make_rig):
+    rig = make_rig(*short_hold(Parameter('mode', value='tutorial')))
+    rig.set_clock(10.0)
+    rig.advance(0.2)
+    rig.both_eyes(0.3, -0.1)  # |lx| - |rx| = 0.2: ball to the right, fine clockwise turn
+    rig.advance(0.1)
+    linear, angular = rig.last_twist()
+    assert rig.node.state == 'lock_on'
+    assert linear == pytest.approx(0.0) and angular == pytest.approx(-2 * 0.03 / 0.164)
+
+
+def test_cliff_stops_forward_motion(make_rig):
+    rig = make_rig(*short_hold())
+    rig.set_clock(10.0)
+    rig.advance(0.2)
+    rig.cliff([0.1, 0.2])
+    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.advance(0.1)
+    linear, _ = rig.last_twist()
+    assert rig.node.state == 'avoid_cliff' and linear < 0
+
+
+def test_detections_expire_when_a_camera_stops(make_rig):
+    rig = make_rig(*short_hold())
+    rig.set_clock(10.0)
+    rig.advance(0.2)
+    rig.cliff([1.0, 1.0])
+    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.advance(0.1)
+    assert rig.node.state == 'approach'
+    rig.advance(0.6)  # older than stale_s (0.5 s) now
+    assert rig.node.state == 'search'
+    assert rig.last_twist()[0] == pytest.approx(0.0)
+
+
+def test_survives_bad_inputs(make_rig):
+    rig = make_rig(*short_hold())
+    rig.set_clock(10.0)
+    rig.advance(0.2)
+    good = ball_frame(AHEAD_X)
+    small = jpeg(render(100, 80, [Disc(50, 40, 10)]))
+    for data in (b'', b'\x00garbage' * 10, good[:len(good) // 2], small):
+        rig.image(0, data)
+    for values in ([1.0], [1.0, 1.0, 1.0], [float('nan'), 1.0], [1.0, 7.5]):
+        rig.cliff(values)
+    assert rig.node.rejected == {'empty': 1, 'corrupt': 2, 'size': 1, 'cliff': 4}
+    assert rig.node.frames_processed == 0 and rig.node.cliff.value is None
+    # Still alive, still driving, and still taking good input.
+    count = len(rig.twists)
+    rig.advance(0.1)
+    assert len(rig.twists) > count
+    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.cliff([1.0, 1.0])
+    rig.advance(0.1)
+    assert rig.node.frames_processed == 2 and rig.node.state == 'approach'
+
+
+def test_carries_on_when_the_clock_jumps_back(make_rig):
+    rig = make_rig(*short_hold())
+    rig.set_clock(10.0)
+    rig.advance(0.3)
+    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.advance(0.1)
+    assert rig.node.state == 'approach'
+    rig.set_clock(1.0)  # the simulator restarted
+    rig.advance(0.2)
+    stamp = rig.twists[-1].header.stamp
+    assert stamp.sec == 1  # publishing on the new timeline
+    rig.advance(0.2)
+    assert rig.node.state == 'search'  # started over: old detections were dropped
+    assert rig.last_twist()[1] == pytest.approx(SEARCH_SPIN)
+
+
+def test_debug_image_only_while_subscribed(make_rig, tmp_path):
+    rig = make_rig(*short_hold(), save_debug=str(tmp_path))
+    got = []
+    rig.probe.create_subscription(CompressedImage, '/miro/kick_blue_ball/debug/caml/compressed',
+                                  got.append, 2)
+    rig.wait_until(lambda: rig.node.pub_debug[0].get_subscription_count() > 0, 'debug sub')
+    rig.image(0, ball_frame(0.1))
+    rig.image(1, ball_frame(None))
+    rig.wait_until(lambda: got, 'a debug image')
+    assert rig.node.pub_debug[1].get_subscription_count() == 0
+    image = cv2.imdecode(np.frombuffer(bytes(got[0].data), np.uint8), cv2.IMREAD_COLOR)
+    green = (image[:, :, 1] > 200) & (image[:, :, 0] < 80) & (image[:, :, 2] < 80)
+    assert green.sum() > 100, 'no circle drawn'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['caml_000001.jpg', 'camr_000002.jpg']
+
+
+def test_robot_name_prefixes_the_topics(make_rig):
+    rig = make_rig(*short_hold(), robot='miro02')
+    rig.set_clock(10.0)
+    rig.advance(0.3)
+    assert rig.twists and rig.twists[-1].twist.angular.z == pytest.approx(SEARCH_SPIN)
+
+
+def test_bad_parameter_is_refused(ros_context):
+    with pytest.raises(ValueError, match='tick'):
+        KickBlueBall(context=ros_context, parameter_overrides=[Parameter('tick', value='fast')])
+
+
+def test_help_lists_parameters_and_topics(capsys):
+    with pytest.raises(SystemExit) as done:
+        main(['kick_blue_ball', '--help'])
+    assert done.value.code == 0
+    text = capsys.readouterr().out
+    for word in ('--save-debug', 'hue_window', 'kick_duration', '0.4', '/control/cmd_vel',
+                 'sensors/cliff', 'tutorial or improved'):
+        assert word in text
+
+
+def test_bad_command_line_is_one_line(capsys):
+    with pytest.raises(SystemExit) as done:
+        main(['kick_blue_ball', '--speed', 'ludicrous', '--ros-args', '-p', 'fast:=0.3'])
+    assert done.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and 'unrecognized arguments: --speed ludicrous' in err
+    assert build_parser().parse_args(['--save-debug', 'x']).save_debug == 'x'
+
+
+def test_bad_ros_parameter_from_the_shell_is_one_line():
+    env = dict(os.environ, PYTHONWARNINGS='ignore')
+    done = subprocess.run([sys.executable, '-m', 'miro_ball', '--ros-args', '-p', 'mode:=fancy'],
+                          capture_output=True, text=True, timeout=60, env=env)
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines() == [
+        "kick_blue_ball: error: mode must be one of tutorial, improved, not 'fancy'"]
