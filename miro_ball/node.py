@@ -10,7 +10,6 @@ import math
 import os
 import signal
 import sys
-import time
 from collections import Counter
 from functools import partial
 
@@ -33,6 +32,7 @@ from miro_ball.behaviour import BehaviourParams, make_behaviour
 from miro_ball.constants import FRAME_SIZES, JOINT_NAMES, topic
 from miro_ball.detection import annotate, BallDetector, DetectionParams
 from miro_ball.kinematics import clamp_wheel_speeds, finite, wheel_speed2cmd_vel
+from miro_ball.throttle import Throttled
 
 NODE_NAME = 'kick_blue_ball'
 EYES = ('caml', 'camr')  # index 0 is the left eye, as the MDK's CAM_L
@@ -81,25 +81,6 @@ class Latest:
         return self.value
 
 
-class Warnings:
-    """Warnings rate-limited per kind (rclpy's throttle is per call site, not per kind)."""
-
-    def __init__(self, logger, period_s):
-        self.logger, self.period_s = logger, period_s
-        self._last = {}
-        self._skipped = Counter()
-
-    def __call__(self, kind, text):
-        now = time.monotonic()
-        if kind in self._last and now - self._last[kind] < self.period_s:
-            self._skipped[kind] += 1
-            return
-        if self._skipped[kind]:
-            text += ' (%d more like this since the last report)' % self._skipped.pop(kind)
-        self._last[kind] = now
-        self.logger.warning(text)
-
-
 class KickBlueBall(Node):
     """The controller. Attributes for tests and embedding:
 
@@ -107,7 +88,8 @@ class KickBlueBall(Node):
     frames_processed  camera frames decoded and run through the detector
     rejected          Counter of ignored inputs by kind (empty, corrupt, size, cliff)
     last_command      (left, right) wheel speeds of the latest twist, m/s
-    detector, behaviour, config (ControllerParams)
+    last_tick         node time (s) of the latest control tick, None before the first
+    detector, behaviour, config (ControllerParams), pub_twist
     """
 
     def __init__(self, *, context=None, parameter_overrides=None, save_debug=None):
@@ -121,7 +103,7 @@ class KickBlueBall(Node):
         self.rejected = Counter()
         self.last_command = None
         self.state = STARTUP
-        self._warn = Warnings(self.get_logger(), WARN_EVERY_S)
+        self._warn = Throttled(self.get_logger().warning, WARN_EVERY_S)
         self.balls = [Latest() for _ in EYES]
         self.cliff = Latest()
         self._restart()
@@ -157,6 +139,10 @@ class KickBlueBall(Node):
         self._last_tick = None
         for latest in self.balls + [self.cliff]:
             latest.clear()
+
+    @property
+    def last_tick(self):
+        return self._last_tick
 
     def _seconds(self):
         return self.get_clock().now().nanoseconds * 1e-9

@@ -82,8 +82,9 @@ def run_episode(context, placement=None, mode='improved', limit_s=60.0, renderer
         kicked_at, fell = None, False
         tick = sim.ticks_per_platform_tick
         while sim.time < limit_s:
+            frames_before = sim_node.frames_published
             sim_node.advance(tick)
-            _spin_until_controller_at(executor, controller, sim.time)
+            _spin_until_controller_at(executor, controller, sim_node, frames_before)
             fell = fell or sim.robot_height() < FELL_BELOW_M
             if kicked_at is None and math.dist(sim.ball_position()[:2], start[:2]) >= \
                     KICK_DISTANCE_M:
@@ -112,11 +113,18 @@ def _wait_for_links(executor, sim_node, controller, timeout_s=10.0):
         executor.spin_once(timeout_sec=0.01)
 
 
-def _spin_until_controller_at(executor, controller, sim_time, timeout_s=2.0):
-    """Run callbacks until the controller has ticked at sim_time, then deliver its output."""
+def _spin_until_controller_at(executor, controller, sim_node, frames_before, timeout_s=2.0):
+    """Run callbacks until the controller has taken in the camera frames of this tick and
+    ticked at the simulator's time, then deliver its output."""
+    def seen():
+        return controller.frames_processed + sum(controller.rejected.values())
+    wanted = seen() + sim_node.frames_published - frames_before
+
+    def caught_up():
+        tick = controller._last_tick
+        return seen() >= wanted and tick is not None and tick >= sim_node.sim.time - 1e-6
     deadline = time.monotonic() + timeout_s
-    while (controller._last_tick is None or controller._last_tick < sim_time - 1e-6) \
-            and time.monotonic() < deadline:
+    while not caught_up() and time.monotonic() < deadline:
         executor.spin_once(timeout_sec=0.005)
     for _ in range(20):
         executor.spin_once(timeout_sec=0)

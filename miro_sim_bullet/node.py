@@ -260,12 +260,14 @@ class SimNode(Node):
         sim = self.sim
         for _ in range(steps):
             sim.step()
-            if sim.step_index % sim.ticks_per_platform_tick == 0:
-                self._publish_tick()
+            # Images of an instant go out before its /clock, so a controller on sim time
+            # has them when its timer fires for that instant.
             if sim.step_index >= self._frame_step(self._next_frame):
                 self._publish_cameras()
                 while self._frame_step(self._next_frame) <= sim.step_index:
                     self._next_frame += 1
+            if sim.step_index % sim.ticks_per_platform_tick == 0:
+                self._publish_tick()
             rate = self.params['overhead_rate']
             if rate > 0 and sim.time >= self._next_overhead:
                 self._publish_overhead()
@@ -345,7 +347,6 @@ class SimNode(Node):
 
     def _publish_cameras(self):
         stamp = _stamp(self.sim.time)
-        self.pub_clock.publish(ClockMsg(clock=stamp))
         started = time.perf_counter()
         rendered = 0
         for eye, side in EYES:

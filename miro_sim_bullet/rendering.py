@@ -26,6 +26,7 @@ Facts about the EGL plugin that shape this module (pybullet 3.2.7, measured):
 * Its pbuffer is 1024x768; larger images are stretched, so they are rendered as tiles with
   off-axis projections and stitched.
 """
+import collections
 import ctypes
 import dataclasses
 import functools
@@ -204,10 +205,17 @@ def _last_line(text):
 # ------------------------------------------------------ shadow-map switch (memory poke)
 
 _SHADOW_SYMBOL = b'useShadowMap'
+# ELF64 little-endian records (Elf64_Ehdr, Elf64_Shdr, Elf64_Phdr, Elf64_Sym).
 _ELF_HEADER = struct.Struct('<16sHHIQQQIHHHHHH')
 _ELF_SECTION = struct.Struct('<IIQQQQIIQQ')
 _ELF_PROGRAM = struct.Struct('<IIQQQQQQ')
 _ELF_SYMBOL = struct.Struct('<IBBHQQ')
+_Header = collections.namedtuple('_Header', 'ident type machine version entry phoff shoff'
+                                 ' flags ehsize phentsize phnum shentsize shnum shstrndx')
+_Section = collections.namedtuple('_Section',
+                                  'name type flags addr offset size link info align entsize')
+_Segment = collections.namedtuple('_Segment',
+                                  'type flags offset vaddr paddr filesz memsz align')
 _SHT_PROGBITS, _SHT_SYMTAB = 1, 2
 _SHF_WRITE, _SHF_ALLOC = 0x1, 0x2
 _STT_OBJECT = 1
@@ -242,58 +250,47 @@ def _set_shadow_pass(path, enabled):
 def _shadow_symbol(path):
     """(st_value, p_vaddr of the segment at file offset 0) for useShadowMap in ``path``."""
     with open(path, 'rb') as f:
-        header = _unpack_at(f, _ELF_HEADER, 0)
-        ident, phoff, shoff = header[0], header[5], header[6]
-        phentsize, phnum, shentsize, shnum = header[9], header[10], header[11], header[12]
-        if ident[:4] != b'\x7fELF' or ident[4] != 2 or ident[5] != 1:
+        header = _Header._make(_read_table(f, _ELF_HEADER, 0, 1)[0])
+        if header.ident[:4] != b'\x7fELF' or header.ident[4:6] != b'\x02\x01':
             raise _PatchError('not a 64-bit little-endian ELF file')
-        if shentsize != _ELF_SECTION.size or phentsize != _ELF_PROGRAM.size:
+        if (header.shentsize, header.phentsize) != (_ELF_SECTION.size, _ELF_PROGRAM.size):
             raise _PatchError('unexpected ELF header entry sizes')
-        sections = _unpack_table(f, _ELF_SECTION, shoff, shnum)
-        segments = _unpack_table(f, _ELF_PROGRAM, phoff, phnum)
+        sections = [_Section._make(row) for row in
+                    _read_table(f, _ELF_SECTION, header.shoff, header.shnum)]
+        segments = [_Segment._make(row) for row in
+                    _read_table(f, _ELF_PROGRAM, header.phoff, header.phnum)]
         value, shndx = _find_object(f, sections, _SHADOW_SYMBOL)
         _check_flag_section(f, sections, shndx, value)
-    heads = [seg for seg in segments if seg[0] == _PT_LOAD and seg[2] == 0]
+    heads = [seg for seg in segments if seg.type == _PT_LOAD and seg.offset == 0]
     if len(heads) != 1:
         raise _PatchError('no single PT_LOAD segment at file offset 0')
-    return value, heads[0][3]
+    return value, heads[0].vaddr
 
 
-def _unpack_at(f, layout, offset):
+def _read_bytes(f, offset, size):
     f.seek(offset)
-    data = f.read(layout.size)
-    if len(data) != layout.size:
+    data = f.read(size)
+    if len(data) != size:
         raise _PatchError('truncated ELF file')
-    return layout.unpack(data)
-
-
-def _unpack_table(f, layout, offset, count):
-    f.seek(offset)
-    data = f.read(layout.size * count)
-    if len(data) != layout.size * count:
-        raise _PatchError('truncated ELF table')
-    return list(layout.iter_unpack(data))
-
-
-def _read_section(f, section):
-    f.seek(section[4])
-    data = f.read(section[5])
-    if len(data) != section[5]:
-        raise _PatchError('truncated ELF section')
     return data
+
+
+def _read_table(f, layout, offset, count):
+    return list(layout.iter_unpack(_read_bytes(f, offset, layout.size * count)))
 
 
 def _find_object(f, sections, name):
     """(st_value, st_shndx) of the only 1-byte STT_OBJECT symbol ``name`` in .symtab."""
-    symtabs = [s for s in sections if s[1] == _SHT_SYMTAB]
-    if len(symtabs) != 1 or symtabs[0][9] != _ELF_SYMBOL.size:
+    symtabs = [s for s in sections if s.type == _SHT_SYMTAB]
+    if len(symtabs) != 1 or symtabs[0].entsize != _ELF_SYMBOL.size:
         raise _PatchError('no usable .symtab (stripped plugin?)')
-    if symtabs[0][6] >= len(sections):
+    symtab = symtabs[0]
+    if symtab.link >= len(sections):
         raise _PatchError('.symtab links to a missing string table')
-    names = _read_section(f, sections[symtabs[0][6]])
+    names = _read_bytes(f, sections[symtab.link].offset, sections[symtab.link].size)
     found = []
     for st_name, info, _, shndx, value, size in _ELF_SYMBOL.iter_unpack(
-            _read_section(f, symtabs[0])):
+            _read_bytes(f, symtab.offset, symtab.size)):
         if info & 0xf == _STT_OBJECT and names[st_name:st_name + len(name) + 1] == name + b'\0':
             found.append((value, shndx, size))
     if len(found) != 1:
@@ -308,13 +305,13 @@ def _check_flag_section(f, sections, shndx, value):
     """The flag must live in initialised writable data and start out as true."""
     if shndx == 0 or shndx >= min(len(sections), _SHN_LORESERVE):
         raise _PatchError('useShadowMap is not in a regular section')
-    _, kind, flags, addr, offset, size = sections[shndx][:6]
-    if kind != _SHT_PROGBITS or flags & (_SHF_WRITE | _SHF_ALLOC) != _SHF_WRITE | _SHF_ALLOC:
+    section = sections[shndx]
+    wanted = _SHF_WRITE | _SHF_ALLOC
+    if section.type != _SHT_PROGBITS or section.flags & wanted != wanted:
         raise _PatchError('useShadowMap is not in writable initialised data')
-    if not addr <= value < addr + size:
+    if not section.addr <= value < section.addr + section.size:
         raise _PatchError('useShadowMap lies outside its section')
-    f.seek(offset + value - addr)
-    if f.read(1) != b'\x01':
+    if _read_bytes(f, section.offset + value - section.addr, 1) != b'\x01':
         raise _PatchError('useShadowMap is not initialised to true in the file')
 
 
@@ -471,9 +468,11 @@ class Renderer:
 
     ``kind``: 'auto' (EGL when :func:`probe_egl` succeeds and no other EGL Renderer is open,
     else TinyRenderer), 'egl' (raise :class:`RendererUnavailable` if it cannot be used) or
-    'tiny'. Create it before adding bodies to the client. ``egl_shadow_pass=True`` keeps the
-    EGL plugin's stock 4096x4096 shadow-map pass (about 11 ms per image on llvmpipe; the
-    images lose cast shadows without it). ``log`` receives one line describing the choice.
+    'tiny'. Create it before adding bodies to the client, and with EGL build the world and
+    render in the thread that created it. ``egl_shadow_pass=True`` keeps the EGL plugin's
+    stock 4096x4096 shadow-map pass (about 11 ms per image on llvmpipe; the images lose cast
+    shadows without it). ``log`` receives one line describing the choice. ``kind`` and
+    ``name`` tell what is in use ('tiny' or 'egl'; e.g. 'egl (stock, shadow pass on)').
     """
 
     def __init__(self, client_id, kind='auto', log=print, egl_shadow_pass=False):
@@ -510,14 +509,14 @@ class Renderer:
         ``view_matrix`` (column-major world-to-camera matrix as from computeViewMatrix)."""
         plan = _tile_plan(intrinsics, self._backend.max_size, self._backend.pixel_shift)
         if len(plan) == 1:
-            return self._tile_rgb(view_matrix, *plan[0])
+            _, _, w, h, projection = plan[0]
+            return self._tile_rgb(view_matrix, w, h, projection)
         image = np.empty((intrinsics.height, intrinsics.width, 3), np.uint8)
         for x0, y0, w, h, projection in plan:
-            self._tile_rgb(view_matrix, x0, y0, w, h, projection,
-                           out=image[y0:y0 + h, x0:x0 + w])
+            self._tile_rgb(view_matrix, w, h, projection, out=image[y0:y0 + h, x0:x0 + w])
         return image
 
-    def _tile_rgb(self, view, x0, y0, width, height, projection, out=None):
+    def _tile_rgb(self, view, width, height, projection, out=None):
         pixels = self._backend.shot(width, height, view, projection)
         # A no-op on numpy-enabled pybullet; converts the flat list otherwise.
         rgba = np.asarray(pixels, dtype=np.uint8).reshape(height, width, 4)

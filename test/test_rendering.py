@@ -256,14 +256,13 @@ def test_egl_worlds_come_and_go(worlds):
 
 def test_one_egl_renderer_per_process(worlds):
     first = worlds('egl')
-    log = []
     second = worlds('auto')
     assert second.renderer.name == 'tiny'
     assert any('another EGL Renderer' in line for line in second.log), second.log
     client = p.connect(p.DIRECT)
     try:
         with pytest.raises(RendererUnavailable, match='another EGL Renderer'):
-            Renderer(client, 'egl', log=log.append)
+            Renderer(client, 'egl', log=lambda _: None)
     finally:
         p.disconnect(client)
     first.close()
@@ -325,3 +324,8 @@ def shadow_map_flag():
 def test_shadow_symbol_lookup_rejects_other_files(path):
     with pytest.raises(rendering._PatchError):
         rendering._shadow_symbol(path)
+
+
+def test_shadow_flag_is_only_written_inside_the_loaded_plugin():
+    with pytest.raises(rendering._PatchError, match='0 mappings'):
+        rendering._runtime_address('/nonexistent/plugin.so', 0x1000, 0)
