@@ -54,6 +54,8 @@ class BehaviourParams:
         default=5.0, metadata={'help': 'improved: kick when the bearing is within this, deg'})
     kick_radius: float = field(
         default=0.05, metadata={'help': 'improved: kick when ball r / width reaches this'})
+    lost_grace_s: float = field(
+        default=0.3, metadata={'help': 'improved: hold course this long after losing the ball, s'})
     search_turn_deg: float = field(
         default=360.0, metadata={'help': 'improved: turn this far before exploring, deg'})
     explore_distance: float = field(
@@ -69,7 +71,7 @@ class BehaviourParams:
         positive = (self.centre_error, self.kick_duration, self.steer_gain, self.turn_only_deg,
                     self.kick_bearing_deg, self.kick_radius, self.search_turn_deg,
                     self.explore_distance, self.backoff_s)
-        if not all(v > 0 for v in positive):
+        if not all(v > 0 for v in positive) or self.lost_grace_s < 0:
             raise ValueError('durations, distances, angles, gains and thresholds must be > 0')
 
 
@@ -217,6 +219,7 @@ class ImprovedBehaviour(_Machine):
         self._last_t = None
         self._manoeuvre = None
         self._kick_start = None
+        self._seen = None  # (time, bearing) of the latest sighting
 
     @property
     def _spin_rate(self):
@@ -226,9 +229,15 @@ class ImprovedBehaviour(_Machine):
         dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
         self._last_t = t
         bearing = ball_bearing(left, right)
+        closest = max((b.r for b in (left, right) if b is not None), default=0.0)
         if bearing is not None:
             self.side = 1 if bearing > 0 else -1
-        closest = max((b.r for b in (left, right) if b is not None), default=0.0)
+            self._seen = (t, bearing)
+        elif (self.state in (APPROACH, KICK) and self._seen is not None
+              and t - self._seen[0] <= self.params.lost_grace_s):
+            # One missed frame (the ball between the eyes' views, a bad JPEG) should not
+            # end an approach: hold course on the last bearing for a moment.
+            bearing = self._seen[1]
         wheels = self._by_state(t, dt, bearing, closest, cliff)
         drops = self._drops(cliff)
         if any(drops) and sum(wheels) > 0:

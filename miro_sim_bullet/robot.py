@@ -38,6 +38,10 @@ DARK = (0.08, 0.08, 0.08, 1.0)
 # Link (= joint) indices in creation order.
 WHEEL_L, WHEEL_R, NECK, GIMBAL, HEAD, TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L, EAR_R = \
     range(11)
+# The six LEDs of control/illum in MiRo's order LF, LM, LR, RF, RM, RR: patches on the
+# body's flanks, fixed links so each can have a colour of its own.
+ILLUM_LINKS = tuple(range(11, 17))
+ILLUM_X = (0.03, -0.04, -0.11)  # front, middle, rear (BODY frame)
 KIN_LINKS = {LIFT: NECK, YAW: GIMBAL, PITCH: HEAD}
 # Cosmetic order: droop, wag, eyelid l/r, ear l/r; value 0..1 -> angle range.
 COSMETIC_LINKS = (TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L, EAR_R)
@@ -158,6 +162,10 @@ class MiroModel:
             _Link(0.0565, HEAD + 1, (EAR_IN_HEAD[0], -EAR_IN_HEAD[1], EAR_IN_HEAD[2]),
                   (0, 0, 1), *ear),
         ]
+        led = self._shape(box, WHITE, collide=False, halfExtents=(0.025, 0.002, 0.012))
+        links += [_Link(0.001, 0, (x, side * 0.101, 0.055), (0, 0, 1), *led,
+                        joint_type=pb.JOINT_FIXED)
+                  for side in (1, -1) for x in ILLUM_X]
         body = pb.createMultiBody(
             baseMass=1.570796, baseCollisionShapeIndex=body_collision,
             baseVisualShapeIndex=body_visual, basePosition=(0, 0, 1.0),
@@ -182,6 +190,15 @@ class MiroModel:
             lo, hi = JOINT_LIMITS_RAD[joint]
             pb.changeDynamics(body, link, jointLowerLimit=lo, jointUpperLimit=hi, **kw)
         return body
+
+    def show_illum(self, argb_values):
+        """Colour the LED patches: 0xAARRGGBB, AA the brightness; dark LEDs look white."""
+        for link, argb in zip(ILLUM_LINKS, argb_values):
+            level = ((argb >> 24) & 0xFF) / 255.0
+            rgb = [((argb >> shift) & 0xFF) / 255.0 for shift in (16, 8, 0)]
+            colour = [w + level * (c - w) for c, w in zip(rgb, WHITE[:3])]
+            pb.changeVisualShape(self.body_id, link, rgbaColor=(*colour, 1.0),
+                                 physicsClientId=self.client)
 
     def body_frame(self):
         """World (position, rotation matrix) of the BODY frame (the axle midpoint).

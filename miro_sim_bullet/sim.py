@@ -191,6 +191,7 @@ class MiroSim:
     def set_illum(self, argb):
         """Six 0xAARRGGBB LEDs, shown as the colour of the body patches."""
         self.illum = list(argb)
+        self.model.show_illum(self.illum)
 
     @property
     def cliff_reflex_enabled(self):

@@ -131,12 +131,20 @@ def test_improved_searches_clockwise_until_it_has_seen_a_ball(improved):
 ])
 def test_improved_remembers_the_side(improved, left, right, direction):
     improved.step(0.0, left, right, FLOOR)
-    command = improved.step(TICK, None, None, FLOOR)
-    assert command.state == SEARCH and LOST in command.messages
+    command = run(improved, 0.4, t0=TICK)[-1]  # past lost_grace_s (0.3 s)
+    assert command.state == SEARCH
     assert (command.left, command.right) == (-0.1 * direction, 0.1 * direction)
     assert improved.side == direction
     # Still that way after a while.
-    assert run(improved, 1.0, t0=2 * TICK)[-1][:2] == (-0.1 * direction, 0.1 * direction)
+    assert run(improved, 1.0, t0=0.5)[-1][:2] == (-0.1 * direction, 0.1 * direction)
+
+
+def test_improved_holds_course_through_a_missed_frame(improved):
+    improved.step(0.0, ball(0.0), None, FLOOR)  # 27 deg left
+    held = run(improved, 0.28, t0=TICK)  # up to t = 0.28 s
+    assert all(c.state == APPROACH and turn(c) > 0 for c in held)
+    lost = improved.step(0.32, None, None, FLOOR)
+    assert lost.state == SEARCH and lost.messages == (LOST, MESSAGES[SEARCH])
 
 
 def test_improved_drives_straight_at_a_centred_ball(improved):

@@ -210,7 +210,7 @@ def test_detections_expire_when_a_camera_stops(make_rig):
     rig.both_eyes(AHEAD_X, -AHEAD_X)
     rig.advance(0.1)
     assert rig.node.state == 'approach'
-    rig.advance(0.6)  # older than stale_s (0.5 s) now
+    rig.advance(1.0)  # past stale_s (0.5 s) and then lost_grace_s (0.3 s)
     assert rig.node.state == 'search'
     assert rig.last_twist()[0] == pytest.approx(0.0)
 

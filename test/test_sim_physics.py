@@ -140,3 +140,15 @@ def test_reset_restores_the_initial_state():
     sim.run(0.5)
     assert sim.read_sensors().kinematic_positions[1] == pytest.approx(math.radians(34), abs=0.02)
     sim.close()
+
+
+def test_illum_colours_the_body_patches(empty):
+    import pybullet as pb
+    from miro_sim_bullet.robot import ILLUM_LINKS
+    empty.set_illum([0xFFFF0000, 0x8000FF00, 0, 0, 0, 0xFF0000FF])
+    colours = {row[1]: row[7] for row in pb.getVisualShapeData(empty.robot_id,
+                                                               physicsClientId=empty.client)}
+    assert colours[ILLUM_LINKS[0]][:3] == pytest.approx((1.0, 0.0, 0.0))
+    assert colours[ILLUM_LINKS[1]][1] > 0.95 and colours[ILLUM_LINKS[1]][0] < 0.5  # half-lit green
+    assert colours[ILLUM_LINKS[2]][:3] == pytest.approx((0.92, 0.92, 0.90))
+    assert colours[ILLUM_LINKS[5]][:3] == pytest.approx((0.0, 0.0, 1.0))
