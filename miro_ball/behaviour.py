@@ -187,14 +187,14 @@ class Manoeuvre:
     """Open-loop wheel-speed segments (left, right, seconds) played back to back."""
 
     def __init__(self, t, segments):
-        self.segments = []
+        self.segments = []  # (end time, left, right)
         for left, right, seconds in segments:
-            self.segments.append((t, t + seconds, left, right))
             t += seconds
+            self.segments.append((t, left, right))
 
     def at(self, t):
         """(left, right) for time t, or None when the manoeuvre is over."""
-        for start, end, left, right in self.segments:
+        for end, left, right in self.segments:
             if t < end:
                 return left, right
         return None
@@ -220,10 +220,7 @@ class ImprovedBehaviour(_Machine):
         self._manoeuvre = None
         self._kick_start = None
         self._seen = None  # (time, bearing) of the latest sighting
-
-    @property
-    def _spin_rate(self):
-        return wheel_speed2cmd_vel(spin(1, self.params.slow))[1]
+        self._spin_rate = wheel_speed2cmd_vel(spin(1, params.slow))[1]  # rad/s, > 0
 
     def _decide(self, t, left, right, cliff):
         dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
@@ -273,16 +270,16 @@ class ImprovedBehaviour(_Machine):
             if wheels is not None:
                 return wheels
             self._start_search()
-        return self._search(dt)
+        return self._search(t, dt)
 
     def _kick(self, bearing):
         """Full speed, still steering while the ball is in view."""
         return self._steer(self.params.fast, 0.0 if bearing is None else bearing, taper=False)
 
-    def _search(self, dt):
-        self.turned += abs(self._spin_rate) * dt
+    def _search(self, t, dt):
+        self.turned += self._spin_rate * dt
         if self.turned >= math.radians(self.params.search_turn_deg):
-            return self._explore()
+            return self._explore(t)
         return spin(self.side, self.params.slow)
 
     def _start_search(self, *extra):
@@ -296,19 +293,17 @@ class ImprovedBehaviour(_Machine):
         turn_only_deg, so a ball far to the side is faced before it is chased.
         """
         p = self.params
-        rate_limit = abs(self._spin_rate)
-        rate = max(-rate_limit, min(rate_limit, p.steer_gain * bearing))
+        rate = max(-self._spin_rate, min(self._spin_rate, p.steer_gain * bearing))
         if taper:
             speed *= max(0.0, 1.0 - abs(bearing) / math.radians(p.turn_only_deg))
         return cmd_vel2wheel_speed(speed, rate)
 
     def _turn_for(self, direction, angle):
         """A spin segment turning `angle` rad towards direction at the search speed."""
-        return spin(direction, self.params.slow) + (angle / abs(self._spin_rate),)
+        return spin(direction, self.params.slow) + (angle / self._spin_rate,)
 
-    def _explore(self):
+    def _explore(self, t):
         p = self.params
-        t = self._last_t
         turn = self._turn_for(self.rng.choice((-1, 1)), self.rng.uniform(math.pi / 4, math.pi))
         distance = self.rng.uniform(0.5, 1.0) * p.explore_distance
         drive = (p.approach_speed, p.approach_speed, distance / p.approach_speed)

@@ -1,6 +1,6 @@
 """Controller benchmark: detection cost per frame and the node's image-to-command latency.
 
-    python -m miro_ball.bench [--frames N] [--latency N]
+    python -m miro_ball.bench [--frames N] [--latency N] [--cv-threads N]
 
 Detection runs on synthetic frames (shaded balls on a grey floor, see synthetic.py).
 The latency part runs the node in-process on wall time, publishes a JPEG to one eye
@@ -130,7 +130,10 @@ def main(argv=None):
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--frames', type=int, default=300, help='detections per case')
     parser.add_argument('--latency', type=int, default=100, help='frames for the node latency')
+    parser.add_argument('--cv-threads', type=int, default=1,
+                        help='OpenCV threads (the kick_blue_ball command uses 1)')
     options = parser.parse_args(argv)
+    cv2.setNumThreads(options.cv_threads)
     bench_detection(options.frames)
     if options.latency > 0:
         bench_latency(options.latency)

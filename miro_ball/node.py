@@ -219,7 +219,8 @@ class KickBlueBall(Node):
         self._last_tick = now
         if self._started is None:
             self._started = now
-            self.get_logger().info('holding the head pose for %g s' % self.config.head_hold_s)
+            if self.config.head_hold_s > 0:
+                self.get_logger().info('holding the head pose for %g s' % self.config.head_hold_s)
         if now - self._started < self.config.head_hold_s:
             self.state = STARTUP
             self._publish_head()
@@ -240,8 +241,8 @@ class KickBlueBall(Node):
         for kind, latest in list(zip(EYES, self.balls)) + [('cliff', self.cliff)]:
             since = latest.stamp if latest.stamp is not None else self._started
             if now - since > stale:
-                self._warn('silent ' + kind, 'nothing on %s for %.1f s%s' % (
-                    kind, now - since, '' if kind in EYES else ' (exploration stays on the spot)'))
+                self._warn('silent ' + kind,
+                           'nothing on sensors/%s for %.1f s' % (kind, now - since))
 
     def _publish_head(self):
         msg = JointState(name=list(JOINT_NAMES),
@@ -279,9 +280,13 @@ def build_parser():
     width = max(len(name) for name, _, _ in rows)
     lines = ['parameters (--ros-args -p name:=value):']
     lines += ['  %-*s  %-14s %s' % (width, name, default, text) for name, default, text in rows]
-    lines += ['', 'topics (robot_name %s):' % params.ControllerParams().robot_name]
-    lines += ['  %-3s %s  [%s] %s' % (way, name, kind, what)
-              for name, kind, way, what in topics(params.ControllerParams().robot_name)]
+    robot = params.ControllerParams().robot_name
+    used = topics(robot)
+    width = max(len(name) for name, _, _, _ in used)
+    lines += ['', 'topics (robot_name %s):' % robot]
+    lines += ['  %-3s %-*s  %s, %s' % (way, width, name, kind, what)
+              for name, kind, way, what in used]
+    lines += ['', 'With --ros-args -p use_sim_time:=true the control tick follows /clock.']
     parser = _Parser(
         prog='kick_blue_ball',
         description='MiRo-E kick_blue_ball controller for ROS 2: finds the blue ball with '
@@ -315,6 +320,9 @@ def main(argv=None):
             os.makedirs(options.save_debug, exist_ok=True)
         except OSError as err:
             parser.error('--save-debug: %s' % err)
+    # Detection takes about a millisecond; OpenCV's worker threads would only add
+    # wake-up jitter on a small machine shared with the simulator.
+    cv2.setNumThreads(1)
     # Our own SIGINT/SIGTERM handling, so the context is still up to send the zero twist.
     signal.signal(signal.SIGTERM, _interrupt)
     try:

@@ -121,7 +121,7 @@ def _spin_until_controller_at(executor, controller, sim_node, frames_before, tim
     wanted = seen() + sim_node.frames_published - frames_before
 
     def caught_up():
-        tick = controller._last_tick
+        tick = controller.last_tick
         return seen() >= wanted and tick is not None and tick >= sim_node.sim.time - 1e-6
     deadline = time.monotonic() + timeout_s
     while not caught_up() and time.monotonic() < deadline:

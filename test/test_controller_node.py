@@ -19,6 +19,7 @@ from std_msgs.msg import Float32MultiArray  # noqa: E402
 
 from miro_ball.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES  # noqa: E402
 from miro_ball.node import build_parser, KickBlueBall, main  # noqa: E402
+from miro_ball.params import ControllerParams  # noqa: E402
 from miro_ball.synthetic import Disc, jpeg, render  # noqa: E402
 
 TICK = 0.02
@@ -215,6 +216,17 @@ def test_detections_expire_when_a_camera_stops(make_rig):
     assert rig.last_twist()[0] == pytest.approx(0.0)
 
 
+def test_stop_sends_a_zero_twist(make_rig):
+    rig = make_rig(*short_hold())
+    rig.set_clock(10.0)
+    rig.advance(0.2)
+    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.advance(0.1)
+    assert rig.last_twist()[0] > 0.1
+    rig.node.stop()
+    assert rig.last_twist() == (0.0, 0.0)
+
+
 def test_survives_bad_inputs(make_rig):
     rig = make_rig(*short_hold())
     rig.set_clock(10.0)
@@ -274,6 +286,13 @@ def test_robot_name_prefixes_the_topics(make_rig):
     rig.set_clock(10.0)
     rig.advance(0.3)
     assert rig.twists and rig.twists[-1].twist.angular.z == pytest.approx(SEARCH_SPIN)
+
+
+def test_robot_name_defaults_to_the_environment(monkeypatch):
+    monkeypatch.setenv('MIRO_ROBOT_NAME', 'miro07')
+    assert ControllerParams().robot_name == 'miro07'
+    monkeypatch.delenv('MIRO_ROBOT_NAME')
+    assert ControllerParams().robot_name == 'miro'
 
 
 def test_bad_parameter_is_refused(ros_context):
