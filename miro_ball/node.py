@@ -297,10 +297,6 @@ def build_parser():
     return parser
 
 
-def _interrupt(signum, frame):
-    raise KeyboardInterrupt
-
-
 def _fail(parser, err):
     """Exit 2 with the first line of an error: no traceback for bad user input."""
     first_line = (str(err).strip().splitlines() or [type(err).__name__])[0]
@@ -324,7 +320,7 @@ def main(argv=None):
     # wake-up jitter on a small machine shared with the simulator.
     cv2.setNumThreads(1)
     # Our own SIGINT/SIGTERM handling, so the context is still up to send the zero twist.
-    signal.signal(signal.SIGTERM, _interrupt)
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
         node = KickBlueBall(save_debug=options.save_debug)

@@ -66,6 +66,10 @@ def coerce(name, value, default):
         if not isinstance(value, str):
             raise fail('a string')
         return value
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise fail('true or false')
+        return value
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise fail('a number')
     if not math.isfinite(value):

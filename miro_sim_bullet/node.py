@@ -8,6 +8,7 @@ paused, the ~/step service or in-process code calls advance().
 import argparse
 import math
 import os
+import signal
 import sys
 import time
 
@@ -17,9 +18,12 @@ import rclpy
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import PointStamped, Pose2D, Twist, TwistStamped
 from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
+from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.signals import SignalHandlerOptions
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import (BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState,
@@ -30,6 +34,7 @@ from std_srvs.srv import SetBool, Trigger
 from miro_ball.constants import (FRAME_SIZES, JOINT_NAMES, UPSTREAM_FLAG_SIMULATOR,
                                  WHEEL_MAX_SPEED_M_PER_S, topic)
 from miro_ball.kinematics import cmd_vel2wheel_speed, finite
+from miro_ball.params import coerce
 from miro_ball.throttle import Throttled
 from miro_sim_bullet.rendering import Intrinsics, RendererUnavailable
 from miro_sim_bullet.sim import MiroSim
@@ -68,9 +73,11 @@ class SimNode(Node):
 
     def __init__(self, *, context=None, parameter_overrides=None):
         super().__init__('miro_sim', context=context, parameter_overrides=parameter_overrides)
+        p = {}
         for name, default, description in PARAMETERS:
-            self.declare_parameter(name, default)
-        p = {name: self.get_parameter(name).value for name, _, _ in PARAMETERS}
+            descriptor = ParameterDescriptor(description=description, dynamic_typing=True)
+            p[name] = coerce(name, self.declare_parameter(name, default, descriptor).value,
+                             default)
         self.params = p
         size = (p['frame_width'], p['frame_height'])
         if size not in FRAME_SIZES:
@@ -389,9 +396,15 @@ def parse_args(argv):
 
 def main(argv=None):
     argv = sys.argv if argv is None else argv
-    args = parse_args(rclpy.utilities.remove_ros_args(argv)[1:])
+    try:
+        cli_args = rclpy.utilities.remove_ros_args(argv)[1:]
+    except Exception as err:  # rclpy's malformed --ros-args error has no public class
+        sys.exit(f'miro_sim: error: {err}')
+    args = parse_args(cli_args)
     overrides = [Parameter('world', value=args.world)] if args.world else []
-    rclpy.init(args=argv)
+    # Ctrl+C and SIGTERM end the spin as KeyboardInterrupt, with the context still up.
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     try:
         node = SimNode(parameter_overrides=overrides)
@@ -399,7 +412,7 @@ def main(argv=None):
     except (WorldError, RendererUnavailable, ValueError) as err:
         print(f'miro_sim: error: {err}', file=sys.stderr)
         sys.exit(2)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
         if node is not None:
