@@ -16,7 +16,7 @@ from miro_ball.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
 from miro_ball.kinematics import clamp_wheel_speeds, cmd_vel2wheel_speed
 from miro_sim_bullet import robot as rb
 from miro_sim_bullet.rendering import Intrinsics, Renderer, view_matrix_from_pose
-from miro_sim_bullet.world_file import World, load_world
+from miro_sim_bullet.world_file import Shape, World, load_world
 
 GRAVITY = 9.8
 CMD_TIMEOUT_S = 0.5
@@ -76,13 +76,17 @@ class MiroSim:
         pb.setGravity(0, 0, -GRAVITY, **kw)
         world = self.world
         if world.ground_height is not None:
-            self._static_box((0, 0, world.ground_height - 0.05), (100, 100, 0.1),
-                             world.ground_colour)
+            self._shape(Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
+                              size=(100, 100, 0.1), colour=world.ground_colour))
         for shape in world.shapes:
             self._shape(shape)
         self.ball_id = None
         if world.ball is not None:
-            self.ball_id = self._ball(world.ball)
+            ball = world.ball
+            self.ball_id = self._shape(Shape(
+                kind='sphere', position=(*ball.position, ball.radius), radius=ball.radius,
+                colour=ball.colour, mass=ball.mass, friction=ball.friction,
+                restitution=ball.restitution))
         # Sensor rays test against WORLD_GROUP only, so MiRo never sees itself.
         for body in range(pb.getNumBodies(**kw)):
             pb.setCollisionFilterGroupMask(body, -1, WORLD_GROUP, 0xFFFF, **kw)
@@ -107,14 +111,6 @@ class MiroSim:
         self._apply_joint_motors()
         self.cliff = self._read_cliff()
 
-    def _static_box(self, centre, size, colour, yaw=0.0):
-        kw = self._kw()
-        half = [s / 2 for s in size]
-        col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, **kw)
-        vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=half, rgbaColor=(*colour, 1), **kw)
-        return pb.createMultiBody(0, col, vis, centre, pb.getQuaternionFromEuler((0, 0, yaw)),
-                                  **kw)
-
     def _shape(self, shape):
         kw = self._kw()
         if shape.kind == 'box':
@@ -132,17 +128,6 @@ class MiroSim:
                                   pb.getQuaternionFromEuler((0, 0, shape.yaw)), **kw)
         pb.changeDynamics(body, -1, lateralFriction=shape.friction,
                           restitution=shape.restitution, **kw)
-        return body
-
-    def _ball(self, ball):
-        kw = self._kw()
-        col = pb.createCollisionShape(pb.GEOM_SPHERE, radius=ball.radius, **kw)
-        vis = pb.createVisualShape(pb.GEOM_SPHERE, radius=ball.radius,
-                                   rgbaColor=(*ball.colour, 1), **kw)
-        body = pb.createMultiBody(ball.mass, col, vis, (*ball.position, ball.radius), **kw)
-        # A light hollow toy: it rolls (rolling friction 0) and bounces.
-        pb.changeDynamics(body, -1, lateralFriction=ball.friction, restitution=ball.restitution,
-                          rollingFriction=0.0, spinningFriction=0.0, **kw)
         return body
 
     def reset(self):
