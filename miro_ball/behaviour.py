@@ -44,12 +44,14 @@ class BehaviourParams:
     cliff_threshold: float = field(
         default=CLIFF_THRESHOLD, metadata={'help': 'improved: cliff reading below this = drop'})
     seed: int = field(default=0, metadata={'help': 'improved: seed of the exploration RNG'})
+    search_speed: float = field(
+        default=0.25, metadata={'help': 'improved: wheel speed when turning to search or steer, m/s'})
     approach_speed: float = field(
-        default=0.2, metadata={'help': 'improved: forward speed while approaching, m/s'})
+        default=0.4, metadata={'help': 'improved: forward speed while approaching, m/s'})
     steer_gain: float = field(
         default=3.0, metadata={'help': 'improved: turn rate per rad of ball bearing, 1/s'})
     turn_only_deg: float = field(
-        default=45.0, metadata={'help': 'improved: turn on the spot beyond this bearing, deg'})
+        default=70.0, metadata={'help': 'improved: turn on the spot beyond this bearing, deg'})
     kick_bearing_deg: float = field(
         default=5.0, metadata={'help': 'improved: kick when the bearing is within this, deg'})
     kick_radius: float = field(
@@ -64,9 +66,10 @@ class BehaviourParams:
         default=1.0, metadata={'help': 'improved: reverse this long away from an edge, s'})
 
     def __post_init__(self):
-        speeds = (self.slow, self.fast, self.fine, self.approach_speed)
+        speeds = (self.slow, self.fast, self.fine, self.search_speed, self.approach_speed)
         if not all(0 < v <= WHEEL_MAX_SPEED_M_PER_S for v in speeds):
-            raise ValueError('slow, fast, fine and approach_speed must be in (0, %g] m/s'
+            raise ValueError('slow, fast, fine, search_speed and approach_speed must be in '
+                             '(0, %g] m/s'
                              % WHEEL_MAX_SPEED_M_PER_S)
         positive = (self.centre_error, self.kick_duration, self.steer_gain, self.turn_only_deg,
                     self.kick_bearing_deg, self.kick_radius, self.search_turn_deg,
@@ -118,6 +121,9 @@ def spin(direction, speed):
 
 class _Machine:
     """Shared bookkeeping: the state name and the messages of this tick."""
+
+    # The tutorial sets the head pose before its loop starts: wheels still meanwhile.
+    waits_for_head = True
 
     def __init__(self, params: BehaviourParams):
         self.params = params
@@ -211,6 +217,8 @@ class ImprovedBehaviour(_Machine):
        into the kick once the ball is centred and close.
     """
 
+    waits_for_head = False  # the head starts in its pose anyway: search while it settles
+
     def __init__(self, params: BehaviourParams):
         super().__init__(params)
         self.rng = random.Random(params.seed)
@@ -220,7 +228,7 @@ class ImprovedBehaviour(_Machine):
         self._manoeuvre = None
         self._kick_start = None
         self._seen = None  # (time, bearing) of the latest sighting
-        self._spin_rate = wheel_speed2cmd_vel(spin(1, params.slow))[1]  # rad/s, > 0
+        self._spin_rate = wheel_speed2cmd_vel(spin(1, params.search_speed))[1]  # rad/s, > 0
 
     def _decide(self, t, left, right, cliff):
         dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
@@ -280,7 +288,7 @@ class ImprovedBehaviour(_Machine):
         self.turned += self._spin_rate * dt
         if self.turned >= math.radians(self.params.search_turn_deg):
             return self._explore(t)
-        return spin(self.side, self.params.slow)
+        return spin(self.side, self.params.search_speed)
 
     def _start_search(self, *extra):
         self.turned = 0.0
@@ -300,7 +308,7 @@ class ImprovedBehaviour(_Machine):
 
     def _turn_for(self, direction, angle):
         """A spin segment turning `angle` rad towards direction at the search speed."""
-        return spin(direction, self.params.slow) + (angle / self._spin_rate,)
+        return spin(direction, self.params.search_speed) + (angle / self._spin_rate,)
 
     def _explore(self, t):
         p = self.params

@@ -222,10 +222,11 @@ class KickBlueBall(Node):
             if self.config.head_hold_s > 0:
                 self.get_logger().info('holding the head pose for %g s' % self.config.head_hold_s)
         if now - self._started < self.config.head_hold_s:
-            self.state = STARTUP
             self._publish_head()
-            self.drive(0.0, 0.0)
-            return
+            if self.behaviour.waits_for_head:
+                self.state = STARTUP
+                self.drive(0.0, 0.0)
+                return
         self._check_silence(now)
         stale = self.config.stale_s
         left, right = (latest.fresh(now, stale) for latest in self.balls)

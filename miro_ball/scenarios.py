@@ -54,8 +54,11 @@ def placements(count, seed=0):
 
 
 def run_episode(context, placement=None, mode='improved', limit_s=60.0, renderer='auto',
-                world='miro', seed=1, settle_s=1.0):
-    """One episode from a placement (None: the world's own start); returns an Outcome."""
+                world='miro', seed=1, settle_s=1.0, controller_params=()):
+    """One episode from a placement (None: the world's own start); returns an Outcome.
+
+    controller_params: extra (name, value) ROS parameters of the controller.
+    """
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.parameter import Parameter
 
@@ -67,7 +70,7 @@ def run_episode(context, placement=None, mode='improved', limit_s=60.0, renderer
         Parameter('renderer', value=renderer)])
     controller = KickBlueBall(context=context, parameter_overrides=[
         Parameter('use_sim_time', value=True), Parameter('mode', value=mode),
-        Parameter('seed', value=seed)])
+        Parameter('seed', value=seed)] + [Parameter(n, value=v) for n, v in controller_params])
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(sim_node)
     executor.add_node(controller)

@@ -14,6 +14,8 @@ from miro_ball.kinematics import wheel_speed2cmd_vel
 
 TICK = 0.02
 FLOOR = (1.0, 1.0)
+DEFAULTS = BehaviourParams()
+SEARCH_WHEELS = (DEFAULTS.search_speed, -DEFAULTS.search_speed)  # clockwise
 
 # Where a ball straight ahead appears in each eye (the eyes look 27 deg outwards).
 AHEAD_X = math.tan(CAM_DIVERGENCE_RAD) / (2 * math.tan(math.radians(60)))
@@ -120,7 +122,7 @@ def improved():
 
 def test_improved_searches_clockwise_until_it_has_seen_a_ball(improved):
     command = improved.step(0.0, None, None, FLOOR)
-    assert command.state == SEARCH and (command.left, command.right) == (0.1, -0.1)
+    assert command.state == SEARCH and (command.left, command.right) == SEARCH_WHEELS
 
 
 @pytest.mark.parametrize('left,right,direction', [
@@ -133,10 +135,11 @@ def test_improved_remembers_the_side(improved, left, right, direction):
     improved.step(0.0, left, right, FLOOR)
     command = run(improved, 0.4, t0=TICK)[-1]  # past lost_grace_s (0.3 s)
     assert command.state == SEARCH
-    assert (command.left, command.right) == (-0.1 * direction, 0.1 * direction)
+    wheels = tuple(-direction * w for w in SEARCH_WHEELS)
+    assert (command.left, command.right) == wheels
     assert improved.side == direction
     # Still that way after a while.
-    assert run(improved, 1.0, t0=0.5)[-1][:2] == (-0.1 * direction, 0.1 * direction)
+    assert run(improved, 1.0, t0=0.5)[-1][:2] == wheels
 
 
 def test_improved_holds_course_through_a_missed_frame(improved):
@@ -150,7 +153,7 @@ def test_improved_holds_course_through_a_missed_frame(improved):
 def test_improved_drives_straight_at_a_centred_ball(improved):
     command = improved.step(0.0, *CENTRED_FAR, FLOOR)
     assert command.state == APPROACH
-    assert forward(command) == pytest.approx(0.2)
+    assert forward(command) == pytest.approx(DEFAULTS.approach_speed)
     assert turn(command) == pytest.approx(0.0, abs=1e-9)
 
 
@@ -159,11 +162,11 @@ def test_improved_steers_while_driving(improved):
     x = math.tan(CAM_DIVERGENCE_RAD - math.radians(15)) / (2 * math.tan(math.radians(60)))
     command = improved.step(0.0, ball(x), None, FLOOR)
     assert command.state == APPROACH
-    assert 0.05 < forward(command) < 0.2 and turn(command) > 0.5
+    assert 0.05 < forward(command) < DEFAULTS.approach_speed and turn(command) > 0.5
     # Far to the right: turn on the spot first, at most as fast as the search spin.
     command = improved.step(TICK, None, ball(0.45), FLOOR)
     assert forward(command) == pytest.approx(0.0, abs=1e-9)
-    assert turn(command) == pytest.approx(-2 * 0.1 / 0.164)
+    assert turn(command) == pytest.approx(-2 * DEFAULTS.search_speed / 0.164)
 
 
 def test_improved_speeds_up_into_the_kick_when_centred_and_close(improved):
@@ -180,7 +183,7 @@ def test_improved_speeds_up_into_the_kick_when_centred_and_close(improved):
 def test_improved_does_not_kick_an_off_centre_ball(improved):
     close_left = (ball(AHEAD_X + 0.08, 0.06), ball(-AHEAD_X + 0.08, 0.06))
     command = improved.step(0.0, *close_left, FLOOR)
-    assert command.state == APPROACH and forward(command) < 0.2
+    assert command.state == APPROACH and forward(command) < DEFAULTS.approach_speed
 
 
 @pytest.mark.parametrize('cliff,away', [((0.2, 1.0), -1), ((1.0, 0.1), 1)])
@@ -229,7 +232,7 @@ def test_improved_never_moves_forward_over_a_cliff_random_inputs():
 
 def explore_after_full_turn(seed, cliff=FLOOR):
     machine = ImprovedBehaviour(BehaviourParams(seed=seed))
-    full_turn_s = 2 * math.pi / (2 * 0.1 / 0.164)
+    full_turn_s = 2 * math.pi / (2 * DEFAULTS.search_speed / 0.164)
     commands = run(machine, full_turn_s + 6.0, cliff=cliff)
     return machine, commands, full_turn_s
 
@@ -241,7 +244,7 @@ def test_improved_explores_after_a_fruitless_full_turn():
     assert first * TICK == pytest.approx(full_turn_s, abs=2 * TICK)
     assert all(s == SEARCH for s in states[:first])
     moves = [c for c in commands if c.state == EXPLORE and forward(c) > 0]
-    assert moves and all(forward(c) == pytest.approx(0.2) for c in moves)
+    assert moves and all(forward(c) == pytest.approx(DEFAULTS.approach_speed) for c in moves)
 
 
 def test_improved_exploration_is_seeded():

@@ -17,13 +17,16 @@ from rosgraph_msgs.msg import Clock  # noqa: E402
 from sensor_msgs.msg import CompressedImage, JointState  # noqa: E402
 from std_msgs.msg import Float32MultiArray  # noqa: E402
 
+from miro_ball.behaviour import BehaviourParams  # noqa: E402
 from miro_ball.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES  # noqa: E402
 from miro_ball.node import build_parser, KickBlueBall, main  # noqa: E402
 from miro_ball.params import ControllerParams  # noqa: E402
 from miro_ball.synthetic import Disc, jpeg, render  # noqa: E402
 
 TICK = 0.02
-SEARCH_SPIN = -2 * 0.1 / 0.164  # rad/s, clockwise
+DEFAULTS = BehaviourParams()
+SEARCH_SPIN = -2 * DEFAULTS.search_speed / 0.164  # rad/s, clockwise (improved)
+TUTORIAL_SPIN = -2 * DEFAULTS.slow / 0.164
 # Column where a ball straight ahead appears in each eye (the eyes look 27 deg outwards).
 AHEAD_X = math.tan(CAM_DIVERGENCE_RAD) / (2 * math.tan(math.radians(60)))
 
@@ -133,8 +136,8 @@ def short_hold(*more):
     return [Parameter('head_hold_s', value=0.1)] + list(more)
 
 
-def test_holds_the_head_then_searches(make_rig):
-    rig = make_rig()
+def test_tutorial_holds_the_head_then_searches(make_rig):
+    rig = make_rig(Parameter('mode', value='tutorial'))
     rig.set_clock(10.0)
     rig.advance(0.5)
     assert rig.node.state == 'startup'
@@ -149,14 +152,25 @@ def test_holds_the_head_then_searches(make_rig):
     rig.advance(0.3)
     assert len(rig.joints) == joints_after_hold, 'head pose still published after the hold'
     linear, angular = rig.last_twist()
-    assert linear == pytest.approx(0.0) and angular == pytest.approx(SEARCH_SPIN)
+    assert linear == pytest.approx(0.0) and angular == pytest.approx(TUTORIAL_SPIN)
     twist = rig.twists[-1]
     assert twist.header.frame_id == 'base_link'
     stamp = twist.header.stamp.sec + twist.header.stamp.nanosec * 1e-9
     assert 11.0 < stamp <= rig.now + 1e-6  # stamped with simulated time
 
 
-@pytest.mark.parametrize('mode,speed', [('tutorial', 0.4), ('improved', 0.2)])
+def test_improved_searches_while_the_head_settles(make_rig):
+    rig = make_rig()
+    rig.set_clock(10.0)
+    rig.advance(0.5)
+    assert rig.joints and list(rig.joints[-1].position) == pytest.approx(
+        [0.0, math.radians(34.0), 0.0, 0.0])
+    assert rig.node.state == 'search'
+    assert rig.last_twist()[1] == pytest.approx(SEARCH_SPIN)
+
+
+@pytest.mark.parametrize('mode,speed', [('tutorial', DEFAULTS.fast),
+                                        ('improved', DEFAULTS.approach_speed)])
 def test_drives_forward_at_a_ball_centred_in_both_eyes(make_rig, mode, speed):
     rig = make_rig(*short_hold(Parameter('mode', value=mode)))
     rig.set_clock(10.0)
