@@ -12,7 +12,7 @@ PY="$VENV/bin/python"
 
 say() { printf '[dev.sh] %s\n' "$*" >&2; }
 
-have_egl() { ldconfig -p 2>/dev/null | grep -q 'libEGL.so.1' && ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1; }
+have_egl() { compgen -G '/usr/lib/*/libEGL.so.1' >/dev/null && compgen -G '/usr/lib/*/dri/swrast_dri.so' >/dev/null; }
 
 system_packages() {
   local want=()

@@ -83,11 +83,16 @@ class SimNode(Node):
         if size not in FRAME_SIZES:
             raise ValueError(f'frame size {size[0]}x{size[1]} is not one of MiRo\'s: '
                              + ', '.join(f'{w}x{h}' for w, h in FRAME_SIZES))
-        for name in ('camera_rate', 'physics_dt'):
-            if not p[name] > 0:
-                raise ValueError(f'{name} must be > 0, got {p[name]}')
-        if not p['real_time_factor'] >= 0:
-            raise ValueError(f'real_time_factor must be >= 0, got {p["real_time_factor"]}')
+        checks = (('camera_rate', p['camera_rate'] > 0, '> 0'),
+                  ('physics_dt', 0 < p['physics_dt'] <= 0.02, 'in (0, 0.02] s'),
+                  ('real_time_factor', p['real_time_factor'] >= 0, '>= 0'),
+                  ('hfov_deg', 0 < p['hfov_deg'] < 180, 'in (0, 180)'),
+                  ('step_count', p['step_count'] >= 1, '>= 1'),
+                  ('jpeg_quality', 1 <= p['jpeg_quality'] <= 100, 'in 1..100'),
+                  ('overhead_rate', p['overhead_rate'] >= 0, '>= 0'))
+        for name, ok, rule in checks:
+            if not ok:
+                raise ValueError(f'parameter {name} must be {rule}, got {p[name]}')
         self.warn = Throttled(self.get_logger().warning)
         self.sim = MiroSim(p['world'], physics_dt=p['physics_dt'], renderer=p['renderer'],
                            log=self.get_logger().info)

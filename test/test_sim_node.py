@@ -3,6 +3,8 @@
 The world is stepped by the test (the node starts paused), never by wall-clock time.
 """
 import math
+import subprocess
+import sys
 
 import cv2
 import numpy as np
@@ -167,3 +169,24 @@ def test_eye_cameras_publish_matching_stereo_frames(sim_node, probe, executor):
 def test_cameras_render_only_while_subscribed(sim_node, executor):
     run(sim_node, executor, 1.0)
     assert sim_node.frames_published == 0
+
+
+@pytest.mark.parametrize('args, message', [
+    (['--world', 'nowhere'], "unknown world 'nowhere'"),
+    (['--ros-args', '-p', 'frame_width:=100'], 'frame size 100x360 is not one of'),
+    (['--ros-args', '-p', 'camera_rate:=abc'], "parameter 'camera_rate' must be a number"),
+])
+def test_bad_start_options_fail_in_one_line(args, message):
+    out = subprocess.run([sys.executable, '-m', 'miro_sim_bullet', *args], capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 2
+    errors = [line for line in out.stderr.splitlines() if line.startswith('miro_sim: error:')]
+    assert len(errors) == 1 and message in errors[0]
+    assert 'Traceback' not in out.stderr
+
+
+def test_help_lists_the_parameters_and_worlds():
+    out = subprocess.run([sys.executable, '-m', 'miro_sim_bullet', '--help'],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0
+    assert 'real_time_factor' in out.stdout and 'bundled worlds: empty, miro, table' in out.stdout
