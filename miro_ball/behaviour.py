@@ -45,7 +45,8 @@ class BehaviourParams:
         default=CLIFF_THRESHOLD, metadata={'help': 'improved: cliff reading below this = drop'})
     seed: int = field(default=0, metadata={'help': 'improved: seed of the exploration RNG'})
     search_speed: float = field(
-        default=0.25, metadata={'help': 'improved: wheel speed when turning to search or steer, m/s'})
+        default=0.25,
+        metadata={'help': 'improved: wheel speed when turning to search or steer, m/s'})
     approach_speed: float = field(
         default=0.4, metadata={'help': 'improved: forward speed while approaching, m/s'})
     steer_gain: float = field(

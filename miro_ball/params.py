@@ -27,7 +27,8 @@ class ControllerParams:
     stale_s: float = field(
         default=0.5, metadata={'help': 'forget detections and cliff readings older than this, s'})
     head_hold_s: float = field(
-        default=1.0, metadata={'help': 'hold the head pose this long at start (tutorial: wheels still), s'})
+        default=1.0,
+        metadata={'help': 'hold the head pose this long at start (tutorial: wheels still), s'})
     head_lift_deg: float = field(
         default=round(math.degrees(LIFT_RAD_CALIB), 6),
         metadata={'help': 'lift joint of the start pose [tilt 0, lift, yaw 0, pitch 0], deg'})
