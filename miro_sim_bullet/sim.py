@@ -27,7 +27,21 @@ COSMETIC_TORQUE_NM = 0.2
 BATTERY_VOLTAGE = 4.8  # NiMH nominal
 AMBIENT_LIGHT = 0.5
 WORLD_GROUP, ROBOT_GROUP = 1, 2  # collision groups: sensor rays see only the world
-SONAR_RING = ((0.0, 0.0),) + tuple((r, a * math.pi / 3) for r in (0.5, 1.0) for a in range(6))
+
+
+def _cone_directions(half_angle, rings=(0.5, 1.0), per_ring=6):
+    """Unit vectors (head frame, x forward) filling a cone: its axis and rings around it."""
+    directions = [np.array([1.0, 0.0, 0.0])]
+    for ring in rings:
+        off = ring * math.tan(half_angle)
+        for k in range(per_ring):
+            a = 2 * math.pi * k / per_ring
+            d = np.array([1.0, off * math.cos(a), off * math.sin(a)])
+            directions.append(d / np.linalg.norm(d))
+    return np.array(directions)
+
+
+SONAR_DIRECTIONS = _cone_directions(rb.SONAR_HALF_CONE)
 
 
 @dataclass
@@ -271,11 +285,7 @@ class MiroSim:
         pos, rot = self._link_frame(rb.HEAD)
         start = pos + rot @ np.array(rb.SONAR_IN_HEAD)
         lo, hi = rb.SONAR_RANGE
-        ends = []
-        for frac, angle in SONAR_RING:
-            off = frac * math.tan(rb.SONAR_HALF_CONE)
-            direction = np.array([1.0, off * math.cos(angle), off * math.sin(angle)])
-            ends.append(start + hi * rot @ (direction / np.linalg.norm(direction)))
+        ends = start + hi * SONAR_DIRECTIONS @ rot.T
         hits = pb.rayTestBatch([start] * len(ends), ends, collisionFilterMask=WORLD_GROUP,
                                **self._kw())
         found = [h[2] * hi for h in hits if h[0] >= 0]

@@ -152,3 +152,16 @@ def test_illum_colours_the_body_patches(empty):
     assert colours[ILLUM_LINKS[1]][1] > 0.95 and colours[ILLUM_LINKS[1]][0] < 0.5  # half-lit green
     assert colours[ILLUM_LINKS[2]][:3] == pytest.approx((0.92, 0.92, 0.90))
     assert colours[ILLUM_LINKS[5]][:3] == pytest.approx((0.0, 0.0, 1.0))
+
+
+def test_sonar_sees_the_ball_ahead_and_nothing_beyond_range(empty):
+    # Head and nose up: the 34-degree cone clears the floor.
+    empty.set_kinematic_targets([0.0, math.radians(8), 0.0, math.radians(-22)])
+    empty.run(1.0)
+    assert empty.read_sensors().sonar == math.inf
+    empty.set_kinematic_targets([0.0, math.radians(8), 0.0, 0.0])
+    empty.place(ball_xy=(0.6, 0.0))
+    empty.run(1.0)
+    sonar = empty.read_sensors().sonar
+    nose_x = empty.eye_pose(+1)[0][0]  # the sonar sits near the eyes, at the front
+    assert sonar == pytest.approx(0.6 - 0.1 - nose_x, abs=0.06)
