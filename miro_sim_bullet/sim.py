@@ -91,7 +91,7 @@ class MiroSim:
         world = self.world
         if world.ground_height is not None:
             self._shape(Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
-                              size=(100, 100, 0.1), colour=world.ground_colour))
+                              size=(*world.ground_size, 0.1), colour=world.ground_colour))
         for shape in world.shapes:
             self._shape(shape)
         self.ball_id = None

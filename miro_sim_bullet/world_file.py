@@ -51,6 +51,7 @@ class World:
     ball: Ball | None = None
     ground_height: float | None = None
     ground_colour: tuple = DEFAULT_COLOUR
+    ground_size: tuple = (100.0, 100.0)
     shapes: tuple = field(default_factory=tuple)
 
 
@@ -115,6 +116,12 @@ class _Parser:
             self.fail(where, f'must be a list of {length} numbers, got {value!r}')
         return tuple(self.number(f'{where}[{i}]', v) for i, v in enumerate(value))
 
+    def size(self, where, value, length):
+        extents = self.vector(where, value, length)
+        if min(extents) <= 0:
+            self.fail(where, 'every extent must be > 0')
+        return extents
+
     def colour(self, where, value):
         rgb = self.vector(where, value, 3)
         if not all(0.0 <= c <= 1.0 for c in rgb):
@@ -134,7 +141,7 @@ class _Parser:
             shapes.extend(self.ring(f'ring[{i}]', table))
         ground = data.get('ground')
         if ground is not None:
-            self.keys('ground', ground, {'height', 'colour'})
+            self.keys('ground', ground, {'height', 'colour', 'size'})
         description = data.get('description', '')
         if not isinstance(description, str):
             self.fail('description', 'must be a string')
@@ -148,6 +155,8 @@ class _Parser:
                 'ground.height', ground.get('height', 0.0)),
             ground_colour=DEFAULT_COLOUR if ground is None else self.colour(
                 'ground.colour', ground.get('colour', list(DEFAULT_COLOUR))),
+            ground_size=(100.0, 100.0) if ground is None else self.size(
+                'ground.size', ground.get('size', [100.0, 100.0]), 2),
             shapes=tuple(shapes),
         )
 
@@ -186,11 +195,7 @@ class _Parser:
         for key in dims:
             if key not in table:
                 self.fail(where, f'missing {key!r}')
-        size = ()
-        if kind == 'box':
-            size = self.vector(f'{where}.size', table['size'], 3)
-            if min(size) <= 0:
-                self.fail(f'{where}.size', 'every extent must be > 0')
+        size = self.size(f'{where}.size', table['size'], 3) if kind == 'box' else ()
         return Shape(
             kind=kind,
             position=self.vector(f'{where}.position', table.get('position', [0, 0, 0]), 3),
