@@ -57,9 +57,13 @@ def measure(renderer, sim_seconds, width, height, rate):
         'frames_per_wall_s': (len(received) - frames0) / wall,
         'frames_per_sim_s': (len(received) - frames0) / (node.sim.time - sim0),
         'ms_per_stereo_frame': 1000 * statistics.median(node.render_seconds[renders0:]),
-        'peak_rss_mb': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
     }
-    node.destroy_node()
+    workers = 0 if node.sim.eye_workers is None else len(node.sim.eye_workers.processes)
+    figures['renderer'] += f' + {workers} eye processes' if workers else ''
+    node.destroy_node()  # also ends the eye processes, so their peak is known below
+    # Peak memory of this process plus that of each eye process (the largest one's).
+    figures['peak_rss_mb'] = (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss + workers
+                              * resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss) / 1024
     listener.destroy_node()
     rclpy.try_shutdown(context=context)
     return figures

@@ -54,6 +54,7 @@ PARAMETERS = (
     ('camera_rate', 15.0, 'eye camera frames per simulated second'),
     ('hfov_deg', 120.0, 'eye camera horizontal field of view (pinhole)'),
     ('renderer', 'auto', 'auto | tiny | egl'),
+    ('eye_workers', True, 'with TinyRenderer, render each eye in a process of its own'),
     ('jpeg_quality', 80, 'JPEG quality of sensors/cam?/compressed'),
     ('overhead_rate', 0.0, 'frames per simulated second of ~/overhead/compressed; 0 = off'),
 )
@@ -95,7 +96,7 @@ class SimNode(Node):
                 raise ValueError(f'parameter {name} must be {rule}, got {p[name]}')
         self.warn = Throttled(self.get_logger().warning)
         self.sim = MiroSim(p['world'], physics_dt=p['physics_dt'], renderer=p['renderer'],
-                           log=self.get_logger().info)
+                           log=self.get_logger().info, eye_workers=p['eye_workers'])
         self.intrinsics = Intrinsics.from_hfov(*size, p['hfov_deg'])
         self.get_logger().info(
             f'world {self.sim.world.source}; renderer {self.sim.renderer.name}; cameras '
@@ -245,7 +246,7 @@ class SimNode(Node):
             return
         rtf = self.params['real_time_factor']
         if rtf == 0:
-            self.advance(5 * self.sim.ticks_per_platform_tick)
+            self.advance(self.sim.ticks_per_platform_tick)  # one tick: no bursts of frames
         else:
             wall0, sim0 = self._anchor
             behind = sim0 + (time.monotonic() - wall0) * rtf - self.sim.time
@@ -360,13 +361,14 @@ class SimNode(Node):
     def _publish_cameras(self):
         stamp = _stamp(self.sim.time)
         started = time.perf_counter()
-        rendered = 0
-        for eye, side in EYES:
+        wanted = [(eye, side) for eye, side in EYES
+                  if any(p.get_subscription_count() for p in self.pub_eyes[eye])]
+        if not wanted:
+            return
+        images = self.sim.render_eyes([side for _, side in wanted], self.intrinsics)
+        for (eye, _), rgb in zip(wanted, images):
             compressed, raw, info = self.pub_eyes[eye]
-            if not any(p.get_subscription_count() for p in (compressed, raw, info)):
-                continue
             frame_id = f'{eye}_optical_frame'
-            rgb = self.sim.render_eye(side, self.intrinsics)
             if compressed.get_subscription_count():
                 compressed.publish(self._jpeg(rgb, stamp, frame_id))
             if raw.get_subscription_count():
@@ -376,10 +378,8 @@ class SimNode(Node):
                 msg.header.stamp, msg.header.frame_id = stamp, frame_id
                 raw.publish(msg)
             info.publish(self._camera_info(stamp, frame_id))
-            rendered += 1
-        if rendered:
-            self.frames_published += rendered
-            self.render_seconds.append(time.perf_counter() - started)
+        self.frames_published += len(wanted)
+        self.render_seconds.append(time.perf_counter() - started)
 
     def destroy_node(self):
         self.sim.close()

@@ -15,6 +15,7 @@ from miro_ball.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                  KIN_CALIB_RAD, PLATFORM_TICK_S, TILT_RAD, WHEEL_RADIUS_M)
 from miro_ball.kinematics import clamp_wheel_speeds, cmd_vel2wheel_speed
 from miro_sim_bullet import robot as rb
+from miro_sim_bullet.eye_workers import EyeWorkers
 from miro_sim_bullet.rendering import Intrinsics, Renderer, view_matrix_from_pose
 from miro_sim_bullet.world_file import Shape, World, load_world
 
@@ -67,8 +68,10 @@ class Sensors:
 class MiroSim:
     """One PyBullet world with MiRo in it."""
 
-    def __init__(self, world='miro', physics_dt=0.001, renderer=None, log=print):
-        """renderer: None (no cameras), 'auto', 'tiny' or 'egl'."""
+    def __init__(self, world='miro', physics_dt=0.001, renderer=None, log=print,
+                 eye_workers=False):
+        """renderer: None (no cameras), 'auto', 'tiny' or 'egl'. eye_workers: when the
+        renderer is TinyRenderer, render the two eyes in two helper processes."""
         self.world = world if isinstance(world, World) else load_world(world)
         self.dt = physics_dt
         self.ticks_per_platform_tick = max(1, round(PLATFORM_TICK_S / physics_dt))
@@ -77,6 +80,10 @@ class MiroSim:
         self.renderer = None if renderer is None else Renderer(self.client, kind=renderer,
                                                                log=log)
         self._build()
+        self.eye_workers = None
+        if eye_workers and self.renderer is not None and self.renderer.kind == 'tiny':
+            self.eye_workers = EyeWorkers(self.world, physics_dt)
+            log('eyes rendered in 2 worker processes, one eye each')
 
     # -- world ------------------------------------------------------------------------------
     def _kw(self):
@@ -159,6 +166,9 @@ class MiroSim:
         self.cliff = self._read_cliff()
 
     def close(self):
+        if self.eye_workers is not None:
+            self.eye_workers.close()
+            self.eye_workers = None
         if self.renderer is not None:
             self.renderer.close()
             self.renderer = None
@@ -346,6 +356,34 @@ class MiroSim:
     def render_eye(self, side, intrinsics):
         """RGB image (h, w, 3) of one eye now."""
         return self.render_view(*self.eye_pose(side), intrinsics)
+
+    def render_eyes(self, sides, intrinsics):
+        """RGB images of the given eyes (+1 left, -1 right) at this instant."""
+        if self.eye_workers is None:
+            return [self.render_eye(side, intrinsics) for side in sides]
+        views = [view_matrix_from_pose(*self.eye_pose(side)) for side in sides]
+        return self.eye_workers.render(self.state(), views, intrinsics)
+
+    def state(self):
+        """Poses of everything that can move and MiRo's joint angles: enough to redraw."""
+        kw = self._kw()
+        bodies = [(body, *pb.getBasePositionAndOrientation(body, **kw))
+                  for body in range(pb.getNumBodies(**kw))
+                  if body == self.robot_id or pb.getDynamicsInfo(body, -1, **kw)[0] > 0]
+        joints = range(pb.getNumJoints(self.robot_id, **kw))
+        angles = [s[0] for s in pb.getJointStates(self.robot_id, joints, **kw)]
+        return bodies, angles, list(self.illum)
+
+    def set_state(self, state):
+        """Pose this world as state() of an identically built one describes."""
+        kw = self._kw()
+        bodies, angles, illum = state
+        for body, position, orientation in bodies:
+            pb.resetBasePositionAndOrientation(body, position, orientation, **kw)
+        for joint, angle in enumerate(angles):
+            pb.resetJointState(self.robot_id, joint, angle, **kw)
+        if illum != self.illum:
+            self.set_illum(illum)
 
     def render_view(self, position, rotation, intrinsics):
         """RGB image from any camera pose (x forward, y left, z up)."""

@@ -84,3 +84,19 @@ def test_ball_is_blue_after_jpeg(sim):
     u, v = (int(round(c)) for c in blue_centroid(rgb))
     b, g, r = bgr[v, u]
     assert b > 150 and g < 60 and r < 60
+
+
+def test_eye_worker_processes_render_exactly_what_the_simulator_would():
+    world = MiroSim('miro', renderer='tiny', eye_workers=True)
+    try:
+        assert world.eye_workers is not None
+        world.set_kinematic_targets([0.0, math.radians(50), math.radians(20), 0.0])
+        world.set_cmd_vel(0.2, 0.5)
+        world.run(1.0)  # robot, head and (maybe) ball have moved since the workers' copy
+        intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
+        from_workers = world.render_eyes([+1, -1], intrinsics)
+        in_process = [world.render_eye(side, intrinsics) for side in (+1, -1)]
+        for a, b in zip(from_workers, in_process):
+            assert np.array_equal(a, b)
+    finally:
+        world.close()
