@@ -63,7 +63,7 @@ def _serve(connection, world, physics_dt):
             state, view, intrinsics = job
             sim.set_state(state)
             connection.send_bytes(sim.renderer.render(view, intrinsics).tobytes())
-    except (EOFError, KeyboardInterrupt):
-        pass  # the simulator went away
+    except (EOFError, OSError, KeyboardInterrupt):
+        pass  # the simulator went away (stopped, or interrupted mid-frame)
     finally:
         sim.close()
