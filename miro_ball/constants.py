@@ -25,7 +25,6 @@ LIFT_RAD_CALIB = math.radians(34.0)
 KIN_CALIB_RAD = (TILT_RAD, LIFT_RAD_CALIB, 0.0, 0.0)
 
 # Cosmetic joints (section 1.5): droop, wag, eyelid l/r, ear l/r, each 0..1.
-COSMETIC_NAMES = ('droop', 'wag', 'eye_l', 'eye_r', 'ear_l', 'ear_r')
 COSMETIC_CALIB = (0.0, 0.5, 0.0, 0.0, 1.0 / 3.0, 1.0 / 3.0)
 
 # Cameras (section 2)
@@ -40,9 +39,6 @@ CLIFF_THRESHOLD = 0.7
 # Flags (section 3.3)
 UPSTREAM_FLAG_SIMULATOR = 1 << 15
 DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX = 1 << 21
-
-# Toy ball (section 6)
-BALL_RADIUS_M = 0.1
 
 
 def topic(robot_name: str, name: str) -> str:

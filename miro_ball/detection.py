@@ -149,8 +149,3 @@ def annotate(frame_bgr, ball: Optional[Ball]):
         cv2.circle(out, (cx, cy), r, (0, 255, 0), 2)
         cv2.circle(out, (cx, cy), 2, (0, 0, 255), 3)
     return out
-
-
-def detect_ball(frame_bgr, params: DetectionParams = DetectionParams()) -> Optional[Ball]:
-    """One-shot convenience wrapper around BallDetector."""
-    return BallDetector(params).detect(frame_bgr)

@@ -62,7 +62,6 @@ class Sensors:
     imu_head: tuple
     battery_voltage: float
     light: tuple
-    flags: int
 
 
 class MiroSim:
@@ -343,7 +342,6 @@ class MiroSim:
             imu_head=self._imu(rb.HEAD, 'head'),
             battery_voltage=BATTERY_VOLTAGE,
             light=(AMBIENT_LIGHT,) * 4,
-            flags=self.flags,
         )
 
     # -- cameras ----------------------------------------------------------------------------
