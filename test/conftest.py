@@ -13,7 +13,7 @@ os.environ['ROS_DOMAIN_ID'] = str(1 + os.getpid() % 100)
 @pytest.fixture
 def ros_context():
     """A fresh, initialised rclpy Context (never the global one)."""
-    rclpy = pytest.importorskip('rclpy')
+    import rclpy
     from rclpy.context import Context
 
     context = Context()

@@ -7,21 +7,19 @@ import sys
 import cv2
 import numpy as np
 import pytest
+import rclpy
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import TwistStamped
+from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CompressedImage, JointState
+from std_msgs.msg import Float32MultiArray
 
-rclpy = pytest.importorskip('rclpy')
-
-from builtin_interfaces.msg import Time  # noqa: E402
-from geometry_msgs.msg import TwistStamped  # noqa: E402
-from rclpy.parameter import Parameter  # noqa: E402
-from rosgraph_msgs.msg import Clock  # noqa: E402
-from sensor_msgs.msg import CompressedImage, JointState  # noqa: E402
-from std_msgs.msg import Float32MultiArray  # noqa: E402
-
-from miro_ball.behaviour import BehaviourParams  # noqa: E402
-from miro_ball.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES  # noqa: E402
-from miro_ball.node import build_parser, KickBlueBall, main  # noqa: E402
-from miro_ball.params import ControllerParams  # noqa: E402
-from miro_ball.synthetic import Disc, jpeg, render  # noqa: E402
+from miro_ball.behaviour import BehaviourParams
+from miro_ball.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
+from miro_ball.node import build_parser, KickBlueBall, main
+from miro_ball.params import ControllerParams
+from miro_ball.synthetic import Disc, jpeg, render
 
 TICK = 0.02
 DEFAULTS = BehaviourParams()
