@@ -8,7 +8,6 @@ and spins until the frame has been through the detector and until the next twist
 comes back; the latter includes the wait for the next control tick.
 """
 import argparse
-import os
 import statistics
 import time
 
@@ -17,6 +16,7 @@ import numpy as np
 
 from miro_ball.constants import FRAME_SIZES
 from miro_ball.detection import BallDetector
+from miro_ball.isolation import limit_discovery, private_domain
 from miro_ball.synthetic import Disc, jpeg, render
 
 POOL = 16  # distinct frames per case; rendering is slower than detecting
@@ -77,9 +77,9 @@ def bench_latency(count):
     from miro_ball.node import KickBlueBall
 
     # A private domain and robot name: never talk to a real simulator or robot.
-    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    limit_discovery()
     context = Context()
-    rclpy.init(context=context, domain_id=101 + os.getpid() % 100)
+    rclpy.init(context=context, domain_id=private_domain(salt=75))
     node = KickBlueBall(context=context, parameter_overrides=[
         Parameter('robot_name', value='miro_bench'), Parameter('head_hold_s', value=0.0)])
     probe = rclpy.create_node('bench_probe', context=context)

@@ -7,7 +7,6 @@ also writes a video: the overhead view beside the two eye views with the
 controller's detections drawn.
 """
 import argparse
-import os
 import signal
 import subprocess
 import sys
@@ -17,15 +16,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-KICK_DISTANCE_M = 0.3
+from miro_ball.isolation import isolated_env, private_domain
+from miro_ball.scenarios import KICK_DISTANCE_M
+
 VIDEO_FPS = 10.0  # frames per simulated second in the video (= overhead rate)
 PANEL = (480, 270)  # size of each eye view in the video
-
-
-def ros_env(domain_id):
-    """Environment for child processes: their own ROS domain, this host only."""
-    return dict(os.environ, ROS_DOMAIN_ID=str(domain_id), PYTHONUNBUFFERED='1',
-                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
 
 
 class Processes:
@@ -212,11 +207,11 @@ def parse_args(argv):
 
 def main(argv=None):
     args = parse_args(sys.argv[1:] if argv is None else argv)
-    domain_id = 1 + (os.getpid() + 50) % 100
+    domain_id = private_domain(salt=50)
     out = Path(args.out)
     print(f'miro_ball demo: mode {args.mode}, world {args.world}, limit {args.limit:g} s '
           f'simulated, ROS domain {domain_id}; logs in {out}/', flush=True)
-    procs = Processes(node_commands(args), ros_env(domain_id), out)
+    procs = Processes(node_commands(args), isolated_env(domain_id), out)
     try:
         outcome, state, rtf, video = watch(args, procs, domain_id)
     finally:

@@ -13,6 +13,8 @@ import sys
 import time
 from pathlib import Path
 
+from miro_ball.isolation import limit_discovery, private_domain
+
 MODES = ('improved', 'tutorial')
 
 
@@ -91,8 +93,8 @@ def main(argv=None):
     args = parser.parse_args(argv)
     if args.count < 1 or not args.limit > 0:
         parser.error('--count must be >= 1 and --limit > 0')
-    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    args.domain = 1 + (os.getpid() + 25) % 100
+    limit_discovery()
+    args.domain = private_domain(salt=25)
     print(f'scenario benchmark: {args.count} placements (seed {args.seed}), modes '
           f'{", ".join(args.modes)}, limit {args.limit:g} s simulated', flush=True)
     started = time.monotonic()

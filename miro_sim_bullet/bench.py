@@ -13,6 +13,7 @@ import subprocess
 import sys
 import time
 
+from miro_ball.isolation import isolated_env, private_domain
 from miro_sim_bullet.rendering import probe_egl
 
 
@@ -87,8 +88,7 @@ def main(argv=None):
     renderers = ['tiny'] + (['egl'] if probe_egl()[0] else [])
     if 'egl' not in renderers:
         print(f'EGL unavailable ({probe_egl()[1]}): measuring TinyRenderer only')
-    env = dict(os.environ, ROS_DOMAIN_ID=str(1 + os.getpid() % 100),
-               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    env = isolated_env(private_domain())
     print(f'simulator benchmark: {width}x{height} @ {args.rate:g} Hz, both eyes subscribed, '
           f'{args.seconds:g} simulated s x {args.runs} runs per renderer, real_time_factor 0 '
           '(as fast as it goes)')

@@ -31,9 +31,8 @@ from sensor_msgs.msg import (BatteryState, CameraInfo, CompressedImage, Image, I
 from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, UInt32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
-from miro_ball.constants import (FRAME_SIZES, JOINT_NAMES, UPSTREAM_FLAG_SIMULATOR,
-                                 WHEEL_MAX_SPEED_M_PER_S, topic)
-from miro_ball.kinematics import cmd_vel2wheel_speed, finite
+from miro_ball.constants import FRAME_SIZES, JOINT_NAMES, UPSTREAM_FLAG_SIMULATOR, topic
+from miro_ball.kinematics import finite
 from miro_ball.params import coerce
 from miro_ball.throttle import Throttled
 from miro_sim_bullet.rendering import Intrinsics, RendererUnavailable
@@ -163,11 +162,9 @@ class SimNode(Node):
         if not finite(linear, angular):
             self.warn('cmd_vel', f'control/cmd_vel ignored: non-finite ({linear}, {angular})')
             return
-        left, right = cmd_vel2wheel_speed(linear, angular)
-        if max(abs(left), abs(right)) > WHEEL_MAX_SPEED_M_PER_S + 1e-6:
+        if self.sim.set_cmd_vel(linear, angular):
             self.warn('cmd_vel_clamp', f'control/cmd_vel ({linear:g} m/s, {angular:g} rad/s) '
                       'asks more than 0.4 m/s of a wheel: clamped')
-        self.sim.set_cmd_vel(linear, angular)
 
     def _on_kinematic(self, msg):
         positions = list(msg.position)

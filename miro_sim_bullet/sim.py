@@ -181,9 +181,13 @@ class MiroSim:
         return self.step_index * self.dt
 
     def set_cmd_vel(self, linear, angular):
-        """Wheel speeds by MiRo's formula, each clamped to the wheels' +-0.4 m/s."""
-        self.wheel_cmd = clamp_wheel_speeds(*cmd_vel2wheel_speed(linear, angular))
+        """Wheel speeds by MiRo's formula, each clamped to the wheels' +-0.4 m/s;
+        returns True when a wheel had to be clamped."""
+        wanted = cmd_vel2wheel_speed(linear, angular)
+        self.wheel_cmd = clamp_wheel_speeds(*wanted)
         self.last_cmd_time = self.time
+        # A hair over the limit is rounding in the sender's own clamp, not a request.
+        return any(abs(w - c) > 1e-6 for w, c in zip(wanted, self.wheel_cmd))
 
     def set_kinematic_targets(self, positions):
         """Targets [tilt, lift, yaw, pitch] clamped to MiRo's ranges; returns them."""

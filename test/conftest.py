@@ -5,9 +5,10 @@ import os
 
 import pytest
 
-os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-# Domains 1..100; the process id spreads concurrent pytest runs apart.
-os.environ['ROS_DOMAIN_ID'] = str(1 + os.getpid() % 100)
+from miro_ball.isolation import limit_discovery, private_domain
+
+limit_discovery()
+os.environ['ROS_DOMAIN_ID'] = str(private_domain())
 
 
 @pytest.fixture
