@@ -49,8 +49,8 @@ cmd=${1:-help}
 [ $# -gt 0 ] && shift
 case "$cmd" in
   setup) setup ;;
-  demo) setup; exec "$PY" -m miro_ball.demo "$@" ;;
+  demo) setup; exec "$PY" -m miro_ball.lab.demo "$@" ;;
   test) setup; exec "$PY" -m pytest "$@" ;;
-  bench) setup; exec "$PY" -m miro_sim_bullet.bench "$@" ;;
+  bench) setup; exec "$PY" -m miro_ball.lab.sim_bench "$@" ;;
   *) sed -n '2,8p' "$0"; exit 2 ;;
 esac

@@ -36,8 +36,9 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'miro_sim = miro_sim_bullet.node:main',
-            'kick_blue_ball = miro_ball.node:main',
+            'miro_sim = miro_sim_bullet.ros.node:main',
+            'kick_blue_ball = miro_ball.controller.node:main',
+            'ball_mover = miro_ball.examples.ball_mover:main',
         ],
     },
 )

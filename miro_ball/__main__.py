@@ -1,3 +1,3 @@
-from miro_ball.node import main
+from miro_ball.controller.node import main
 
 main()

@@ -5,7 +5,7 @@ import os
 
 import pytest
 
-from miro_ball.isolation import limit_discovery, private_domain
+from miro_ball.common.isolation import limit_discovery, private_domain
 
 limit_discovery()
 os.environ['ROS_DOMAIN_ID'] = str(private_domain())

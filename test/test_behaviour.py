@@ -4,29 +4,38 @@ import random
 
 import pytest
 
-from miro_ball.behaviour import (APPROACH, AVOID, ball_bearing, BehaviourParams, Command,
-                                 eye_bearing, EXPLORE, fit_to_limit, ImprovedBehaviour, KICK,
-                                 LOCK_ON, LOST, make_behaviour, MESSAGES, SEARCH,
-                                 TutorialBehaviour)
-from miro_ball.constants import CAM_DIVERGENCE_RAD, WHEEL_MAX_SPEED_M_PER_S
-from miro_ball.detection import Ball
-from miro_ball.kinematics import wheel_speed2cmd_vel
+from miro_ball.controller.behaviour import (APPROACH, AVOID, ball_bearing, BehaviourParams,
+                                            Command, DEFAULT_CAMERA, DEFAULT_CAMERAS,
+                                            eye_bearing, EXPLORE, fit_to_limit,
+                                            ImprovedBehaviour, KICK, LOCK_ON, LOST,
+                                            make_behaviour, MESSAGES, SEARCH, TutorialBehaviour)
+from miro_ball.controller.detection import Ball, normalise
+from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, FRAME_SIZES, WHEEL_MAX_SPEED_M_PER_S
+from miro_ball.miro.kinematics import wheel_speed2cmd_vel
 
 TICK = 0.02
 FLOOR = (1.0, 1.0)
 DEFAULTS = BehaviourParams()
 SEARCH_WHEELS = (DEFAULTS.search_speed, -DEFAULTS.search_speed)  # clockwise
 
-# Where a ball straight ahead appears in each eye (the eyes look 27 deg outwards).
-AHEAD_X = math.tan(CAM_DIVERGENCE_RAD) / (2 * math.tan(math.radians(60)))
+
+
+def column(angle, camera=DEFAULT_CAMERA):
+    """Normalised image column x where a direction angle rad left of the eye's axis appears."""
+    return (camera.cx - camera.fx * math.tan(angle)) / camera.width - 0.5
+
+
+# Where a ball straight ahead appears in the (left, right) eye: they look 27 deg outwards.
+AHEAD = (column(-CAM_DIVERGENCE_RAD), column(CAM_DIVERGENCE_RAD))
 
 
 def ball(x, r=0.03):
     return Ball(x, -0.1, r)
 
 
-CENTRED_FAR = (ball(AHEAD_X), ball(-AHEAD_X))
-CENTRED_CLOSE = (ball(AHEAD_X, 0.06), ball(-AHEAD_X, 0.06))
+CENTRED_FAR = (ball(AHEAD[0]), ball(AHEAD[1]))
+CENTRED_CLOSE = (ball(AHEAD[0], 0.06), ball(AHEAD[1], 0.06))
 
 
 def run(machine, seconds, left=None, right=None, cliff=FLOOR, t0=0.0):
@@ -98,13 +107,76 @@ def test_tutorial_search_direction_never_changes(tutorial):
 # Geometry -----------------------------------------------------------------
 
 def test_bearing_from_eye_geometry():
-    assert eye_bearing(AHEAD_X, CAM_DIVERGENCE_RAD) == pytest.approx(0.0, abs=1e-9)
-    assert eye_bearing(-AHEAD_X, -CAM_DIVERGENCE_RAD) == pytest.approx(0.0, abs=1e-9)
-    assert eye_bearing(0.0, CAM_DIVERGENCE_RAD) == pytest.approx(CAM_DIVERGENCE_RAD)
-    assert eye_bearing(0.5, 0.0) == pytest.approx(-math.radians(60))  # right edge of the fov
-    assert ball_bearing(None, None) is None
-    assert ball_bearing(*CENTRED_FAR) == pytest.approx(0.0, abs=1e-9)
-    assert ball_bearing(ball(0.0), None) == pytest.approx(CAM_DIVERGENCE_RAD)
+    assert eye_bearing(CENTRED_FAR[0], DEFAULT_CAMERA, CAM_DIVERGENCE_RAD) == pytest.approx(
+        0.0, abs=1e-9)
+    assert eye_bearing(CENTRED_FAR[1], DEFAULT_CAMERA, -CAM_DIVERGENCE_RAD) == pytest.approx(
+        0.0, abs=1e-9)
+    half_pixel = 0.5 / DEFAULT_CAMERA.fx  # rad, near the axis
+    assert eye_bearing(ball(0.0), DEFAULT_CAMERA, CAM_DIVERGENCE_RAD) == pytest.approx(
+        CAM_DIVERGENCE_RAD, abs=half_pixel)
+    # The right edge of the frame (the last pixel's outer side) is 60 deg right of the axis.
+    assert eye_bearing(ball(0.5 - 0.5 / DEFAULT_CAMERA.width), DEFAULT_CAMERA,
+                       0.0) == pytest.approx(-math.radians(60))
+    assert ball_bearing(None, None, DEFAULT_CAMERAS) is None
+    assert ball_bearing(*CENTRED_FAR, DEFAULT_CAMERAS) == pytest.approx(0.0, abs=1e-9)
+    assert ball_bearing(ball(AHEAD[0]), ball(AHEAD[1] + 0.1), DEFAULT_CAMERAS) == pytest.approx(
+        eye_bearing(ball(AHEAD[1] + 0.1), DEFAULT_CAMERA, -CAM_DIVERGENCE_RAD) / 2)
+
+
+def tan_hfov_bearing(x, eye_azimuth):
+    """The bearing before camera_info: a 120 deg pinhole centred on x = 0."""
+    return eye_azimuth - math.atan(2.0 * x * math.tan(math.radians(60)))
+
+
+@pytest.mark.parametrize('width,height', FRAME_SIZES)
+def test_default_camera_keeps_the_120_deg_bearings(width, height):
+    # The default model is what the bearing was before camera_info; the only change is
+    # the principal point, now the image centre (w - 1) / 2 rather than w / 2 in
+    # pixel-centre coordinates: at most half a pixel.
+    cameras = (DEFAULT_CAMERA.scaled_to(width, height),) * 2
+    half_pixel = 0.5 / cameras[0].fx
+    rng = random.Random(7)
+    for _ in range(200):
+        left, right = ball(rng.uniform(-0.5, 0.5)), ball(rng.uniform(-0.5, 0.5))
+        assert eye_bearing(left, cameras[0], CAM_DIVERGENCE_RAD) == pytest.approx(
+            tan_hfov_bearing(left.x, CAM_DIVERGENCE_RAD), abs=half_pixel)
+        assert ball_bearing(left, right, cameras) == pytest.approx(
+            (tan_hfov_bearing(left.x, CAM_DIVERGENCE_RAD)
+             + tan_hfov_bearing(right.x, -CAM_DIVERGENCE_RAD)) / 2, abs=half_pixel)
+
+
+def camera_info_k(hfov_deg, width=1280, height=720):
+    """A camera_info K (row-major 3x3) of a pinhole with this field of view."""
+    return [v for row in Intrinsics.from_hfov(width, height, hfov_deg).K() for v in row]
+
+
+@pytest.mark.parametrize('width,height', FRAME_SIZES)
+def test_bearing_follows_camera_info(width, height):
+    # A 90 deg camera_info (-p hfov_deg:=90 on the simulator), given at 1280x720 whatever
+    # the frames' size: a pixel column u is atan((u - cx) / fx) off the axis (+ left).
+    camera = Intrinsics.from_k(1280, 720, camera_info_k(90.0)).scaled_to(width, height)
+    fx, cx = width / 2, (width - 1) / 2  # tan(45 deg) = 1; pixel centres are integers
+    rng = random.Random(width)
+    for _ in range(200):
+        u = rng.uniform(-0.5, width - 0.5)
+        seen = normalise((u, height / 2, 10.0), (height, width))
+        assert eye_bearing(seen, camera, 0.0) == pytest.approx(-math.atan((u - cx) / fx))
+        assert ball_bearing(seen, None, (camera, DEFAULT_CAMERA)) == pytest.approx(
+            CAM_DIVERGENCE_RAD - math.atan((u - cx) / fx))
+    # The frame's edges are 45 deg off the axis.
+    edge = normalise((width - 0.5, 0.0, 1.0), (height, width))
+    assert eye_bearing(edge, camera, 0.0) == pytest.approx(-math.pi / 4)
+
+
+def test_camera_model_steers_the_improved_behaviour():
+    # A ball 10 deg left of the robot as a 90 deg left eye sees it: the 120 deg default
+    # would put it on the other side.
+    narrow = Intrinsics.from_k(640, 360, camera_info_k(90.0, 640, 360))
+    seen = ball(column(math.radians(10) - CAM_DIVERGENCE_RAD, narrow))
+    steer = ImprovedBehaviour(BehaviourParams()).step(0.0, seen, None, FLOOR,
+                                                      (narrow, DEFAULT_CAMERA))
+    assert turn(steer) == pytest.approx(DEFAULTS.steer_gain * math.radians(10))
+    assert turn(ImprovedBehaviour(BehaviourParams()).step(0.0, seen, None, FLOOR)) < 0
 
 
 def test_fit_to_limit_keeps_the_curve():
@@ -159,8 +231,7 @@ def test_improved_drives_straight_at_a_centred_ball(improved):
 
 def test_improved_steers_while_driving(improved):
     # 15 deg to the left, seen by the left eye only: forward and left together.
-    x = math.tan(CAM_DIVERGENCE_RAD - math.radians(15)) / (2 * math.tan(math.radians(60)))
-    command = improved.step(0.0, ball(x), None, FLOOR)
+    command = improved.step(0.0, ball(column(math.radians(15) - CAM_DIVERGENCE_RAD)), None, FLOOR)
     assert command.state == APPROACH
     assert 0.05 < forward(command) < DEFAULTS.approach_speed and turn(command) > 0.5
     # Far to the right: turn on the spot first, at most as fast as the search spin.
@@ -181,7 +252,7 @@ def test_improved_speeds_up_into_the_kick_when_centred_and_close(improved):
 
 
 def test_improved_does_not_kick_an_off_centre_ball(improved):
-    close_left = (ball(AHEAD_X + 0.08, 0.06), ball(-AHEAD_X + 0.08, 0.06))
+    close_left = (ball(AHEAD[0] + 0.08, 0.06), ball(AHEAD[1] + 0.08, 0.06))
     command = improved.step(0.0, *close_left, FLOOR)
     assert command.state == APPROACH and forward(command) < DEFAULTS.approach_speed
 

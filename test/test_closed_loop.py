@@ -11,7 +11,8 @@ import sys
 
 import pytest
 
-from miro_ball.scenarios import Placement, placements, run_episode
+from miro_ball.lab.scenarios import Placement, placements, run_episode
+from miro_ball.miro.interface import default_robot_name
 
 
 @pytest.mark.parametrize('mode', ['improved', 'tutorial'])
@@ -31,6 +32,13 @@ def test_improved_mode_kicks_from_other_placements(ros_context, placement):
     assert outcome.kicked and not outcome.fell, outcome
 
 
+def test_three_controllers_on_the_football_pitch_kick_the_ball(ros_context):
+    """COM3528's football lab: miro01..miro03, each driven by its own kick_blue_ball."""
+    outcome = run_episode(ros_context, None, world='football_pitch', limit_s=40.0)
+    assert outcome.kicked and not outcome.fell, outcome
+    assert outcome.frames > 0
+
+
 def test_placements_are_reproducible_and_inside_the_arena():
     first, again = placements(20, seed=3), placements(20, seed=3)
     assert first == again
@@ -41,7 +49,7 @@ def test_placements_are_reproducible_and_inside_the_arena():
 
 def test_two_processes_find_each_other_and_kick(tmp_path):
     """The README's main job: two nodes over DDS, headless, until the ball moves."""
-    cmd = [sys.executable, '-m', 'miro_ball.demo', '--no-video', '--limit', '40',
+    cmd = [sys.executable, '-m', 'miro_ball.lab.demo', '--no-video', '--limit', '40',
            '--real-time-factor', '0', '--out', str(tmp_path)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             start_new_session=True)
@@ -55,5 +63,7 @@ def test_two_processes_find_each_other_and_kick(tmp_path):
     assert 'kicked:               yes' in output
     assert 'frames processed' in output
     # Both nodes stopped cleanly: their logs end without a traceback.
-    for log in ('miro_sim.log', 'kick_blue_ball.log'):
+    logs = sorted(p.name for p in tmp_path.glob('*.log'))
+    assert logs == ['kick_blue_ball_%s.log' % default_robot_name(), 'miro_sim.log']
+    for log in logs:
         assert 'Traceback' not in (tmp_path / log).read_text()

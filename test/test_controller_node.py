@@ -3,6 +3,7 @@ import math
 import os
 import subprocess
 import sys
+from types import SimpleNamespace
 
 import cv2
 import numpy as np
@@ -12,21 +13,23 @@ from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TwistStamped
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import CompressedImage, JointState
+from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
 from std_msgs.msg import Float32MultiArray
 
-from miro_ball.behaviour import BehaviourParams
-from miro_ball.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
-from miro_ball.node import build_parser, KickBlueBall, main
-from miro_ball.params import ControllerParams
-from miro_ball.synthetic import Disc, jpeg, render
+from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
+from miro_ball.controller.node import build_parser, KickBlueBall, main
+from miro_ball.controller.params import ControllerParams
+from miro_ball.lab.synthetic import Disc, jpeg, render
+from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
+from miro_ball.miro.interface import CLOCK, default_robot_name, EYES, RobotTopics
+from test_behaviour import AHEAD, camera_info_k, column
 
 TICK = 0.02
 DEFAULTS = BehaviourParams()
 SEARCH_SPIN = -2 * DEFAULTS.search_speed / 0.164  # rad/s, clockwise (improved)
 TUTORIAL_SPIN = -2 * DEFAULTS.slow / 0.164
-# Column where a ball straight ahead appears in each eye (the eyes look 27 deg outwards).
-AHEAD_X = math.tan(CAM_DIVERGENCE_RAD) / (2 * math.tan(math.radians(60)))
+NARROW = Intrinsics.from_k(640, 360, camera_info_k(90.0, 640, 360))  # -p hfov_deg:=90
 
 
 def ball_frame(x=None, r=0.04, width=640, height=360):
@@ -38,28 +41,30 @@ def ball_frame(x=None, r=0.04, width=640, height=360):
 class Rig:
     """The node under test plus a probe node that plays simulator."""
 
-    def __init__(self, context, executor, overrides=(), robot='miro', **kwargs):
+    def __init__(self, context, executor, overrides=(), robot=None, **kwargs):
+        robot = robot or default_robot_name()
         params = [Parameter('use_sim_time', value=True), Parameter('robot_name', value=robot)]
         self.node = KickBlueBall(context=context, parameter_overrides=params + list(overrides),
                                  **kwargs)
         self.probe = rclpy.create_node('fake_sim', context=context)
         self.executor = executor
         self.twists, self.joints = [], []
+        self.names = names = RobotTopics(robot)
         p = self.probe
-
-        def t(name):
-            return '/%s/%s' % (robot, name)
-        self.pub_clock = p.create_publisher(Clock, '/clock', 10)
-        self.pub_cam = [p.create_publisher(CompressedImage, t('sensors/%s/compressed' % cam), 2)
-                        for cam in ('caml', 'camr')]
-        self.pub_cliff = p.create_publisher(Float32MultiArray, t('sensors/cliff'), 2)
-        p.create_subscription(TwistStamped, t('control/cmd_vel'), self.twists.append, 100)
-        p.create_subscription(JointState, t('control/kinematic_joints'), self.joints.append, 100)
+        self.pub_clock = p.create_publisher(Clock, CLOCK, 10)
+        self.pub_cam = [p.create_publisher(CompressedImage, names.eye_compressed(eye), 2)
+                        for eye in EYES]
+        self.pub_info = [p.create_publisher(CameraInfo, names.camera_info(eye), 2)
+                         for eye in EYES]
+        self.pub_cliff = p.create_publisher(Float32MultiArray, names.cliff, 2)
+        p.create_subscription(TwistStamped, names.cmd_vel, self.twists.append, 100)
+        p.create_subscription(JointState, names.kinematic_targets, self.joints.append, 100)
         executor.add_node(self.node)
         executor.add_node(p)
         self.now = 10.0
         self.wait_until(lambda: all(pub.get_subscription_count() > 0 for pub in
-                                    self.pub_cam + [self.pub_cliff, self.pub_clock]),
+                                    self.pub_cam + self.pub_info
+                                    + [self.pub_cliff, self.pub_clock]),
                         'discovery')
 
     def close(self):
@@ -104,6 +109,13 @@ class Rig:
     def both_eyes(self, left_x, right_x, r=0.04):
         self.image(0, ball_frame(left_x, r))
         self.image(1, ball_frame(right_x, r))
+
+    def camera_info(self, eye, width, height, k):
+        """Publish a camera_info and wait for the node to adopt or reject it."""
+        before = self.node.cameras[eye], self.node.rejected['camera_info']
+        self.pub_info[eye].publish(CameraInfo(width=width, height=height, k=k))
+        self.wait_until(lambda: (self.node.cameras[eye], self.node.rejected['camera_info'])
+                        != before, 'the node to take a camera_info')
 
     def cliff(self, values):
         before = self.node.cliff.stamp, sum(self.node.rejected.values())
@@ -174,7 +186,7 @@ def test_drives_forward_at_a_ball_centred_in_both_eyes(make_rig, mode, speed):
     rig.set_clock(10.0)
     rig.advance(0.2)
     rig.cliff([1.0, 1.0])
-    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.both_eyes(*AHEAD)
     assert rig.node.frames_processed == 2
     rig.advance(0.1)
     assert rig.node.state == {'tutorial': 'kick', 'improved': 'approach'}[mode]
@@ -209,7 +221,7 @@ def test_cliff_stops_forward_motion(make_rig):
     rig.set_clock(10.0)
     rig.advance(0.2)
     rig.cliff([0.1, 0.2])
-    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.both_eyes(*AHEAD)
     rig.advance(0.1)
     linear, _ = rig.last_twist()
     assert rig.node.state == 'avoid_cliff' and linear < 0
@@ -220,7 +232,7 @@ def test_detections_expire_when_a_camera_stops(make_rig):
     rig.set_clock(10.0)
     rig.advance(0.2)
     rig.cliff([1.0, 1.0])
-    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.both_eyes(*AHEAD)
     rig.advance(0.1)
     assert rig.node.state == 'approach'
     rig.advance(1.0)  # past stale_s (0.5 s) and then lost_grace_s (0.3 s)
@@ -232,7 +244,7 @@ def test_stop_sends_a_zero_twist(make_rig):
     rig = make_rig(*short_hold())
     rig.set_clock(10.0)
     rig.advance(0.2)
-    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.both_eyes(*AHEAD)
     rig.advance(0.1)
     assert rig.last_twist()[0] > 0.1
     rig.node.stop()
@@ -243,7 +255,7 @@ def test_survives_bad_inputs(make_rig):
     rig = make_rig(*short_hold())
     rig.set_clock(10.0)
     rig.advance(0.2)
-    good = ball_frame(AHEAD_X)
+    good = ball_frame(AHEAD[0])
     small = jpeg(render(100, 80, [Disc(50, 40, 10)]))
     for data in (b'', b'\x00garbage' * 10, good[:len(good) // 2], small):
         rig.image(0, data)
@@ -255,7 +267,7 @@ def test_survives_bad_inputs(make_rig):
     count = len(rig.twists)
     rig.advance(0.1)
     assert len(rig.twists) > count
-    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.both_eyes(*AHEAD)
     rig.cliff([1.0, 1.0])
     rig.advance(0.1)
     assert rig.node.frames_processed == 2 and rig.node.state == 'approach'
@@ -265,7 +277,7 @@ def test_carries_on_when_the_clock_jumps_back(make_rig):
     rig = make_rig(*short_hold())
     rig.set_clock(10.0)
     rig.advance(0.3)
-    rig.both_eyes(AHEAD_X, -AHEAD_X)
+    rig.both_eyes(*AHEAD)
     rig.advance(0.1)
     assert rig.node.state == 'approach'
     rig.set_clock(1.0)  # the simulator restarted
@@ -280,7 +292,7 @@ def test_carries_on_when_the_clock_jumps_back(make_rig):
 def test_debug_image_only_while_subscribed(make_rig, tmp_path):
     rig = make_rig(*short_hold(), save_debug=str(tmp_path))
     got = []
-    rig.probe.create_subscription(CompressedImage, '/miro/kick_blue_ball/debug/caml/compressed',
+    rig.probe.create_subscription(CompressedImage, rig.names.controller_debug(EYES[0]),
                                   got.append, 2)
     rig.wait_until(lambda: rig.node.pub_debug[0].get_subscription_count() > 0, 'debug sub')
     rig.image(0, ball_frame(0.1))
@@ -294,7 +306,7 @@ def test_debug_image_only_while_subscribed(make_rig, tmp_path):
 
 
 def test_robot_name_prefixes_the_topics(make_rig):
-    rig = make_rig(*short_hold(), robot='miro02')
+    rig = make_rig(*short_hold(), robot=default_robot_name() + '2')  # not the default
     rig.set_clock(10.0)
     rig.advance(0.3)
     assert rig.twists and rig.twists[-1].twist.angular.z == pytest.approx(SEARCH_SPIN)
@@ -307,6 +319,49 @@ def test_robot_name_defaults_to_the_environment(monkeypatch):
     assert ControllerParams().robot_name == 'miro'
 
 
+def test_camera_model_follows_camera_info(make_rig):
+    rig = make_rig()
+    assert rig.node.cameras == [DEFAULT_CAMERA, DEFAULT_CAMERA]
+    rig.camera_info(1, 1280, 720, camera_info_k(90.0))
+    assert rig.node.cameras == [DEFAULT_CAMERA, Intrinsics.from_k(1280, 720, camera_info_k(90.0))]
+
+
+@pytest.mark.parametrize('width,height,k', [
+    (640, 360, [0.0] * 9),  # ROS's "uncalibrated"
+    (640, 360, [math.nan] + camera_info_k(90.0, 640, 360)[1:]),
+    (0, 0, camera_info_k(90.0, 640, 360)),
+])
+def test_unusable_camera_info_keeps_the_model(make_rig, width, height, k):
+    rig = make_rig()
+    rig.camera_info(0, 640, 360, camera_info_k(90.0, 640, 360))
+    rig.camera_info(0, width, height, k)
+    assert rig.node.rejected == {'camera_info': 1}
+    assert rig.node.cameras == [NARROW, DEFAULT_CAMERA]
+
+
+def test_camera_info_of_the_wrong_length_is_refused(make_rig):
+    # On the wire k is float64[9] (rclpy pads a short one), so only an in-process
+    # caller can hand the node another length.
+    rig = make_rig()
+    rig.node._on_camera_info(0, SimpleNamespace(width=640, height=360, k=[320.0] * 8))
+    assert rig.node.rejected == {'camera_info': 1}
+    assert rig.node.cameras == [DEFAULT_CAMERA, DEFAULT_CAMERA]
+
+
+def test_steers_by_the_camera_info_model(make_rig):
+    rig = make_rig(*short_hold())
+    rig.set_clock(10.0)
+    rig.camera_info(0, 640, 360, camera_info_k(90.0, 640, 360))
+    rig.advance(0.2)
+    # 10 deg left of the robot as the 90 deg left eye sees it (the 120 deg default model
+    # would put it 1 deg right); a pixel of detection error is 0.01 rad/s of turn.
+    rig.image(0, ball_frame(column(math.radians(10) - CAM_DIVERGENCE_RAD, NARROW)))
+    rig.advance(0.1)
+    assert rig.node.state == 'approach'
+    assert rig.last_twist()[1] == pytest.approx(DEFAULTS.steer_gain * math.radians(10),
+                                                abs=0.03)
+
+
 def test_bad_parameter_is_refused(ros_context):
     with pytest.raises(ValueError, match='tick'):
         KickBlueBall(context=ros_context, parameter_overrides=[Parameter('tick', value='fast')])
@@ -317,9 +372,18 @@ def test_help_lists_parameters_and_topics(capsys):
         main(['kick_blue_ball', '--help'])
     assert done.value.code == 0
     text = capsys.readouterr().out
-    for word in ('--save-debug', 'hue_window', 'kick_duration', '0.4', '/control/cmd_vel',
-                 'sensors/cliff', 'tutorial or improved'):
+    names = RobotTopics(default_robot_name())
+    for word in ('--save-debug', 'hue_window', 'kick_duration', '0.4', names.cmd_vel,
+                 names.cliff, names.camera_info(EYES[0]), 'tutorial or improved'):
         assert word in text
+
+
+def test_help_survives_a_bad_robot_name_in_the_environment(capsys, monkeypatch):
+    monkeypatch.setenv('MIRO_ROBOT_NAME', 'bad name')
+    with pytest.raises(SystemExit) as done:
+        main(['kick_blue_ball', '--help'])
+    assert done.value.code == 0
+    assert "topics: robot name 'bad name' must be" in capsys.readouterr().out
 
 
 def test_bad_command_line_is_one_line(capsys):
@@ -331,10 +395,26 @@ def test_bad_command_line_is_one_line(capsys):
     assert build_parser().parse_args(['--save-debug', 'x']).save_debug == 'x'
 
 
+def run_controller(*ros_args, **env):
+    """The controller from the shell (python -m miro_ball --ros-args ...): (exit code, stderr)."""
+    done = subprocess.run([sys.executable, '-m', 'miro_ball', '--ros-args', *ros_args],
+                          capture_output=True, text=True, timeout=60,
+                          env=dict(os.environ, PYTHONWARNINGS='ignore', **env))
+    return done.returncode, done.stderr.strip().splitlines()
+
+
 def test_bad_ros_parameter_from_the_shell_is_one_line():
-    env = dict(os.environ, PYTHONWARNINGS='ignore')
-    done = subprocess.run([sys.executable, '-m', 'miro_ball', '--ros-args', '-p', 'mode:=fancy'],
-                          capture_output=True, text=True, timeout=60, env=env)
-    assert done.returncode == 2
-    assert done.stderr.strip().splitlines() == [
-        "kick_blue_ball: error: mode must be one of tutorial, improved, not 'fancy'"]
+    assert run_controller('-p', 'mode:=fancy') == (2, [
+        "kick_blue_ball: error: mode must be one of tutorial, improved, not 'fancy'"])
+
+
+@pytest.mark.parametrize('ros_args,env', [
+    (('-p', 'robot_name:=bad name'), {}),
+    (('-p', "robot_name:=''"), {}),
+    ((), {'MIRO_ROBOT_NAME': 'bad name'}),
+])
+def test_bad_robot_name_from_the_shell_is_one_line(ros_args, env):
+    code, lines = run_controller(*ros_args, **env)
+    assert code == 2 and len(lines) == 1, lines
+    assert lines[0].startswith('kick_blue_ball: error: robot_name ')
+    assert 'must be a letter followed by letters, digits or underscores' in lines[0]

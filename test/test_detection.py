@@ -3,10 +3,10 @@ import cv2
 import numpy as np
 import pytest
 
-from miro_ball.constants import FRAME_SIZES
-from miro_ball.detection import (annotate, Ball, BallDetector, DetectionParams, hue_ranges,
-                                 normalise, target_hue, to_pixels)
-from miro_ball.synthetic import BLUE, Disc, GREEN, jpeg, RED, render
+from miro_ball.controller.detection import (annotate, Ball, BallDetector, DetectionParams,
+                                            hue_ranges, normalise, target_hue, to_pixels)
+from miro_ball.lab.synthetic import BLUE, Disc, GREEN, jpeg, RED, render
+from miro_ball.miro.constants import FRAME_SIZES
 
 POS_TOL = 0.01  # of the frame width: 6 px at 640
 RADIUS_TOL = 0.15  # relative

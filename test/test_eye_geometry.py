@@ -5,10 +5,11 @@ import cv2
 import numpy as np
 import pytest
 
-from miro_ball.constants import LIFT_RAD_CALIB
-from miro_sim_bullet.rendering import Intrinsics, probe_egl
-from miro_sim_bullet.sim import MiroSim, project
-from miro_sim_bullet.world_file import load_world
+from miro_ball.miro.constants import LIFT_RAD_CALIB
+from miro_ball.miro.camera import Intrinsics, project
+from miro_sim_bullet.physics.world import SimWorld
+from miro_sim_bullet.render.renderer import probe_egl, view_matrix_from_pose
+from miro_sim_bullet.scene.world_file import load_world
 
 RENDERERS = ['tiny', pytest.param('egl', marks=pytest.mark.skipif(
     not probe_egl()[0], reason='EGL unavailable: ' + probe_egl()[1]))]
@@ -20,20 +21,20 @@ def sim(request, tmp_path):
     path = tmp_path / 'small_ball.toml'
     path.write_text(f'[ball]\nradius = {SMALL_BALL}\n[ground]\nheight = 0.0\n'
                     'colour = [0.6, 0.6, 0.58]\n')
-    world = MiroSim(load_world(str(path)), renderer=request.param)
+    world = SimWorld(load_world(str(path)), renderer=request.param)
     yield world
     world.close()
 
 
 def test_eyes_sit_where_the_mdk_puts_them():
-    world = MiroSim('empty')
+    world = SimWorld('empty')
     world.run(0.5)
-    pos, rot = world.eye_pose(+1)
+    pos, rot = world.robot.eye_pose(+1)
     assert pos == pytest.approx((0.115, 0.043, 0.219), abs=0.004)
     axis = rot[:, 0]
     assert math.degrees(math.asin(axis[2])) == pytest.approx(15.0, abs=1.0)
     assert math.degrees(math.atan2(axis[1], axis[0])) == pytest.approx(28.0, abs=1.0)
-    assert world.read_sensors().kinematic_positions[1] == pytest.approx(LIFT_RAD_CALIB, abs=0.01)
+    assert world.robot.sensors.kinematic_positions[1] == pytest.approx(LIFT_RAD_CALIB, abs=0.01)
     world.close()
 
 
@@ -55,14 +56,14 @@ def blue_centroid(rgb):
 ])
 def test_ball_appears_where_the_pinhole_model_predicts(sim, size, ball_xy, seen_by):
     intrinsics = Intrinsics.from_hfov(*size, 120.0)
-    sim.place(ball_xy=ball_xy)
+    sim.place_ball(*ball_xy)
     sim.run(0.3)
     centre = sim.ball_position()
     for side in (+1, -1):
-        rgb = sim.render_eye(side, intrinsics)
+        rgb, = sim.render_eyes([(sim.robot, side)], intrinsics)
         assert rgb.shape == (size[1], size[0], 3)
         found = blue_centroid(rgb)
-        pos, rot = sim.eye_pose(side)
+        pos, rot = sim.robot.eye_pose(side)
         predicted = project(intrinsics, pos, rot, centre)
         inside = predicted is not None and 0 <= predicted[0] < size[0] and \
             0 <= predicted[1] < size[1]
@@ -76,9 +77,9 @@ def test_ball_appears_where_the_pinhole_model_predicts(sim, size, ball_xy, seen_
 
 def test_ball_is_blue_after_jpeg(sim):
     intrinsics = Intrinsics.from_hfov(640, 360, 120.0)
-    sim.place(ball_xy=(1.0, 0.2))
+    sim.place_ball(1.0, 0.2)
     sim.run(0.2)
-    rgb = sim.render_eye(+1, intrinsics)
+    rgb, = sim.render_eyes([(sim.robot, +1)], intrinsics)
     ok, jpeg = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
     bgr = cv2.imdecode(jpeg, cv2.IMREAD_COLOR)
     u, v = (int(round(c)) for c in blue_centroid(rgb))
@@ -87,15 +88,17 @@ def test_ball_is_blue_after_jpeg(sim):
 
 
 def test_eye_worker_processes_render_exactly_what_the_simulator_would():
-    world = MiroSim('miro', renderer='tiny', eye_workers=True)
+    world = SimWorld('miro', renderer='tiny', eye_workers=True)
     try:
         assert world.eye_workers is not None
-        world.set_kinematic_targets([0.0, math.radians(50), math.radians(20), 0.0])
-        world.set_cmd_vel(0.2, 0.5)
+        world.robot.set_kinematic_targets([0.0, math.radians(50), math.radians(20), 0.0])
+        world.robot.set_cmd_vel(0.2, 0.5)
         world.run(1.0)  # robot, head and (maybe) ball have moved since the workers' copy
         intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
-        from_workers = world.render_eyes([+1, -1], intrinsics)
-        in_process = [world.render_eye(side, intrinsics) for side in (+1, -1)]
+        requests = [(world.robot, +1), (world.robot, -1)]
+        from_workers = world.render_eyes(requests, intrinsics)
+        in_process = [world.renderer.render(view_matrix_from_pose(*world.robot.eye_pose(side)),
+                                            intrinsics) for side in (+1, -1)]
         for a, b in zip(from_workers, in_process):
             assert np.array_equal(a, b)
     finally:

@@ -10,8 +10,9 @@ import numpy as np
 import pybullet as p
 import pytest
 
-from miro_sim_bullet import rendering
-from miro_sim_bullet.rendering import (Intrinsics, opengl_projection, probe_egl, Renderer,
+from miro_sim_bullet.render import renderer as rendering
+from miro_ball.miro.camera import Intrinsics
+from miro_sim_bullet.render.renderer import (opengl_projection, probe_egl, Renderer,
                                        RendererUnavailable, view_matrix_from_pose)
 
 BALL_RADIUS = 0.05
@@ -193,7 +194,7 @@ def test_view_matrix_follows_rep103_link_axes():
 
 def run_probe_in_child(**env_changes):
     env = dict(os.environ, **env_changes)
-    code = 'from miro_sim_bullet.rendering import probe_egl; print(probe_egl())'
+    code = 'from miro_sim_bullet.render.renderer import probe_egl; print(probe_egl())'
     done = subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,
                           text=True, timeout=120)
     assert done.returncode == 0, done.stderr

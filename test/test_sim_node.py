@@ -17,9 +17,13 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, Image, JointState
 from std_msgs.msg import Float32MultiArray, UInt16MultiArray, UInt32, UInt32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
-from miro_ball.constants import UPSTREAM_FLAG_SIMULATOR
-from miro_sim_bullet.node import SimNode
+from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR
+from miro_ball.miro.interface import RobotTopics, SimTopics, default_robot_name
+from miro_sim_bullet.ros.node import SimNode
 from rostools import Probe, drain, spin_until
+
+T = RobotTopics(default_robot_name())
+SIM = SimTopics()
 
 
 @pytest.fixture
@@ -52,11 +56,11 @@ def run(node, executor, sim_seconds, each_tick=None):
 
 def test_sensors_and_clock_follow_simulated_time(sim_node, probe, executor):
     clock = probe.watch(Clock, '/clock')
-    odom = probe.watch(Odometry, '/miro/sensors/odom')
-    flags = probe.watch(UInt32, '/miro/sensors/flags')
-    cliff = probe.watch(Float32MultiArray, '/miro/sensors/cliff')
-    kin = probe.watch(JointState, '/miro/sensors/kinematic_joints')
-    spin_until(executor, lambda: sim_node.pub_odom.get_subscription_count() > 0)
+    odom = probe.watch(Odometry, T.odom)
+    flags = probe.watch(UInt32, T.sensor_flags)
+    cliff = probe.watch(Float32MultiArray, T.cliff)
+    kin = probe.watch(JointState, T.kinematic_joints)
+    spin_until(executor, lambda: sim_node.robots[T.name].pub_odom.get_subscription_count() > 0)
     run(sim_node, executor, 1.0)
     assert spin_until(executor, lambda: len(odom) >= 50)
     assert len(odom) == 50  # 50 Hz for 1 s of simulated time
@@ -71,8 +75,8 @@ def test_sensors_and_clock_follow_simulated_time(sim_node, probe, executor):
 
 
 def test_cmd_vel_drives_the_robot(sim_node, probe, executor):
-    odom = probe.watch(Odometry, '/miro/sensors/odom')
-    cmd = probe.publisher(TwistStamped, '/miro/control/cmd_vel')
+    odom = probe.watch(Odometry, T.odom)
+    cmd = probe.publisher(TwistStamped, T.cmd_vel)
     spin_until(executor, lambda: cmd.get_subscription_count() > 0)
     twist = TwistStamped()
     twist.twist.linear.x = 0.2
@@ -80,21 +84,21 @@ def test_cmd_vel_drives_the_robot(sim_node, probe, executor):
     spin_until(executor, lambda: odom and seconds(odom[-1].header.stamp) >= 2.0)
     x = odom[-1].pose.pose.position.x
     assert x == pytest.approx(0.4, abs=0.04)
-    assert sim_node.sim.robot_pose()[0] == pytest.approx(x, abs=1e-6)
+    assert sim_node.sim.robot.pose()[0] == pytest.approx(x, abs=1e-6)
 
 
 def test_bad_control_messages_are_ignored_with_rate_limited_warnings(sim_node, probe, executor):
     warnings = []
     sim_node.warn.log = warnings.append
     publishers = {
-        'cmd': probe.publisher(TwistStamped, '/miro/control/cmd_vel'),
-        'kin': probe.publisher(JointState, '/miro/control/kinematic_joints'),
-        'cos': probe.publisher(Float32MultiArray, '/miro/control/cosmetic_joints'),
-        'illum': probe.publisher(UInt32MultiArray, '/miro/control/illum'),
-        'tone': probe.publisher(UInt16MultiArray, '/miro/control/tone'),
+        'cmd': probe.publisher(TwistStamped, T.cmd_vel),
+        'kin': probe.publisher(JointState, T.kinematic_targets),
+        'cos': probe.publisher(Float32MultiArray, T.cosmetic_joints),
+        'illum': probe.publisher(UInt32MultiArray, T.illum),
+        'tone': probe.publisher(UInt16MultiArray, T.tone),
     }
     spin_until(executor, lambda: all(p.get_subscription_count() for p in publishers.values()))
-    before = (sim_node.sim.wheel_cmd, list(sim_node.sim.kin_targets), list(sim_node.sim.cosmetic))
+    before = (sim_node.sim.robot.wheel_cmd, list(sim_node.sim.robot.kin_targets), list(sim_node.sim.robot.cosmetic))
     nan_twist = TwistStamped()
     nan_twist.twist.linear.x = float('nan')
     inf_twist = TwistStamped()
@@ -111,43 +115,43 @@ def test_bad_control_messages_are_ignored_with_rate_limited_warnings(sim_node, p
         for key, msg in garbage:
             publishers[key].publish(msg)
     drain(executor, rounds=400)
-    assert (sim_node.sim.wheel_cmd, sim_node.sim.kin_targets, sim_node.sim.cosmetic) == before
+    assert (sim_node.sim.robot.wheel_cmd, sim_node.sim.robot.kin_targets, sim_node.sim.robot.cosmetic) == before
     assert 5 <= len(warnings) <= len(garbage)  # one line per kind, not one per message
     # Finite out-of-range values are clamped, and the node keeps working.
     huge = TwistStamped()
     huge.twist.linear.x = 1e9
     publishers['cmd'].publish(huge)
     publishers['kin'].publish(JointState(position=[0.0, 10.0, -10.0, 0.0]))
-    spin_until(executor, lambda: sim_node.sim.wheel_cmd == (0.4, 0.4))
-    spin_until(executor, lambda: sim_node.sim.kin_targets[1] == pytest.approx(math.radians(60)))
-    assert sim_node.sim.kin_targets[2] == pytest.approx(math.radians(-55))
+    spin_until(executor, lambda: sim_node.sim.robot.wheel_cmd == (0.4, 0.4))
+    spin_until(executor, lambda: sim_node.sim.robot.kin_targets[1] == pytest.approx(math.radians(60)))
+    assert sim_node.sim.robot.kin_targets[2] == pytest.approx(math.radians(-55))
     run(sim_node, executor, 0.2)
-    assert sim_node.sim.robot_pose()[0] > 0.02
+    assert sim_node.sim.robot.pose()[0] > 0.02
 
 
 def test_reset_pause_and_step_services(sim_node, probe, executor):
-    initial = sim_node.sim.robot_pose()
-    sim_node.sim.set_cmd_vel(0.3, 0.5)
+    initial = sim_node.sim.robot.pose()
+    sim_node.sim.robot.set_cmd_vel(0.3, 0.5)
     run(sim_node, executor, 1.0)
-    assert sim_node.sim.robot_pose() != pytest.approx(initial)
-    result = probe.call(executor, Trigger, '/miro_sim/reset', Trigger.Request())
+    assert sim_node.sim.robot.pose() != pytest.approx(initial)
+    result = probe.call(executor, Trigger, SIM.reset, Trigger.Request())
     assert result.success and sim_node.sim.time == 0.0
-    assert sim_node.sim.robot_pose() == pytest.approx(initial)
-    result = probe.call(executor, Trigger, '/miro_sim/step', Trigger.Request())
+    assert sim_node.sim.robot.pose() == pytest.approx(initial)
+    result = probe.call(executor, Trigger, SIM.step, Trigger.Request())
     assert result.success and sim_node.sim.step_index == 20
-    result = probe.call(executor, SetBool, '/miro_sim/pause', SetBool.Request(data=False))
+    result = probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=False))
     assert result.success and not sim_node.paused
-    refused = probe.call(executor, Trigger, '/miro_sim/step', Trigger.Request())
+    refused = probe.call(executor, Trigger, SIM.step, Trigger.Request())
     assert not refused.success
 
 
 def test_eye_cameras_publish_matching_stereo_frames(sim_node, probe, executor):
-    frames = {eye: probe.watch(CompressedImage, f'/miro/sensors/{eye}/compressed')
+    frames = {eye: probe.watch(CompressedImage, T.eye_compressed(eye))
               for eye in ('caml', 'camr')}
-    raw = probe.watch(Image, '/miro/sensors/caml')
-    info = probe.watch(CameraInfo, '/miro/sensors/camr/camera_info')
-    spin_until(executor, lambda: sim_node.pub_eyes['camr'][0].get_subscription_count() > 0
-               and sim_node.pub_eyes['caml'][1].get_subscription_count() > 0)
+    raw = probe.watch(Image, T.eye_raw('caml'))
+    info = probe.watch(CameraInfo, T.camera_info('camr'))
+    spin_until(executor, lambda: sim_node.robots[T.name].pub_eyes['camr'][0].get_subscription_count() > 0
+               and sim_node.robots[T.name].pub_eyes['caml'][1].get_subscription_count() > 0)
     run(sim_node, executor, 1.0)
     spin_until(executor, lambda: len(frames['camr']) >= 15 and len(raw) >= 15)
     assert len(frames['caml']) == len(frames['camr']) == 15  # 15 Hz of simulated time
@@ -189,4 +193,4 @@ def test_help_lists_the_parameters_and_worlds():
     out = subprocess.run([sys.executable, '-m', 'miro_sim_bullet', '--help'],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0
-    assert 'real_time_factor' in out.stdout and 'bundled worlds: empty, miro, table' in out.stdout
+    assert 'real_time_factor' in out.stdout and 'bundled worlds: cube, empty, football, football_pitch, miro, petshop, tables' in out.stdout

@@ -1,16 +1,16 @@
-"""MiroSim without ROS: driving, head, cliff reflex, kicking and reset, in simulated time."""
+"""SimWorld without ROS: driving, head, cliff reflex, kicking and reset, in simulated time."""
 import math
 
 import pytest
 
-from miro_ball.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD
-from miro_sim_bullet.sim import MiroSim
+from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD
+from miro_sim_bullet.physics.world import SimWorld
 
 
 @pytest.fixture
 def empty():
-    sim = MiroSim('empty')
-    sim.place(ball_xy=(5.0, 5.0))  # out of the way
+    sim = SimWorld('empty')
+    sim.place_ball(5.0, 5.0)  # out of the way
     yield sim
     sim.close()
 
@@ -18,27 +18,27 @@ def empty():
 def drive(sim, linear, angular, seconds):
     """Command at the controller's 50 Hz for the given simulated time."""
     for _ in range(round(seconds / 0.02)):
-        sim.set_cmd_vel(linear, angular)
+        sim.robot.set_cmd_vel(linear, angular)
         sim.run(0.02)
 
 
 def test_mass_and_resting_tilt(empty):
     import pybullet as pb
-    body = empty.robot_id
+    body = empty.robot.body_id
     total = sum(pb.getDynamicsInfo(body, link, physicsClientId=empty.client)[0]
                 for link in range(-1, pb.getNumJoints(body, physicsClientId=empty.client)))
     assert 2.4 <= total <= 3.3
     empty.run(1.0)
     orn = pb.getBasePositionAndOrientation(body, physicsClientId=empty.client)[1]
     assert math.degrees(pb.getEulerFromQuaternion(orn)[1]) == pytest.approx(-6.0, abs=1.0)
-    assert empty.robot_height() == pytest.approx(0.045, abs=0.003)
+    assert empty.robot.height() == pytest.approx(0.045, abs=0.003)
 
 
 def test_forward_0_2_m_s_for_2_s_moves_0_4_m(empty):
     drive(empty, 0.2, 0.0, 2.0)
-    x, y, yaw = empty.robot_pose()
+    x, y, yaw = empty.robot.pose()
     assert x == pytest.approx(0.4, abs=0.03) and abs(y) < 0.01 and abs(yaw) < 0.02
-    sensors = empty.read_sensors()
+    sensors = empty.robot.sensors
     assert sensors.pose[0] == pytest.approx(x)
     assert sensors.velocity[0] == pytest.approx(0.2, abs=0.01)
     assert sensors.wheel_speed_opto == pytest.approx((0.2, 0.2), abs=0.01)
@@ -46,81 +46,88 @@ def test_forward_0_2_m_s_for_2_s_moves_0_4_m(empty):
 
 def test_pure_turn_turns_at_the_commanded_rate(empty):
     drive(empty, 0.0, 1.0, 0.5)  # spin up
-    start = empty.robot_pose()
+    start = empty.robot.pose()
     drive(empty, 0.0, 1.0, 1.0)
-    x, y, yaw = empty.robot_pose()
+    x, y, yaw = empty.robot.pose()
     turned = (yaw - start[2] + math.pi) % (2 * math.pi) - math.pi
     assert turned == pytest.approx(1.0, abs=0.05)
     assert math.hypot(x - start[0], y - start[1]) < 0.02
-    assert empty.read_sensors().velocity[1] == pytest.approx(1.0, abs=0.05)
+    assert empty.robot.sensors.velocity[1] == pytest.approx(1.0, abs=0.05)
 
 
 def test_wheel_speeds_are_clamped_to_0_4(empty):
-    empty.set_cmd_vel(5.0, 0.0)
+    empty.robot.set_cmd_vel(5.0, 0.0)
     empty.run(0.04)
-    assert empty.read_sensors().wheel_speed_cmd == (0.4, 0.4)
+    assert empty.robot.sensors.wheel_speed_cmd == (0.4, 0.4)
 
 
 def test_timeout_stops_the_robot(empty):
-    empty.set_cmd_vel(0.2, 0.0)
+    empty.robot.set_cmd_vel(0.2, 0.0)
     empty.run(0.4)
-    assert empty.read_sensors().wheel_speed_cmd == (0.2, 0.2)
+    assert empty.robot.sensors.wheel_speed_cmd == (0.2, 0.2)
     empty.run(0.2)  # 0.6 s since the only command
-    assert empty.read_sensors().wheel_speed_cmd == (0.0, 0.0)
+    assert empty.robot.sensors.wheel_speed_cmd == (0.0, 0.0)
     empty.run(0.5)
-    parked = empty.robot_pose()
+    parked = empty.robot.pose()
     empty.run(1.0)
-    assert empty.robot_pose()[0] == pytest.approx(parked[0], abs=0.002)
+    assert empty.robot.pose()[0] == pytest.approx(parked[0], abs=0.002)
     assert parked[0] < 0.15
 
 
 def test_head_reaches_the_commanded_pose(empty):
     target = [0.0, math.radians(50), math.radians(30), math.radians(-10)]
-    empty.set_kinematic_targets(target)
+    empty.robot.set_kinematic_targets(target)
     empty.run(1.5)
-    reached = empty.read_sensors().kinematic_positions
+    reached = empty.robot.sensors.kinematic_positions
     for got, want in zip(reached[1:], target[1:]):
         assert got == pytest.approx(want, abs=math.radians(1.0))
 
 
 def test_out_of_range_head_targets_are_clamped(empty):
-    applied = empty.set_kinematic_targets([0.3, math.radians(90), -3.0, 1.0])
+    applied = empty.robot.set_kinematic_targets([0.3, math.radians(90), -3.0, 1.0])
     assert applied[1:] == tuple(lim for lim in (JOINT_LIMITS_RAD[1][1], JOINT_LIMITS_RAD[2][0],
                                                 JOINT_LIMITS_RAD[3][1]))
     assert applied[0] == JOINT_LIMITS_RAD[0][0]  # tilt is fixed
     empty.run(2.0)
-    reached = empty.read_sensors().kinematic_positions
+    reached = empty.robot.sensors.kinematic_positions
     assert reached[1] == pytest.approx(JOINT_LIMITS_RAD[1][1], abs=math.radians(1.5))
     assert reached[2] == pytest.approx(JOINT_LIMITS_RAD[2][0], abs=math.radians(1.5))
 
 
-def test_cliff_reflex_stops_at_the_table_edge():
-    sim = MiroSim('table')  # table top 1.5 m long: edge at x = 0.75
-    assert sim.cliff == (1.0, 1.0)
+@pytest.fixture
+def on_table():
+    """MiRo on the table at the origin of the tables world, facing its free edge at x -0.75
+    (a 1 m drop to the floor)."""
+    sim = SimWorld('tables')
+    sim.robot.place(0.0, 0.0, math.pi)
+    yield sim
+    sim.close()
+
+
+def test_cliff_reflex_stops_at_the_table_edge(on_table):
+    sim = on_table
+    assert sim.robot.sensors.cliff == (1.0, 1.0)
     drive(sim, 0.3, 0.0, 5.0)
-    x = sim.robot_pose()[0]
-    assert sim.robot_height() == pytest.approx(0.045, abs=0.005)
-    assert 0.4 < x < 0.75
-    assert min(sim.cliff) < 0.7
-    assert sim.read_sensors().wheel_speed_cmd == (0.0, 0.0)
+    x = sim.robot.pose()[0]
+    assert sim.robot.height() == pytest.approx(0.045, abs=0.005)
+    assert -0.75 < x < -0.4
+    assert min(sim.robot.sensors.cliff) < 0.7
+    assert sim.robot.sensors.wheel_speed_cmd == (0.0, 0.0)
     drive(sim, -0.2, 0.0, 1.0)  # backing away is allowed
-    assert sim.robot_pose()[0] < x - 0.1
-    sim.close()
+    assert sim.robot.pose()[0] > x + 0.1
 
 
-def test_robot_falls_off_the_table_with_the_reflex_disabled():
-    sim = MiroSim('table')
-    sim.flags = DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
-    drive(sim, 0.3, 0.0, 5.0)
-    assert sim.robot_height() < -0.5
-    sim.close()
+def test_robot_falls_off_the_table_with_the_reflex_disabled(on_table):
+    on_table.robot.flags = DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
+    drive(on_table, 0.3, 0.0, 5.0)
+    assert on_table.robot.height() < -0.5
 
 
 def test_driving_into_the_ball_kicks_it():
-    sim = MiroSim('miro')
+    sim = SimWorld('miro')
     start = sim.ball_position()
     drive(sim, 0.0, 0.0, 0.2)
-    sim.place(robot_pose=(0.0, -0.3, 0.0))  # facing the ball 0.6 m ahead
+    sim.robot.place(0.0, -0.3, 0.0)  # facing the ball 0.6 m ahead
     drive(sim, 0.4, 0.0, 2.0)
     moved = math.dist(sim.ball_position()[:2], start[:2])
     assert moved > 0.3
@@ -128,25 +135,25 @@ def test_driving_into_the_ball_kicks_it():
 
 
 def test_reset_restores_the_initial_state():
-    sim = MiroSim('miro')
-    initial = (sim.robot_pose(), sim.ball_position())
-    sim.set_kinematic_targets([0, 1.0, 0.5, 0])
+    sim = SimWorld('miro')
+    initial = (sim.robot.pose(), sim.ball_position())
+    sim.robot.set_kinematic_targets([0, 1.0, 0.5, 0])
     drive(sim, 0.3, 0.5, 2.0)
-    assert sim.robot_pose() != initial[0]
+    assert sim.robot.pose() != initial[0]
     sim.reset()
     assert sim.time == 0.0
-    assert sim.robot_pose() == pytest.approx(initial[0])
+    assert sim.robot.pose() == pytest.approx(initial[0])
     assert sim.ball_position() == pytest.approx(initial[1])
     sim.run(0.5)
-    assert sim.read_sensors().kinematic_positions[1] == pytest.approx(math.radians(34), abs=0.02)
+    assert sim.robot.sensors.kinematic_positions[1] == pytest.approx(math.radians(34), abs=0.02)
     sim.close()
 
 
 def test_illum_colours_the_body_patches(empty):
     import pybullet as pb
-    from miro_sim_bullet.robot import ILLUM_LINKS
-    empty.set_illum([0xFFFF0000, 0x8000FF00, 0, 0, 0, 0xFF0000FF])
-    colours = {row[1]: row[7] for row in pb.getVisualShapeData(empty.robot_id,
+    from miro_sim_bullet.physics.model import ILLUM_LINKS
+    empty.robot.set_illum([0xFFFF0000, 0x8000FF00, 0, 0, 0, 0xFF0000FF])
+    colours = {row[1]: row[7] for row in pb.getVisualShapeData(empty.robot.body_id,
                                                                physicsClientId=empty.client)}
     assert colours[ILLUM_LINKS[0]][:3] == pytest.approx((1.0, 0.0, 0.0))
     assert colours[ILLUM_LINKS[1]][1] > 0.95 and colours[ILLUM_LINKS[1]][0] < 0.5  # half-lit green
@@ -156,12 +163,12 @@ def test_illum_colours_the_body_patches(empty):
 
 def test_sonar_sees_the_ball_ahead_and_nothing_beyond_range(empty):
     # Head and nose up: the 34-degree cone clears the floor.
-    empty.set_kinematic_targets([0.0, math.radians(8), 0.0, math.radians(-22)])
+    empty.robot.set_kinematic_targets([0.0, math.radians(8), 0.0, math.radians(-22)])
     empty.run(1.0)
-    assert empty.read_sensors().sonar == math.inf
-    empty.set_kinematic_targets([0.0, math.radians(8), 0.0, 0.0])
-    empty.place(ball_xy=(0.6, 0.0))
+    assert empty.robot.sensors.sonar == math.inf
+    empty.robot.set_kinematic_targets([0.0, math.radians(8), 0.0, 0.0])
+    empty.place_ball(0.6, 0.0)
     empty.run(1.0)
-    sonar = empty.read_sensors().sonar
-    nose_x = empty.eye_pose(+1)[0][0]  # the sonar sits near the eyes, at the front
+    sonar = empty.robot.sensors.sonar
+    nose_x = empty.robot.eye_pose(+1)[0][0]  # the sonar sits near the eyes, at the front
     assert sonar == pytest.approx(0.6 - 0.1 - nose_x, abs=0.06)

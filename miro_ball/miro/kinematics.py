@@ -1,7 +1,7 @@
 """MiRo's differential-drive formula (MDK wheel_speed2cmd_vel and its inverse)."""
 import math
 
-from miro_ball.constants import WHEEL_MAX_SPEED_M_PER_S, WHEEL_TRACK_M
+from miro_ball.miro.constants import WHEEL_MAX_SPEED_M_PER_S, WHEEL_TRACK_M
 
 
 def wheel_speed2cmd_vel(wheel_speed, track=WHEEL_TRACK_M):

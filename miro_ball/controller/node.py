@@ -3,7 +3,9 @@
 The node decodes each eye's JPEG itself, runs the detector on it, and on every
 control tick (node clock, so simulated time when use_sim_time is set) feeds the
 freshest detections and cliff reading to the chosen behaviour, publishing the
-resulting wheel speeds as a TwistStamped.
+resulting wheel speeds as a TwistStamped. Each eye's pinhole model comes from its
+camera_info (MiRo's simulated 120 deg eye until one arrives), so bearings stay
+right whatever field of view the camera has.
 """
 import argparse
 import math
@@ -24,18 +26,22 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
-from sensor_msgs.msg import CompressedImage, JointState
+from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
 from std_msgs.msg import Float32MultiArray
 
-from miro_ball import params
-from miro_ball.behaviour import BehaviourParams, make_behaviour
-from miro_ball.constants import FRAME_SIZES, JOINT_NAMES, topic
-from miro_ball.detection import annotate, BallDetector, DetectionParams
-from miro_ball.kinematics import clamp_wheel_speeds, finite, wheel_speed2cmd_vel
-from miro_ball.throttle import Throttled
+from miro_ball.common import params
+from miro_ball.common.throttle import Throttled
+from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERAS, make_behaviour
+from miro_ball.controller.detection import annotate, BallDetector, DetectionParams
+from miro_ball.controller.params import ControllerParams, GROUPS
+from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES
+from miro_ball.miro.interface import (CLOCK, CONTROLLER_NODE_NAME, default_robot_name, EYES,
+                                      RobotTopics)
+from miro_ball.miro.kinematics import clamp_wheel_speeds, finite, wheel_speed2cmd_vel
 
-NODE_NAME = 'kick_blue_ball'
-EYES = ('caml', 'camr')  # index 0 is the left eye, as the MDK's CAM_L
+NODE_NAME = CONTROLLER_NODE_NAME
+SIDES = ('left', 'right')  # of EYES, in order
 STARTUP = 'startup'
 WARN_EVERY_S = 5.0
 
@@ -47,19 +53,21 @@ DEBUG_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
 
 def topics(robot_name):
     """(topic, type, direction, purpose) of everything the node uses."""
-    def t(name):
-        return topic(robot_name, name)
-    return [
-        (t('sensors/caml/compressed'), 'sensor_msgs/CompressedImage', 'in', 'left eye, JPEG'),
-        (t('sensors/camr/compressed'), 'sensor_msgs/CompressedImage', 'in', 'right eye, JPEG'),
-        (t('sensors/cliff'), 'std_msgs/Float32MultiArray', 'in', '[L, R], 1 floor, <0.7 drop'),
-        (t('control/cmd_vel'), 'geometry_msgs/TwistStamped', 'out', 'every tick'),
-        (t('control/kinematic_joints'), 'sensor_msgs/JointState', 'out', 'head pose at start'),
-        (t(NODE_NAME + '/debug/caml/compressed'), 'sensor_msgs/CompressedImage', 'out',
-         'annotated, only while subscribed'),
-        (t(NODE_NAME + '/debug/camr/compressed'), 'sensor_msgs/CompressedImage', 'out',
-         'annotated, only while subscribed'),
+    names = RobotTopics(robot_name)
+    used = []
+    for eye, side in zip(EYES, SIDES):
+        used += [(names.eye_compressed(eye), 'sensor_msgs/CompressedImage', 'in',
+                  side + ' eye, JPEG'),
+                 (names.camera_info(eye), 'sensor_msgs/CameraInfo', 'in',
+                  '%s eye pinhole (until one arrives: %g deg)' % (side, CAM_HFOV_DEG_SIM))]
+    used += [
+        (names.cliff, 'std_msgs/Float32MultiArray', 'in', '[L, R], 1 floor, <0.7 drop'),
+        (names.cmd_vel, 'geometry_msgs/TwistStamped', 'out', 'every tick'),
+        (names.kinematic_targets, 'sensor_msgs/JointState', 'out', 'head pose at start'),
     ]
+    used += [(names.controller_debug(eye), 'sensor_msgs/CompressedImage', 'out',
+              'annotated, only while subscribed') for eye in EYES]
+    return used
 
 
 class Latest:
@@ -86,16 +94,19 @@ class KickBlueBall(Node):
 
     state             behaviour state name ('startup' while holding the head)
     frames_processed  camera frames decoded and run through the detector
-    rejected          Counter of ignored inputs by kind (empty, corrupt, size, cliff)
+    rejected          Counter of ignored inputs by kind (empty, corrupt, size, cliff,
+                      camera_info)
+    cameras           each eye's pinhole (camera.Intrinsics) from its latest usable
+                      camera_info, at that camera_info's resolution
     last_command      (left, right) wheel speeds of the latest twist, m/s
     last_tick         node time (s) of the latest control tick, None before the first
-    detector, behaviour, config (ControllerParams), pub_twist
+    detector, behaviour, config (ControllerParams), names (RobotTopics), pub_twist
     """
 
     def __init__(self, *, context=None, parameter_overrides=None, save_debug=None):
         super().__init__(NODE_NAME, context=context,
                          parameter_overrides=list(parameter_overrides or []))
-        self.config = params.declare(self, params.ControllerParams)
+        self.config = params.declare(self, ControllerParams)
         self.detector = BallDetector(params.declare(self, DetectionParams))
         self._behaviour_params = params.declare(self, BehaviourParams)
         self.save_debug = save_debug
@@ -106,22 +117,23 @@ class KickBlueBall(Node):
         self._warn = Throttled(self.get_logger().warning, WARN_EVERY_S)
         self.balls = [Latest() for _ in EYES]
         self.cliff = Latest()
+        self.cameras = list(DEFAULT_CAMERAS)
+        # Each eye's pinhole at the size of the frame its latest detection came from.
+        self._frame_cameras = list(DEFAULT_CAMERAS)
         self._restart()
 
-        name = self.config.robot_name
+        self.names = names = RobotTopics(self.config.robot_name)
         for eye, cam in enumerate(EYES):
-            self.create_subscription(CompressedImage, topic(name, 'sensors/%s/compressed' % cam),
+            self.create_subscription(CompressedImage, names.eye_compressed(cam),
                                      partial(self._on_image, eye), SENSOR_QOS)
-        self.create_subscription(Float32MultiArray, topic(name, 'sensors/cliff'),
-                                 self._on_cliff, SENSOR_QOS)
-        self.pub_twist = self.create_publisher(TwistStamped, topic(name, 'control/cmd_vel'), 10)
-        self.pub_joints = self.create_publisher(
-            JointState, topic(name, 'control/kinematic_joints'), 10)
-        self.pub_debug = [
-            self.create_publisher(CompressedImage,
-                                  topic(name, '%s/debug/%s/compressed' % (NODE_NAME, cam)),
-                                  DEBUG_QOS)
-            for cam in EYES]
+            self.create_subscription(CameraInfo, names.camera_info(cam),
+                                     partial(self._on_camera_info, eye), SENSOR_QOS)
+        self.create_subscription(Float32MultiArray, names.cliff, self._on_cliff, SENSOR_QOS)
+        self.pub_twist = self.create_publisher(TwistStamped, names.cmd_vel, 10)
+        self.pub_joints = self.create_publisher(JointState, names.kinematic_targets, 10)
+        self.pub_debug = [self.create_publisher(CompressedImage, names.controller_debug(cam),
+                                                DEBUG_QOS)
+                          for cam in EYES]
         self.timer = self.create_timer(self.config.tick, self._on_tick)
         # A restarted simulator sends /clock backwards; rcl versions differ in
         # whether a ROS-time timer then waits for the old timeline to come back.
@@ -130,7 +142,7 @@ class KickBlueBall(Node):
                           on_clock_change=False),
             post_callback=lambda jump: self.timer.reset())
         self.get_logger().info("mode '%s', robot '%s', tick %g s"
-                               % (self.config.mode, name, self.config.tick))
+                               % (self.config.mode, names.name, self.config.tick))
 
     def _restart(self):
         """Start afresh: new behaviour, head hold, no percepts (also after time went back)."""
@@ -178,7 +190,22 @@ class KickBlueBall(Node):
         ball = self.detector.detect(frame)
         self.frames_processed += 1
         self.balls[eye].set(now, ball)
+        # camera_info may describe another resolution than the frames (a resized stream).
+        height, width = frame.shape[:2]
+        self._frame_cameras[eye] = self.cameras[eye].scaled_to(width, height)
         self._debug_image(eye, msg.header, frame, ball)
+
+    def _on_camera_info(self, eye, msg):
+        """Adopt the eye's pinhole; an unusable camera_info leaves the previous one."""
+        try:
+            camera = Intrinsics.from_k(msg.width, msg.height, msg.k)
+        except ValueError as err:
+            return self._reject('camera_info', '%s: camera_info unusable: %s' % (EYES[eye], err))
+        if camera != self.cameras[eye]:
+            self.get_logger().info('%s: camera_info %dx%d, fx %.1f, cx %.1f (%.1f deg wide)' % (
+                EYES[eye], camera.width, camera.height, camera.fx, camera.cx,
+                math.degrees(2 * math.atan(camera.width / (2 * camera.fx)))))
+        self.cameras[eye] = camera
 
     def _on_cliff(self, msg):
         data = tuple(msg.data)
@@ -230,7 +257,8 @@ class KickBlueBall(Node):
         self._check_silence(now)
         stale = self.config.stale_s
         left, right = (latest.fresh(now, stale) for latest in self.balls)
-        command = self.behaviour.step(now, left, right, self.cliff.fresh(now, stale))
+        command = self.behaviour.step(now, left, right, self.cliff.fresh(now, stale),
+                                      self._frame_cameras)
         for message in command.messages:
             self.get_logger().info(message)
         self.state = command.state
@@ -239,11 +267,12 @@ class KickBlueBall(Node):
     def _check_silence(self, now):
         """Warn about inputs that stopped (or never started) arriving."""
         stale = self.config.stale_s
-        for kind, latest in list(zip(EYES, self.balls)) + [('cliff', self.cliff)]:
+        watched = [(self.names.eye_compressed(eye), latest)
+                   for eye, latest in zip(EYES, self.balls)] + [(self.names.cliff, self.cliff)]
+        for name, latest in watched:
             since = latest.stamp if latest.stamp is not None else self._started
             if now - since > stale:
-                self._warn('silent ' + kind,
-                           'nothing on sensors/%s for %.1f s' % (kind, now - since))
+                self._warn('silent ' + name, 'nothing on %s for %.1f s' % (name, now - since))
 
     def _publish_head(self):
         msg = JointState(name=list(JOINT_NAMES),
@@ -276,18 +305,20 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, '%s: error: %s (try --help)\n' % (self.prog, message))
 
 
-def build_parser():
-    rows = params.table()
-    width = max(len(name) for name, _, _ in rows)
-    lines = ['parameters (--ros-args -p name:=value):']
-    lines += ['  %-*s  %-14s %s' % (width, name, default, text) for name, default, text in rows]
-    robot = params.ControllerParams().robot_name
-    used = topics(robot)
+def _topic_lines(robot_name):
+    """The --help topic table; a bad robot name in its place (starting then fails on it)."""
+    try:
+        used = topics(robot_name)
+    except ValueError as err:
+        return ['topics: %s' % err]
     width = max(len(name) for name, _, _, _ in used)
-    lines += ['', 'topics (robot_name %s):' % robot]
-    lines += ['  %-3s %-*s  %s, %s' % (way, width, name, kind, what)
-              for name, kind, way, what in used]
-    lines += ['', 'With --ros-args -p use_sim_time:=true the control tick follows /clock.']
+    return ['topics (robot_name %s):' % robot_name] + [
+        '  %-3s %-*s  %s, %s' % (way, width, name, kind, what) for name, kind, way, what in used]
+
+
+def build_parser():
+    lines = params.help_lines(*GROUPS) + [''] + _topic_lines(default_robot_name())
+    lines += ['', 'With --ros-args -p use_sim_time:=true the control tick follows %s.' % CLOCK]
     parser = _Parser(
         prog='kick_blue_ball',
         description='MiRo-E kick_blue_ball controller for ROS 2: finds the blue ball with '

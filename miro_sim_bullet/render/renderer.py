@@ -28,7 +28,6 @@ Facts about the EGL plugin that shape this module (pybullet 3.2.7, measured):
 """
 import collections
 import ctypes
-import dataclasses
 import functools
 import importlib.util
 import math
@@ -42,6 +41,7 @@ import threading
 import cv2
 import numpy as np
 import pybullet as p
+
 
 EGL_MAX_WIDTH = 1024
 EGL_MAX_HEIGHT = 768
@@ -58,40 +58,6 @@ class RendererUnavailable(RuntimeError):
     def __init__(self, reason):
         super().__init__(reason)
         self.reason = reason
-
-
-@dataclasses.dataclass(frozen=True)
-class Intrinsics:
-    """Pinhole camera in the ROS/OpenCV convention: integer (u, v) are pixel centres."""
-
-    width: int
-    height: int
-    fx: float
-    fy: float
-    cx: float
-    cy: float
-    near: float = 0.01
-    far: float = 30.0
-
-    def __post_init__(self):
-        if self.width < 1 or self.height < 1:
-            raise ValueError(f'image size must be positive, got {self.width}x{self.height}')
-        if not 0.0 < self.near < self.far:
-            raise ValueError(f'need 0 < near < far, got near={self.near} far={self.far}')
-
-    @classmethod
-    def from_hfov(cls, width, height, hfov_deg, near=0.01, far=30.0):
-        """Square pixels, principal point at the image centre."""
-        f = (width / 2.0) / math.tan(math.radians(hfov_deg) / 2.0)
-        return cls(width, height, f, f, (width - 1) / 2.0, (height - 1) / 2.0, near, far)
-
-    def K(self):
-        """3x3 camera matrix for sensor_msgs/CameraInfo.k (as nested lists)."""
-        return [[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]]
-
-    def P(self):
-        """3x4 projection matrix for sensor_msgs/CameraInfo.p (monocular: no Tx)."""
-        return [row + [0.0] for row in self.K()]
 
 
 def opengl_projection(intrinsics, x0=0, y0=0, width=None, height=None):

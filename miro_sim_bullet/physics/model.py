@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
-from miro_ball.constants import (CAM_DIVERGENCE_RAD, CAM_ELEVATION_RAD, JOINT_LIMITS_RAD, LIFT,
+from miro_ball.miro.constants import (CAM_DIVERGENCE_RAD, CAM_ELEVATION_RAD, JOINT_LIMITS_RAD, LIFT,
                                  PITCH, TILT_RAD, WHEEL_RADIUS_M, WHEEL_TRACK_M, YAW)
 
 AXLE_HEIGHT = WHEEL_RADIUS_M
@@ -190,6 +190,12 @@ class MiroModel:
             pb.changeDynamics(body, link, jointLowerLimit=lo, jointUpperLimit=hi, **kw)
         return body
 
+    def set_collision_filter(self, group, mask):
+        """Every link of the robot in one collision group (its sensor rays skip it)."""
+        for link in range(-1, pb.getNumJoints(self.body_id, physicsClientId=self.client)):
+            pb.setCollisionFilterGroupMask(self.body_id, link, group, mask,
+                                           physicsClientId=self.client)
+
     def show_illum(self, argb_values):
         """Colour the LED patches: 0xAARRGGBB, AA the brightness; dark LEDs look white."""
         for link, argb in zip(ILLUM_LINKS, argb_values):
@@ -209,11 +215,11 @@ class MiroModel:
         rot = np.array(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
         return np.array(com) - rot @ np.array(BODY_COM), rot
 
-    def place(self, x, y, yaw):
-        """Put the robot at rest on flat floor at z = 0 (FOOT pose x, y, yaw)."""
+    def place(self, x, y, yaw, floor=0.0):
+        """Put the robot at rest on flat floor at height floor (FOOT pose x, y, yaw)."""
         orientation = pb.getQuaternionFromEuler((0.0, TILT_RAD, yaw))
         rot = np.array(pb.getMatrixFromQuaternion(orientation)).reshape(3, 3)
-        com = np.array((x, y, AXLE_HEIGHT)) + rot @ np.array(BODY_COM)
+        com = np.array((x, y, floor + AXLE_HEIGHT)) + rot @ np.array(BODY_COM)
         pb.resetBasePositionAndOrientation(self.body_id, com, orientation,
                                            physicsClientId=self.client)
         pb.resetBaseVelocity(self.body_id, (0, 0, 0), (0, 0, 0), physicsClientId=self.client)

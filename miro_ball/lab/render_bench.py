@@ -1,4 +1,4 @@
-"""Stereo rendering speed per available renderer: ``python -m miro_sim_bullet.render_bench``.
+"""Stereo rendering speed per available renderer: ``python -m miro_ball.lab.render_bench``.
 
 Prints the median milliseconds per stereo pair (two render() calls, 6 cm baseline) for a
 small scene (ground, a few boxes, a ball) at the MiRo camera sizes.
@@ -11,7 +11,8 @@ import time
 import numpy as np
 import pybullet as p
 
-from miro_sim_bullet.rendering import Intrinsics, Renderer, probe_egl, view_matrix_from_pose
+from miro_ball.miro.camera import Intrinsics
+from miro_sim_bullet.render.renderer import Renderer, probe_egl, view_matrix_from_pose
 
 SIZES = ((640, 360), (320, 240), (1280, 720))
 HFOV_DEG = 120.0

@@ -13,7 +13,7 @@ import sys
 import time
 from pathlib import Path
 
-from miro_ball.isolation import limit_discovery, private_domain
+from miro_ball.common.isolation import limit_discovery, private_domain
 
 MODES = ('improved', 'tutorial')
 
@@ -42,7 +42,7 @@ def run(args):
     import rclpy
     from rclpy.context import Context
 
-    from miro_ball.scenarios import placements, run_episode
+    from miro_ball.lab.scenarios import placements, run_episode
 
     results = {mode: [] for mode in args.modes}
     chosen = placements(args.count, seed=args.seed)
@@ -81,7 +81,7 @@ def table(results, count, limit):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog='python -m miro_ball.scenario_bench',
+    parser = argparse.ArgumentParser(prog='python -m miro_ball.lab.scenario_bench',
                                      description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--count', type=int, default=50, help='placements (50)')
@@ -103,7 +103,7 @@ def main(argv=None):
     print('\n' + report)
     Path(args.output).write_text(
         '# Scenario benchmark\n\n'
-        f'`python -m miro_ball.scenario_bench --count {args.count} --seed {args.seed}` '
+        f'`python -m miro_ball.lab.scenario_bench --count {args.count} --seed {args.seed}` '
         f'({args.count} seeded placements of robot and ball in the default arena; success = '
         f'ball moved >= 0.3 m within {args.limit:g} s of simulated time and the robot never '
         f'fell; times are simulated seconds from the start of the episode).\n\n'

@@ -1,19 +1,23 @@
 """Kick-the-ball behaviours as pure state machines (no rclpy).
 
-Each tick the controller calls ``step(t, left, right, cliff)`` with the time in
-seconds (monotonic), the latest fresh detection of each eye (a detection.Ball or
-None) and the latest fresh cliff reading ([left, right], 1 = floor, or None when
-unknown). It gets back a Command: wheel speeds in m/s, the state name and the
-messages to log for behaviour changes that happened during the tick.
+Each tick the controller calls ``step(t, left, right, cliff, cameras)`` with the
+time in seconds (monotonic), the latest fresh detection of each eye (a
+detection.Ball or None), the latest fresh cliff reading ([left, right], 1 = floor,
+or None when unknown) and each eye's pinhole (camera.Intrinsics) at the size of the
+frame its detection came from. It gets back a Command: wheel speeds in m/s, the
+state name and the messages to log for behaviour changes that happened during the
+tick.
 """
 import math
 import random
 from dataclasses import dataclass, field
 from typing import NamedTuple, Optional, Sequence, Tuple
 
-from miro_ball.constants import (CAM_DIVERGENCE_RAD, CAM_HFOV_DEG_SIM, CLIFF_THRESHOLD,
-                                 WHEEL_MAX_SPEED_M_PER_S)
-from miro_ball.kinematics import cmd_vel2wheel_speed, wheel_speed2cmd_vel
+from miro_ball.controller.detection import to_pixels
+from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, CLIFF_THRESHOLD, WHEEL_MAX_SPEED_M_PER_S
+from miro_ball.miro.interface import EYE_SIDE, EYES
+from miro_ball.miro.kinematics import cmd_vel2wheel_speed, wheel_speed2cmd_vel
 
 SEARCH, LOCK_ON, KICK = 'search', 'lock_on', 'kick'
 APPROACH, EXPLORE, AVOID = 'approach', 'explore', 'avoid_cliff'
@@ -28,7 +32,10 @@ MESSAGES = {
 }
 LOST = 'lost the ball'
 
-_TAN_HALF_HFOV = math.tan(math.radians(CAM_HFOV_DEG_SIM) / 2)
+# MiRo's simulated eyes (120 deg pinholes, the simulator's default frame size): the
+# model of both eyes until their camera_info says otherwise.
+DEFAULT_CAMERA = Intrinsics.from_hfov(640, 360)
+DEFAULT_CAMERAS = (DEFAULT_CAMERA,) * len(EYES)
 
 
 @dataclass(frozen=True)
@@ -86,24 +93,26 @@ class Command(NamedTuple):
     messages: Tuple[str, ...] = ()
 
 
-def eye_bearing(x, eye_azimuth):
-    """Bearing (rad, + = left of the robot) of an image column x (+ = right, /width).
+def eye_bearing(ball, camera: Intrinsics, eye_azimuth):
+    """Bearing (rad, + = left of the robot) of a detection in one eye.
 
-    The simulator's eyes are pinhole cameras, so the angle off the optical axis
-    is atan(2 x tan(hfov / 2)); the eye's own azimuth (+27 deg left, -27 right)
-    is added. Elevation and the eyes' lateral offset are ignored: the error is a
-    few degrees and the steering closes the loop anyway.
+    camera is the eye's pinhole at the size of the frame the ball was found in: the
+    ball's pixel column gives the angle off the optical axis, and the eye's own
+    azimuth (+27 deg left, -27 right) is added. Elevation and the eyes' lateral
+    offset are ignored: the error is a few degrees and the steering closes the
+    loop anyway.
     """
-    return eye_azimuth - math.atan(2.0 * x * _TAN_HALF_HFOV)
+    column = to_pixels(ball, (camera.height, camera.width))[0]
+    return eye_azimuth + camera.bearing(column)
 
 
-def ball_bearing(left, right) -> Optional[float]:
-    """Mean bearing from the eyes that see the ball, or None if neither does."""
-    bearings = []
-    if left is not None:
-        bearings.append(eye_bearing(left.x, CAM_DIVERGENCE_RAD))
-    if right is not None:
-        bearings.append(eye_bearing(right.x, -CAM_DIVERGENCE_RAD))
+def ball_bearing(left, right, cameras: Sequence[Intrinsics]) -> Optional[float]:
+    """Mean bearing from the eyes that see the ball, or None if neither does.
+
+    cameras: (left, right) pinholes, each at the size of its eye's frame.
+    """
+    bearings = [eye_bearing(ball, camera, EYE_SIDE[eye] * CAM_DIVERGENCE_RAD)
+                for eye, ball, camera in zip(EYES, (left, right), cameras) if ball is not None]
     return sum(bearings) / len(bearings) if bearings else None
 
 
@@ -136,14 +145,14 @@ class _Machine:
         self._said.append(MESSAGES[state])
         self.state = state
 
-    def step(self, t, left, right, cliff=None) -> Command:
+    def step(self, t, left, right, cliff=None, cameras=DEFAULT_CAMERAS) -> Command:
         self._said = []
         if self.state is None:
             self._go(SEARCH)
-        wheels = self._decide(t, left, right, cliff)
+        wheels = self._decide(t, left, right, cliff, cameras)
         return Command(wheels[0], wheels[1], self.state, tuple(self._said))
 
-    def _decide(self, t, left, right, cliff):
+    def _decide(self, t, left, right, cliff, cameras):
         raise NotImplementedError
 
 
@@ -152,9 +161,10 @@ class TutorialBehaviour(_Machine):
 
     Every tick yields a command: a state change takes effect in the same tick
     rather than skipping one, and the kick is timed in seconds, not loop counts.
+    Like the tutorial it centres on raw image columns, so it needs no camera model.
     """
 
-    def _decide(self, t, left, right, cliff):
+    def _decide(self, t, left, right, cliff, cameras):
         p = self.params
         if self.state == SEARCH:
             if left is None and right is None:
@@ -231,10 +241,10 @@ class ImprovedBehaviour(_Machine):
         self._seen = None  # (time, bearing) of the latest sighting
         self._spin_rate = wheel_speed2cmd_vel(spin(1, params.search_speed))[1]  # rad/s, > 0
 
-    def _decide(self, t, left, right, cliff):
+    def _decide(self, t, left, right, cliff, cameras):
         dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
         self._last_t = t
-        bearing = ball_bearing(left, right)
+        bearing = ball_bearing(left, right, cameras)
         closest = max((b.r for b in (left, right) if b is not None), default=0.0)
         if bearing is not None:
             self.side = 1 if bearing > 0 else -1

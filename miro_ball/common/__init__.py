@@ -1,0 +1,1 @@
+"""Plumbing every node shares: parameters, rate-limited warnings, ROS isolation."""

@@ -1,0 +1,84 @@
+"""ROS parameters declared from dataclasses: one field, one parameter.
+
+A field's default is the parameter's default and its metadata['help'] the
+description, so a node's declarations, its --help and the README cannot drift
+apart. The dataclass's __post_init__ validates the whole set.
+"""
+import math
+from dataclasses import MISSING, fields
+
+
+def default_of(f):
+    return f.default_factory() if f.default is MISSING else f.default
+
+
+def coerce(name, value, default):
+    """A parameter value in the type of its default, or ValueError saying what was wrong.
+
+    Numbers are accepted loosely (-p fast:=1 is 1.0), since ROS types 1 as an integer.
+    """
+    def fail(kind):
+        return ValueError("parameter '%s' must be %s, not %r" % (name, kind, value))
+
+    if isinstance(default, tuple):
+        if isinstance(value, (str, bytes)) or not hasattr(value, '__len__'):
+            raise fail('a list of %d integers' % len(default))
+        if len(value) != len(default):
+            raise fail('a list of %d integers' % len(default))
+        return tuple(coerce(name, v, default[0]) for v in value)
+    if isinstance(default, str):
+        if not isinstance(value, str):
+            raise fail('a string')
+        return value
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise fail('true or false')
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise fail('a number')
+    if not math.isfinite(value):
+        raise fail('finite')
+    if isinstance(default, int):
+        if value != int(value):
+            raise fail('an integer')
+        return int(value)
+    return float(value)
+
+
+def declare(node, cls, overrides=None):
+    """Declare every field of cls on the node and return the filled-in dataclass.
+
+    overrides: {name: value} that win over the node's own (e.g. from the command line).
+    """
+    from rcl_interfaces.msg import ParameterDescriptor
+
+    values = {}
+    for f in fields(cls):
+        default = default_of(f)
+        descriptor = ParameterDescriptor(description=f.metadata['help'], dynamic_typing=True)
+        declared = list(default) if isinstance(default, tuple) else default
+        value = node.declare_parameter(f.name, declared, descriptor).value
+        if overrides and f.name in overrides:
+            value = overrides[f.name]
+        values[f.name] = coerce(f.name, value, default)
+    return cls(**values)
+
+
+def _show(value):
+    if isinstance(value, tuple):
+        return '[%s]' % ','.join(str(v) for v in value)
+    return str(value)
+
+
+def table(*groups):
+    """(name, default as text, help) for every parameter of the groups, in order."""
+    return [(f.name, _show(default_of(f)), f.metadata['help'])
+            for cls in groups for f in fields(cls)]
+
+
+def help_lines(*groups):
+    """The parameter table as --help epilog lines."""
+    rows = table(*groups)
+    width = max(len(name) for name, _, _ in rows)
+    return ['parameters (--ros-args -p name:=value):'] + [
+        '  %-*s  %-14s %s' % (width, name, default, text) for name, default, text in rows]

@@ -1,0 +1,1 @@
+"""kick_blue_ball: detection and behaviours (pure), their parameters, and the ROS node."""

@@ -1,0 +1,1 @@
+"""Example clients, one small file each: what students copy from."""

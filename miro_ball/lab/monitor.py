@@ -1,0 +1,101 @@
+"""An observer of a run over ROS: simulated time, the ball, the robots, the controllers.
+
+It only subscribes (to /clock, the simulator's ground truth and the controllers'
+annotated frames), so it can watch any run: the demo's, a grader's, a user's.
+Image callbacks are optional; they get each frame decoded to BGR.
+"""
+import cv2
+import numpy as np
+
+from miro_ball.lab.judge import FELL_BELOW_M, KICK_DISTANCE_M, ball_moved
+from miro_ball.miro.constants import WHEEL_RADIUS_M
+from miro_ball.miro.interface import CLOCK, EYES, RobotTopics, SimTopics
+
+
+def decode(msg):
+    """BGR image of a CompressedImage, or None if it does not decode."""
+    return cv2.imdecode(np.frombuffer(bytes(msg.data), np.uint8), cv2.IMREAD_COLOR)
+
+
+class RobotWatch:
+    """What the monitor knows about one robot."""
+
+    def __init__(self):
+        self.frames = 0  # annotated frames its controller published
+        self.start_z = None  # floor height when first seen
+        self.position = None  # x, y, z of the point under its axle
+        self.fell = False
+
+
+class Monitor:
+    """Subscribes on ``node`` (which should use sim time) for the given robot names."""
+
+    def __init__(self, node, robots, on_eye=None, on_overhead=None, qos=10):
+        from geometry_msgs.msg import PointStamped, PoseStamped
+        from rosgraph_msgs.msg import Clock
+        from sensor_msgs.msg import CompressedImage
+
+        self.sim_time = 0.0
+        self.ball_start = None
+        self.ball = None
+        self.kick_time = None
+        self.kicker = None  # the robot nearest the ball when it was kicked
+        self.robots = {name: RobotWatch() for name in robots}
+        sim = SimTopics()
+        node.create_subscription(Clock, CLOCK, self._on_clock, qos)
+        node.create_subscription(PointStamped, sim.ball, self._on_ball, qos)
+        for index, name in enumerate(robots):
+            node.create_subscription(PoseStamped, sim.object_pose(name),
+                                     lambda msg, n=name: self._on_robot(n, msg), qos)
+            for side, eye in enumerate(EYES):
+                node.create_subscription(
+                    CompressedImage, RobotTopics(name).controller_debug(eye),
+                    lambda msg, n=name, i=index, s=side: self._on_debug(n, i, s, msg, on_eye),
+                    5)
+        if on_overhead is not None:
+            node.create_subscription(CompressedImage, sim.overhead,
+                                     lambda msg: self._on_image(msg, on_overhead), 5)
+
+    @property
+    def kicked(self):
+        return self.kick_time is not None
+
+    @property
+    def moved(self):
+        """How far the ball is from where it was first seen (m)."""
+        return 0.0 if self.ball is None else ball_moved(self.ball_start, self.ball)
+
+    def _on_clock(self, msg):
+        self.sim_time = msg.clock.sec + msg.clock.nanosec * 1e-9
+
+    def _on_ball(self, msg):
+        self.ball = (msg.point.x, msg.point.y)
+        self.ball_start = self.ball_start or self.ball
+        if not self.kicked and self.moved >= KICK_DISTANCE_M:
+            self.kick_time = self.sim_time
+            self.kicker = self._nearest_robot(self.ball_start)
+
+    def _nearest_robot(self, point):
+        placed = [(ball_moved(point, w.position), name)
+                  for name, w in self.robots.items() if w.position is not None]
+        return min(placed)[1] if placed else None
+
+    def _on_robot(self, name, msg):
+        watch = self.robots[name]
+        p = msg.pose.position
+        watch.position = (p.x, p.y, p.z)
+        if watch.start_z is None:
+            watch.start_z = p.z
+        # The pose is of the point under the axle: the axle is WHEEL_RADIUS_M above it.
+        watch.fell = watch.fell or p.z + WHEEL_RADIUS_M - watch.start_z < FELL_BELOW_M
+
+    def _on_debug(self, name, index, side, msg, on_eye):
+        self.robots[name].frames += 1
+        if on_eye is not None:
+            self._on_image(msg, lambda bgr: on_eye(index, side, bgr))
+
+    @staticmethod
+    def _on_image(msg, callback):
+        bgr = decode(msg)
+        if bgr is not None:
+            callback(bgr)

@@ -1,0 +1,1 @@
+"""The PyBullet world: static bodies, movable objects, MiRo robots and their sensors."""

@@ -1,0 +1,229 @@
+"""One MiRo in the world: its body, what its platform does each tick, what it senses.
+
+The platform runs at 50 Hz of simulated time (the world calls tick()): it applies
+the command timeout and the cliff reflex, drives the wheel motors and samples
+every sensor, so readers get one consistent snapshot per tick (``sensors``).
+"""
+import math
+
+import numpy as np
+import pybullet as pb
+
+from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
+                                      DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
+                                      KIN_CALIB_RAD, TILT_RAD, WHEEL_RADIUS_M)
+from miro_ball.miro.kinematics import clamp_wheel_speeds, cmd_vel2wheel_speed
+from miro_sim_bullet.physics import model as rb
+from miro_sim_bullet.physics.sensors import (SONAR_DIRECTIONS, Accelerometer, Sensors,
+                                             cliff_value)
+
+CMD_TIMEOUT_S = 0.5
+WHEEL_TORQUE_NM = 0.5  # enough to reach 0.4 m/s in a few cm, weak enough to stall on a wall
+HEAD_SPEED_RAD_S = 2.0  # servo-like slew rate of the neck joints
+HEAD_TORQUE_NM = 2.0
+COSMETIC_TORQUE_NM = 0.2
+
+
+class MiroRobot:
+    """A MiRo-E named ``name``; ``clock()`` gives the world's simulated time.
+
+    ``ray_mask``: the collision groups its sensor rays see (everything but itself).
+    """
+
+    def __init__(self, client, name, spec, clock, ray_mask):
+        self.client = client
+        self.name = name
+        self.spec = spec
+        self.clock = clock
+        self.ray_mask = ray_mask
+        self.model = rb.MiroModel(client)
+        self.body_id = self.model.body_id
+        self.imu = {'body': Accelerometer(), 'head': Accelerometer()}
+        self.sensors = None
+        self.start()
+
+    def _kw(self):
+        return {'physicsClientId': self.client}
+
+    def start(self):
+        """At the world file's pose with the platform as it powers up."""
+        self.model.place(*self.spec.pose, floor=self.spec.floor)
+        self.wheel_cmd = (0.0, 0.0)
+        self.wheel_out = (0.0, 0.0)
+        self.last_cmd_time = -math.inf
+        self.kin_targets = list(KIN_CALIB_RAD)
+        self.cosmetic = list(COSMETIC_CALIB)
+        self.flags = 0
+        self.illum = [0] * 6
+        for accelerometer in self.imu.values():
+            accelerometer.reset()
+        self._set_joints_to_targets()
+        self._apply_joint_motors()
+        self.tick()
+
+    def place(self, x, y, yaw, floor=None):
+        """Move the robot to rest at (x, y, yaw), on its own floor unless given one."""
+        self.model.place(x, y, yaw, floor=self.spec.floor if floor is None else floor)
+        self.sensors = self._read_sensors(self._read_cliff())
+
+    # -- commands ---------------------------------------------------------------------------
+    def set_cmd_vel(self, linear, angular):
+        """Wheel speeds by MiRo's formula, each clamped to the wheels' +-0.4 m/s;
+        returns True when a wheel had to be clamped."""
+        wanted = cmd_vel2wheel_speed(linear, angular)
+        self.wheel_cmd = clamp_wheel_speeds(*wanted)
+        self.last_cmd_time = self.clock()
+        # A hair over the limit is rounding in the sender's own clamp, not a request.
+        return any(abs(w - c) > 1e-6 for w, c in zip(wanted, self.wheel_cmd))
+
+    def set_kinematic_targets(self, positions):
+        """Targets [tilt, lift, yaw, pitch] clamped to MiRo's ranges; returns them."""
+        self.kin_targets = [min(max(p, lo), hi) for p, (lo, hi) in
+                            zip(positions, JOINT_LIMITS_RAD)]
+        self._apply_joint_motors()
+        return tuple(self.kin_targets)
+
+    def set_cosmetic(self, values):
+        self.cosmetic = [min(max(v, 0.0), 1.0) for v in values]
+        self._apply_joint_motors()
+
+    def set_illum(self, argb):
+        """Six 0xAARRGGBB LEDs, shown as the colour of the body patches."""
+        self.illum = list(argb)
+        self.model.show_illum(self.illum)
+
+    @property
+    def cliff_reflex_enabled(self):
+        return not self.flags & DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
+
+    def _cosmetic_angles(self):
+        return [lo + v * (hi - lo) for v, (lo, hi) in zip(self.cosmetic, rb.COSMETIC_RANGES)]
+
+    def _set_joints_to_targets(self):
+        kw = self._kw()
+        for joint, link in rb.KIN_LINKS.items():
+            pb.resetJointState(self.body_id, link, self.kin_targets[joint], **kw)
+        for link, angle in zip(rb.COSMETIC_LINKS, self._cosmetic_angles()):
+            pb.resetJointState(self.body_id, link, angle, **kw)
+
+    def _apply_joint_motors(self):
+        kw = self._kw()
+        for joint, link in rb.KIN_LINKS.items():
+            pb.setJointMotorControl2(self.body_id, link, pb.POSITION_CONTROL,
+                                     targetPosition=self.kin_targets[joint],
+                                     maxVelocity=HEAD_SPEED_RAD_S, force=HEAD_TORQUE_NM, **kw)
+        pb.setJointMotorControlArray(self.body_id, list(rb.COSMETIC_LINKS), pb.POSITION_CONTROL,
+                                     targetPositions=self._cosmetic_angles(),
+                                     forces=[COSMETIC_TORQUE_NM] * 6, **kw)
+
+    # -- the 50 Hz platform tick ------------------------------------------------------------
+    def tick(self):
+        """What MiRo's platform does at 50 Hz: sense, then timeout, cliff reflex, motors."""
+        cliff = self._read_cliff()
+        left, right = self.wheel_cmd
+        if self.clock() - self.last_cmd_time > CMD_TIMEOUT_S:
+            left = right = 0.0
+        forward = left + right > 0.0
+        if forward and self.cliff_reflex_enabled and min(cliff) < CLIFF_THRESHOLD:
+            left = right = 0.0
+        self.wheel_out = (left, right)
+        pb.setJointMotorControlArray(
+            self.body_id, [rb.WHEEL_L, rb.WHEEL_R], pb.VELOCITY_CONTROL,
+            targetVelocities=[left / WHEEL_RADIUS_M, right / WHEEL_RADIUS_M],
+            forces=[WHEEL_TORQUE_NM] * 2, **self._kw())
+        self.sensors = self._read_sensors(cliff)
+
+    # -- ground truth -----------------------------------------------------------------------
+    def pose(self):
+        """(x, y, yaw) of the point on the floor under the wheel axle."""
+        pos, rot = self.model.body_frame()
+        return pos[0], pos[1], math.atan2(rot[1, 0], rot[0, 0])
+
+    def ground_truth(self):
+        """(x, y, z, yaw) of the FOOT frame: z is its floor's height while it stands."""
+        x, y, yaw = self.pose()
+        return x, y, self.model.body_frame()[0][2] - rb.AXLE_HEIGHT, yaw
+
+    def height(self):
+        """Height of the wheel axle above its floor: about 0.045, far less after a fall."""
+        return self.model.body_frame()[0][2] - self.spec.floor
+
+    # -- sensors ----------------------------------------------------------------------------
+    def link_frame(self, link):
+        """World (position, rotation matrix) of a link; -1 is the BODY frame."""
+        if link < 0:
+            return self.model.body_frame()
+        state = pb.getLinkState(self.body_id, link, computeForwardKinematics=1, **self._kw())
+        return np.array(state[4]), np.array(pb.getMatrixFromQuaternion(state[5])).reshape(3, 3)
+
+    def _rays(self, starts, ends):
+        return pb.rayTestBatch(starts, ends, collisionFilterMask=self.ray_mask, **self._kw())
+
+    def _read_cliff(self):
+        pos, rot = self.link_frame(-1)
+        down = rb.CLIFF_PITCH_DOWN
+        ray_dir = rot @ np.array([math.cos(down), 0.0, -math.sin(down)])
+        x, y, z = rb.CLIFF_IN_BODY
+        starts = [pos + rot @ np.array([x, side * y, z]) for side in (1, -1)]
+        hits = self._rays(starts, [s + rb.CLIFF_RANGE * ray_dir for s in starts])
+        return tuple(cliff_value(h[2] * rb.CLIFF_RANGE if h[0] >= 0 else math.inf)
+                     for h in hits)
+
+    def _read_sonar(self):
+        pos, rot = self.link_frame(rb.HEAD)
+        start = pos + rot @ np.array(rb.SONAR_IN_HEAD)
+        lo, hi = rb.SONAR_RANGE
+        ends = start + hi * SONAR_DIRECTIONS @ rot.T
+        found = [h[2] * hi for h in self._rays([start] * len(ends), ends) if h[0] >= 0]
+        return max(lo, min(found)) if found else math.inf
+
+    def _imu(self, link, part):
+        """Orientation, angular velocity and specific force of a link, in its own frame."""
+        kw = self._kw()
+        if link < 0:
+            orn = pb.getBasePositionAndOrientation(self.body_id, **kw)[1]
+            lin, ang = pb.getBaseVelocity(self.body_id, **kw)
+        else:
+            state = pb.getLinkState(self.body_id, link, computeLinkVelocity=1,
+                                    computeForwardKinematics=1, **kw)
+            orn, lin, ang = state[5], state[6], state[7]
+        rot = np.array(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
+        force = self.imu[part].specific_force(self.clock(), rot, np.array(lin))
+        return tuple(orn), tuple(rot.T @ np.array(ang)), force
+
+    def _read_sensors(self, cliff):
+        kw = self._kw()
+        states = pb.getJointStates(self.body_id, [rb.NECK, rb.GIMBAL, rb.HEAD, rb.WHEEL_L,
+                                                  rb.WHEEL_R], **kw)
+        lin, ang = pb.getBaseVelocity(self.body_id, **kw)
+        x, y, yaw = self.pose()
+        forward = lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw)
+        return Sensors(
+            time=self.clock(),
+            kinematic_positions=(TILT_RAD, *(s[0] for s in states[:3])),
+            kinematic_velocities=(0.0, *(s[1] for s in states[:3])),
+            pose=(x, y, yaw),
+            velocity=(forward, ang[2]),
+            wheel_speed_cmd=self.wheel_out,
+            wheel_speed_opto=tuple(s[1] * WHEEL_RADIUS_M for s in states[3:]),
+            cliff=cliff,
+            sonar=self._read_sonar(),
+            imu_body=self._imu(-1, 'body'),
+            imu_head=self._imu(rb.HEAD, 'head'),
+        )
+
+    # -- cameras ----------------------------------------------------------------------------
+    def eye_pose(self, side):
+        """World (position, rotation) of an eye camera, side +1 left / -1 right."""
+        head_pos, head_rot = self.link_frame(rb.HEAD)
+        eye_pos, eye_rot = rb.eye_in_head(side)
+        return head_pos + head_rot @ eye_pos, head_rot @ eye_rot
+
+    # -- snapshots for the eye workers --------------------------------------------------------
+    def joint_angles(self):
+        joints = range(pb.getNumJoints(self.body_id, **self._kw()))
+        return [s[0] for s in pb.getJointStates(self.body_id, joints, **self._kw())]
+
+    def set_joint_angles(self, angles):
+        for joint, angle in enumerate(angles):
+            pb.resetJointState(self.body_id, joint, angle, **self._kw())

@@ -1,0 +1,210 @@
+"""The simulated world without ROS: one PyBullet client, its bodies, its robots, time.
+
+SimWorld is what the ROS node wraps and what tests drive directly: build a world
+from its description, step it, move things, read the ground truth, render any
+robot's eyes. Nothing here sleeps or looks at the wall clock.
+"""
+import math
+
+import pybullet as pb
+
+from miro_ball.miro.constants import PLATFORM_TICK_S
+from miro_ball.miro.interface import default_robot_name
+from miro_sim_bullet.physics.robot import MiroRobot
+from miro_sim_bullet.physics.sensors import GRAVITY
+from miro_sim_bullet.render.eye_workers import EyeWorkers
+from miro_sim_bullet.render.renderer import Renderer, view_matrix_from_pose
+from miro_sim_bullet.scene.world_file import BALL_NAME, MAX_ROBOTS, Shape, World, load_world
+
+# Collision groups: bit 0 for everything that is not a robot, one bit per robot, so each
+# robot's sensor rays see the world and the other robots but never itself.
+WORLD_GROUP = 1
+ALL_GROUPS = (1 << (MAX_ROBOTS + 1)) - 1
+
+
+def robot_group(index):
+    return 1 << (index + 1)
+
+
+class SimWorld:
+    """A world with its MiRos in it.
+
+    world: a World or a bundled name / file path. robot_name names the world's robot
+    when the file leaves it unnamed (default $MIRO_ROBOT_NAME or 'miro').
+    renderer: None (no cameras), 'auto', 'tiny' or 'egl'. eye_workers: with
+    TinyRenderer, render eyes in two helper processes.
+    """
+
+    def __init__(self, world='miro', physics_dt=0.001, renderer=None, log=print,
+                 eye_workers=False, robot_name=None):
+        self.description = world if isinstance(world, World) else load_world(world)
+        self.robot_name = robot_name or default_robot_name()
+        self.dt = physics_dt
+        self.ticks_per_platform_tick = max(1, round(PLATFORM_TICK_S / physics_dt))
+        self.client = pb.connect(pb.DIRECT)
+        # Before any body exists: the EGL plugin only sees bodies created after it.
+        self.renderer = None if renderer is None else Renderer(self.client, kind=renderer,
+                                                               log=log)
+        self._build()
+        self.eye_workers = None
+        if eye_workers and self.renderer is not None and self.renderer.kind == 'tiny':
+            self.eye_workers = EyeWorkers(self.description, physics_dt, self.robot_name)
+            log('eyes rendered in 2 worker processes')
+
+    # -- building -----------------------------------------------------------------------------
+    def _kw(self):
+        return {'physicsClientId': self.client}
+
+    def _build(self):
+        kw = self._kw()
+        pb.resetSimulation(**kw)
+        pb.setPhysicsEngineParameter(fixedTimeStep=self.dt, deterministicOverlappingPairs=1,
+                                     **kw)
+        pb.setGravity(0, 0, -GRAVITY, **kw)
+        self.step_index = 0
+        world = self.description
+        if world.ground_height is not None:
+            self._shape(Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
+                              size=(*world.ground_size, 0.1), colour=world.ground_colour))
+        self.objects = {}  # name -> body id of everything movable but the robots
+        for shape in world.shapes:
+            body = self._shape(shape)
+            if shape.mass > 0:
+                self.objects[shape.name] = body
+        self.ball_id = None
+        if world.ball is not None:
+            ball = world.ball
+            self.ball_id = self._shape(Shape(
+                kind='sphere', position=(*ball.position, ball.floor + ball.radius),
+                radius=ball.radius, colour=ball.colour, mass=ball.mass, friction=ball.friction,
+                restitution=ball.restitution))
+            self.objects[BALL_NAME] = self.ball_id
+        for body in range(pb.getNumBodies(**kw)):
+            pb.setCollisionFilterGroupMask(body, -1, WORLD_GROUP, ALL_GROUPS, **kw)
+        self.robots = {}
+        for index, spec in enumerate(world.robots):
+            name = spec.name or self.robot_name
+            robot = MiroRobot(self.client, name, spec, clock=lambda: self.time,
+                              ray_mask=ALL_GROUPS & ~robot_group(index))
+            robot.model.set_collision_filter(robot_group(index), ALL_GROUPS)
+            self.robots[name] = robot
+
+    def _shape(self, shape):
+        kw = self._kw()
+        if shape.kind == 'box':
+            dims = {'halfExtents': [s / 2 for s in shape.size]}
+            cdims = dims
+        elif shape.kind == 'cylinder':
+            dims = {'radius': shape.radius, 'length': shape.length}
+            cdims = {'radius': shape.radius, 'height': shape.length}
+        else:
+            dims = cdims = {'radius': shape.radius}
+        geom = {'box': pb.GEOM_BOX, 'cylinder': pb.GEOM_CYLINDER, 'sphere': pb.GEOM_SPHERE}
+        col = pb.createCollisionShape(geom[shape.kind], **cdims, **kw)
+        vis = pb.createVisualShape(geom[shape.kind], rgbaColor=(*shape.colour, 1), **dims, **kw)
+        body = pb.createMultiBody(shape.mass, col, vis, shape.position,
+                                  pb.getQuaternionFromEuler((0, 0, shape.yaw)), **kw)
+        pb.changeDynamics(body, -1, lateralFriction=shape.friction,
+                          restitution=shape.restitution, **kw)
+        return body
+
+    def reset(self):
+        """Back to the world's initial state (rebuilt from scratch: deterministic)."""
+        self._build()
+
+    def close(self):
+        if self.eye_workers is not None:
+            self.eye_workers.close()
+            self.eye_workers = None
+        if self.renderer is not None:
+            self.renderer.close()
+            self.renderer = None
+        if self.client is not None and pb.isConnected(self.client):
+            pb.disconnect(self.client)
+        self.client = None
+
+    # -- robots and objects ---------------------------------------------------------------------
+    @property
+    def robot(self):
+        """The first robot: the only one in a single-robot world."""
+        return next(iter(self.robots.values()))
+
+    def place_ball(self, x, y):
+        """Put the ball at rest on its floor at (x, y)."""
+        if self.ball_id is None:
+            return
+        ball = self.description.ball
+        self.set_object_pose(BALL_NAME, (x, y, ball.floor + ball.radius))
+
+    def set_object_pose(self, name, position, orientation=(0.0, 0.0, 0.0, 1.0)):
+        """Move a movable object (its centre) or a robot (the point on the floor under its
+        axle; only the heading of orientation counts) and stop it. KeyError if unknown."""
+        if name in self.robots:
+            x, y, z, w = orientation
+            yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+            self.robots[name].place(position[0], position[1], yaw, floor=position[2])
+            return
+        body = self.objects[name]
+        pb.resetBasePositionAndOrientation(body, position, orientation, **self._kw())
+        pb.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0), **self._kw())
+
+    def object_poses(self):
+        """{name: (position, orientation xyzw)} of every movable object."""
+        return {name: pb.getBasePositionAndOrientation(body, **self._kw())
+                for name, body in self.objects.items()}
+
+    def ball_position(self):
+        if self.ball_id is None:
+            return None
+        return pb.getBasePositionAndOrientation(self.ball_id, **self._kw())[0]
+
+    # -- time -----------------------------------------------------------------------------------
+    @property
+    def time(self):
+        return self.step_index * self.dt
+
+    def step(self, n=1):
+        """Advance n physics steps; every robot's platform ticks every 20 ms of them."""
+        kw = self._kw()
+        for _ in range(n):
+            pb.stepSimulation(**kw)
+            self.step_index += 1
+            if self.step_index % self.ticks_per_platform_tick == 0:
+                for robot in self.robots.values():
+                    robot.tick()
+
+    def run(self, seconds):
+        self.step(round(seconds / self.dt))
+
+    # -- images ---------------------------------------------------------------------------------
+    def render_eyes(self, requests, intrinsics):
+        """RGB images, one per (robot, side) in requests (side +1 left, -1 right), all of
+        this instant."""
+        views = [view_matrix_from_pose(*robot.eye_pose(side)) for robot, side in requests]
+        if self.eye_workers is None:
+            return [self.renderer.render(view, intrinsics) for view in views]
+        return self.eye_workers.render(self.snapshot(), views, intrinsics)
+
+    def render_view(self, position, rotation, intrinsics):
+        """RGB image from any camera pose (x forward, y left, z up)."""
+        return self.renderer.render(view_matrix_from_pose(position, rotation), intrinsics)
+
+    def snapshot(self):
+        """Poses of everything that moves and each robot's joints and LEDs: enough for an
+        identically built world to draw the same picture."""
+        kw = self._kw()
+        bodies = [(body, *pb.getBasePositionAndOrientation(body, **kw))
+                  for body in (*self.objects.values(),
+                               *(r.body_id for r in self.robots.values()))]
+        robots = [(robot.joint_angles(), list(robot.illum)) for robot in self.robots.values()]
+        return bodies, robots
+
+    def restore(self, snapshot):
+        """Pose this world as snapshot() of an identically built one describes."""
+        bodies, robots = snapshot
+        for body, position, orientation in bodies:
+            pb.resetBasePositionAndOrientation(body, position, orientation, **self._kw())
+        for robot, (angles, illum) in zip(self.robots.values(), robots):
+            robot.set_joint_angles(angles)
+            if illum != robot.illum:
+                robot.set_illum(illum)

@@ -1,0 +1,1 @@
+"""The simulator on ROS: message conversion, one interface per robot, the pacing node."""

@@ -1,0 +1,155 @@
+"""Simulator state to ROS messages and back: plain functions, no node needed."""
+import math
+
+import cv2
+import numpy as np
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import PointStamped, Pose2D, PoseStamped
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState, \
+    Range
+from std_msgs.msg import Float32MultiArray
+
+from miro_ball.miro.constants import JOINT_NAMES
+from miro_sim_bullet.physics import model as rb
+
+WORLD_FRAME = 'world'
+MAX_COORDINATE_M = 1000.0  # where set_pose may put things: far beyond any bundled world
+
+
+def stamp(seconds):
+    nanoseconds = int(round(seconds * 1e9))
+    return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+
+
+def clock(seconds):
+    return Clock(clock=stamp(seconds))
+
+
+def _yaw_quaternion(q, yaw):
+    q.z, q.w = math.sin(yaw / 2), math.cos(yaw / 2)
+    return q
+
+
+def kinematic_joints(s, when):
+    msg = JointState(name=list(JOINT_NAMES), position=list(s.kinematic_positions),
+                     velocity=list(s.kinematic_velocities))
+    msg.header.stamp = when
+    return msg
+
+
+def odometry(s, when):
+    """Ground truth as odometry: odom -> base_link, the pose of the FOOT frame."""
+    x, y, yaw = s.pose
+    forward, turn = s.velocity
+    msg = Odometry(child_frame_id='base_link')
+    msg.header.stamp, msg.header.frame_id = when, 'odom'
+    msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
+    _yaw_quaternion(msg.pose.pose.orientation, yaw)
+    msg.twist.twist.linear.x, msg.twist.twist.angular.z = forward, turn
+    return msg
+
+
+def body_pose(s):
+    x, y, yaw = s.pose
+    return Pose2D(x=x, y=y, theta=yaw)
+
+
+def floats(values):
+    return Float32MultiArray(data=[float(v) for v in values])
+
+
+def sonar(s, when):
+    lo, hi = rb.SONAR_RANGE
+    msg = Range(radiation_type=Range.ULTRASOUND, field_of_view=2 * rb.SONAR_HALF_CONE,
+                min_range=lo, max_range=hi, range=s.sonar)
+    msg.header.stamp, msg.header.frame_id = when, 'sonar'
+    return msg
+
+
+def imu(reading, when, frame_id):
+    orientation, angular, linear = reading
+    msg = Imu()
+    msg.header.stamp, msg.header.frame_id = when, frame_id
+    o, w, a = msg.orientation, msg.angular_velocity, msg.linear_acceleration
+    o.x, o.y, o.z, o.w = orientation
+    w.x, w.y, w.z = angular
+    a.x, a.y, a.z = linear
+    return msg
+
+
+def battery(s, when):
+    msg = BatteryState(voltage=s.battery_voltage, present=True, percentage=1.0)
+    msg.header.stamp = when
+    return msg
+
+
+def camera_info(intrinsics, when, frame_id):
+    k = intrinsics
+    msg = CameraInfo(width=k.width, height=k.height, distortion_model='plumb_bob',
+                     d=[0.0] * 5, k=[v for row in k.K() for v in row],
+                     r=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                     p=[v for row in k.P() for v in row])
+    msg.header.stamp, msg.header.frame_id = when, frame_id
+    return msg
+
+
+def jpeg(rgb, when, frame_id, quality):
+    ok, data = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR),
+                            [cv2.IMWRITE_JPEG_QUALITY, quality])
+    msg = CompressedImage(format='rgb8; jpeg compressed bgr8', data=data.tobytes())
+    msg.header.stamp, msg.header.frame_id = when, frame_id
+    return msg
+
+
+def raw_image(rgb, when, frame_id):
+    h, w = rgb.shape[:2]
+    msg = Image(height=h, width=w, encoding='rgb8', is_bigendian=0, step=3 * w,
+                data=rgb.tobytes())
+    msg.header.stamp, msg.header.frame_id = when, frame_id
+    return msg
+
+
+def point(position, when):
+    msg = PointStamped()
+    msg.header.stamp, msg.header.frame_id = when, WORLD_FRAME
+    msg.point.x, msg.point.y, msg.point.z = (float(v) for v in position)
+    return msg
+
+
+def pose(position, orientation, when):
+    msg = PoseStamped()
+    msg.header.stamp, msg.header.frame_id = when, WORLD_FRAME
+    p, o = msg.pose.position, msg.pose.orientation
+    p.x, p.y, p.z = (float(v) for v in position)
+    o.x, o.y, o.z, o.w = (float(v) for v in orientation)
+    return msg
+
+
+def robot_pose(x, y, z, yaw, when):
+    """A robot's ground truth: the point on its floor under the axle, heading only."""
+    return pose((x, y, z), (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)), when)
+
+
+def pose_request(msg):
+    """(name, position, orientation xyzw) asked for by a set_pose message, or ValueError.
+
+    The name is header.frame_id. An all-zero orientation (a message with only a
+    position filled in) means upright; any other is normalised.
+    """
+    name = msg.header.frame_id
+    p, o = msg.pose.position, msg.pose.orientation
+    position = (p.x, p.y, p.z)
+    orientation = np.array([o.x, o.y, o.z, o.w])
+    if not all(math.isfinite(v) and abs(v) <= MAX_COORDINATE_M for v in position):
+        raise ValueError(f'position must be finite and within {MAX_COORDINATE_M:g} m, '
+                         f'got {position}')
+    if not np.all(np.isfinite(orientation)):
+        raise ValueError(f'orientation must be finite, got {tuple(orientation)}')
+    norm = float(np.linalg.norm(orientation))
+    if norm == 0.0:
+        return name, position, (0.0, 0.0, 0.0, 1.0)
+    if norm < 1e-6 or norm > 1e6:
+        raise ValueError(f'orientation is no rotation (norm {norm:g})')
+    return name, position, tuple(float(v) for v in orientation / norm)

@@ -1,0 +1,155 @@
+"""MiRo's ROS interface for one robot of the simulated world, under /<name>/.
+
+It publishes the robot's 50 Hz sensors and its eyes, and turns control messages
+into platform commands after checking them: wrong lengths and non-finite values
+are ignored, finite values out of range are clamped, both with a rate-limited
+warning. The robot is looked up by name each time, so a world reset (which
+rebuilds every robot) needs nothing from here.
+"""
+import math
+
+from geometry_msgs.msg import Pose2D, Twist, TwistStamped
+from nav_msgs.msg import Odometry
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState, \
+    Range
+from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, UInt32MultiArray
+
+from miro_ball.miro.constants import JOINT_NAMES, UPSTREAM_FLAG_SIMULATOR
+from miro_ball.miro.interface import EYE_SIDE, EYES, RobotTopics
+from miro_ball.miro.kinematics import finite
+from miro_sim_bullet.ros import convert
+
+CAMERA_QOS = QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE)
+
+
+class RobotInterface:
+    """The topics of robot ``name`` of ``node.sim``; warnings go to ``node.warn``."""
+
+    def __init__(self, node, name):
+        self.node = node
+        self.name = name
+        self.topics = t = RobotTopics(name)
+
+        def pub(msg_type, topic, qos=10):
+            return node.create_publisher(msg_type, topic, qos)
+
+        self.pub_eyes = {eye: (pub(CompressedImage, t.eye_compressed(eye), CAMERA_QOS),
+                               pub(Image, t.eye_raw(eye), CAMERA_QOS),
+                               pub(CameraInfo, t.camera_info(eye), CAMERA_QOS))
+                         for eye in EYES}
+        self.pub_kin = pub(JointState, t.kinematic_joints)
+        self.pub_odom = pub(Odometry, t.odom)
+        self.pub_pose = pub(Pose2D, t.body_pose)
+        self.pub_vel = pub(Twist, t.body_vel)
+        self.pub_wheel_cmd = pub(Float32MultiArray, t.wheel_speed_cmd)
+        self.pub_wheel_opto = pub(Float32MultiArray, t.wheel_speed_opto)
+        self.pub_cliff = pub(Float32MultiArray, t.cliff)
+        self.pub_sonar = pub(Range, t.sonar)
+        self.pub_imu = {part: pub(Imu, t.imu(part)) for part in ('body', 'head')}
+        self.pub_battery = pub(BatteryState, t.battery)
+        self.pub_light = pub(Float32MultiArray, t.light)
+        self.pub_touch = [pub(UInt16, t.touch(part)) for part in ('head', 'body')]
+        self.pub_flags = pub(UInt32, t.sensor_flags)
+        self.subs = [node.create_subscription(msg_type, topic, callback, 10)
+                     for msg_type, topic, callback in (
+                         (TwistStamped, t.cmd_vel, self._on_cmd_vel),
+                         (JointState, t.kinematic_targets, self._on_kinematic),
+                         (Float32MultiArray, t.cosmetic_joints, self._on_cosmetic),
+                         (UInt32MultiArray, t.illum, self._on_illum),
+                         (UInt16MultiArray, t.tone, self._on_tone),
+                         (UInt32, t.control_flags, self._on_flags))]
+
+    @property
+    def robot(self):
+        return self.node.sim.robots[self.name]
+
+    def _warn(self, kind, message):
+        self.node.warn(f'{self.name}:{kind}', message)
+
+    # -- control topics -----------------------------------------------------------------------
+    def _on_cmd_vel(self, msg):
+        linear, angular = msg.twist.linear.x, msg.twist.angular.z
+        if not finite(linear, angular):
+            self._warn('cmd_vel', f'{self.topics.cmd_vel} ignored: non-finite '
+                       f'({linear}, {angular})')
+            return
+        if self.robot.set_cmd_vel(linear, angular):
+            self._warn('cmd_vel_clamp', f'{self.topics.cmd_vel} ({linear:g} m/s, '
+                       f'{angular:g} rad/s) asks more than 0.4 m/s of a wheel: clamped')
+
+    def _on_kinematic(self, msg):
+        positions = list(msg.position)
+        if len(positions) != 4 or not finite(*positions):
+            self._warn('kin', f'{self.topics.kinematic_targets} ignored: need 4 finite '
+                       f'positions [tilt, lift, yaw, pitch], got {positions[:8]}')
+            return
+        applied = self.robot.set_kinematic_targets(positions)
+        if any(abs(a - b) > 1e-9 for a, b in zip(applied[1:], positions[1:])):
+            self._warn('kin_clamp', f"{self.topics.kinematic_targets} clamped to MiRo's "
+                       'ranges: ' + ', '.join(f'{n} {math.degrees(a):.1f} deg' for n, a in
+                                              zip(JOINT_NAMES[1:], applied[1:])))
+
+    def _on_cosmetic(self, msg):
+        values = list(msg.data)
+        if len(values) != 6 or not finite(*values):
+            self._warn('cos', f'{self.topics.cosmetic_joints} ignored: need 6 finite values, '
+                       f'got {values[:8]}')
+            return
+        if any(not 0.0 <= v <= 1.0 for v in values):
+            self._warn('cos_clamp', f'{self.topics.cosmetic_joints} clamped to 0..1')
+        self.robot.set_cosmetic(values)
+
+    def _on_illum(self, msg):
+        if len(msg.data) != 6:
+            self._warn('illum', f'{self.topics.illum} ignored: need 6 ARGB values, got '
+                       f'{len(msg.data)}')
+            return
+        self.robot.set_illum(msg.data)
+
+    def _on_tone(self, msg):
+        if len(msg.data) != 3:
+            self._warn('tone', f'{self.topics.tone} ignored: need 3 values, got '
+                       f'{len(msg.data)}')
+            return
+        frequency, volume, ticks = msg.data
+        self._warn('tone_play', f'{self.name}: tone {frequency} Hz, volume {volume}, '
+                   f'{ticks} ticks (not audible in simulation)')
+
+    def _on_flags(self, msg):
+        self.robot.flags = msg.data
+
+    # -- publishing ---------------------------------------------------------------------------
+    def publish_tick(self, when):
+        """This platform tick's sensor readings, stamped ``when``."""
+        s = self.robot.sensors
+        odom = convert.odometry(s, when)
+        self.pub_kin.publish(convert.kinematic_joints(s, when))
+        self.pub_odom.publish(odom)
+        self.pub_pose.publish(convert.body_pose(s))
+        self.pub_vel.publish(odom.twist.twist)
+        self.pub_wheel_cmd.publish(convert.floats(s.wheel_speed_cmd))
+        self.pub_wheel_opto.publish(convert.floats(s.wheel_speed_opto))
+        self.pub_cliff.publish(convert.floats(s.cliff))
+        self.pub_sonar.publish(convert.sonar(s, when))
+        for part, reading in (('body', s.imu_body), ('head', s.imu_head)):
+            self.pub_imu[part].publish(convert.imu(reading, when, f'imu_{part}'))
+        self.pub_battery.publish(convert.battery(s, when))
+        self.pub_light.publish(convert.floats(s.light))
+        for pub in self.pub_touch:
+            pub.publish(UInt16(data=0))
+        self.pub_flags.publish(UInt32(data=UPSTREAM_FLAG_SIMULATOR))
+
+    def wanted_eyes(self):
+        """[(eye, side)] of the eyes someone subscribes to: only those are rendered."""
+        return [(eye, EYE_SIDE[eye]) for eye in EYES
+                if any(p.get_subscription_count() for p in self.pub_eyes[eye])]
+
+    def publish_eye(self, eye, rgb, when, intrinsics, jpeg_quality):
+        compressed, raw, info = self.pub_eyes[eye]
+        frame_id = f'{eye}_optical_frame'
+        if compressed.get_subscription_count():
+            compressed.publish(convert.jpeg(rgb, when, frame_id, jpeg_quality))
+        if raw.get_subscription_count():
+            raw.publish(convert.raw_image(rgb, when, frame_id))
+        info.publish(convert.camera_info(intrinsics, when, frame_id))

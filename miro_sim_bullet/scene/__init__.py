@@ -1,0 +1,1 @@
+"""World descriptions: the TOML files and what they contain (no PyBullet)."""
