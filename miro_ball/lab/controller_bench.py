@@ -17,8 +17,10 @@ import numpy as np
 from miro_ball.miro.constants import FRAME_SIZES
 from miro_ball.controller.detection import BallDetector
 from miro_ball.common.isolation import limit_discovery, private_domain
+from miro_ball.miro.interface import RobotTopics
 from miro_ball.lab.synthetic import Disc, jpeg, render
 
+BENCH_ROBOT = 'miro_bench'  # a name no real simulator or robot answers to
 POOL = 16  # distinct frames per case; rendering is slower than detecting
 
 
@@ -81,12 +83,13 @@ def bench_latency(count):
     context = Context()
     rclpy.init(context=context, domain_id=private_domain(salt=75))
     node = KickBlueBall(context=context, parameter_overrides=[
-        Parameter('robot_name', value='miro_bench'), Parameter('head_hold_s', value=0.0)])
+        Parameter('robot_name', value=BENCH_ROBOT), Parameter('head_hold_s', value=0.0)])
     probe = rclpy.create_node('bench_probe', context=context)
     twists = []
-    probe.create_subscription(TwistStamped, '/miro_bench/control/cmd_vel',
+    topics = RobotTopics(BENCH_ROBOT)
+    probe.create_subscription(TwistStamped, topics.cmd_vel,
                               lambda msg: twists.append(time.perf_counter()), 10)
-    pub = probe.create_publisher(CompressedImage, '/miro_bench/sensors/caml/compressed', 2)
+    pub = probe.create_publisher(CompressedImage, topics.eye_compressed('caml'), 2)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     executor.add_node(probe)

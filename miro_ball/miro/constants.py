@@ -40,7 +40,3 @@ CLIFF_THRESHOLD = 0.7
 UPSTREAM_FLAG_SIMULATOR = 1 << 15
 DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX = 1 << 21
 
-
-def topic(robot_name: str, name: str) -> str:
-    """Absolute MiRo topic, e.g. topic('miro', 'sensors/caml') -> '/miro/sensors/caml'."""
-    return '/' + robot_name.strip('/') + '/' + name
