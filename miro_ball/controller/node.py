@@ -10,7 +10,6 @@ right whatever field of view the camera has.
 import argparse
 import math
 import os
-import signal
 import sys
 from collections import Counter
 from functools import partial
@@ -21,7 +20,7 @@ import rclpy
 from geometry_msgs.msg import TwistStamped
 from rclpy.clock import JumpThreshold
 from rclpy.duration import Duration
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
@@ -30,6 +29,7 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
 from std_msgs.msg import Float32MultiArray
 
 from miro_ball.common import params
+from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERAS, make_behaviour
 from miro_ball.controller.detection import annotate, BallDetector, DetectionParams
@@ -352,22 +352,17 @@ def main(argv=None):
     # wake-up jitter on a small machine shared with the simulator.
     cv2.setNumThreads(1)
     # Our own SIGINT/SIGTERM handling, so the context is still up to send the zero twist.
-    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    stop = StopRequest()
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
         node = KickBlueBall(save_debug=options.save_debug)
-    except KeyboardInterrupt:
-        rclpy.try_shutdown()
-        return 130
     except Exception as err:  # a bad parameter or topic name: say so in one line
         rclpy.try_shutdown()
         _fail(parser, err)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
     try:
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        spin_until_stopped(executor, stop)
     finally:
         if rclpy.ok():
             node.stop()

@@ -8,14 +8,13 @@ set_pose requests. Either a steady wall-clock timer advances the world
 the ~/step service or in-process code calls advance().
 """
 import argparse
-import signal
 import sys
 import time
 
 import rclpy
 from geometry_msgs.msg import PointStamped, PoseStamped
 from rclpy.clock import Clock, ClockType
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
@@ -24,6 +23,7 @@ from sensor_msgs.msg import CompressedImage
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.common.params import declare, help_lines
+from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera import Intrinsics
 from miro_ball.miro.interface import CLOCK, SIM_NODE_NAME, SimTopics
@@ -227,18 +227,18 @@ def main(argv=None):
         sys.exit(f'miro_sim: error: {err}')
     args = parse_args(cli_args)
     overrides = [] if args.world is None else [Parameter('world', value=args.world)]
-    # Ctrl+C and SIGTERM end the spin as KeyboardInterrupt, with the context still up.
-    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    # Ctrl+C and SIGTERM end the spin with the context still up (see stopping.py).
+    stop = StopRequest()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     try:
         node = SimNode(parameter_overrides=overrides)
-        rclpy.spin(node)
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        spin_until_stopped(executor, stop)
     except (WorldError, RendererUnavailable, ValueError) as err:
         print(f'miro_sim: error: {err}', file=sys.stderr)
         sys.exit(2)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
     finally:
         if node is not None:
             node.destroy_node()
