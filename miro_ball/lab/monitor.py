@@ -73,7 +73,7 @@ class Monitor:
         self.ball_start = self.ball_start or self.ball
         if not self.kicked and self.moved >= KICK_DISTANCE_M:
             self.kick_time = self.sim_time
-            self.kicker = self._nearest_robot(self.ball_start)
+            self.kicker = self._nearest_robot(self.ball)
 
     def _nearest_robot(self, point):
         placed = [(ball_moved(point, w.position), name)

@@ -3,9 +3,11 @@
 Success = the ball moved >= 0.3 m within the limit (60 s simulated) and the
 robot never fell. Writes BENCHMARKS.md with the table and the machine it ran
 on. Each placement and its controller seed are fixed by --seed, and episodes
-run in simulated time, so a rerun plays the same placements.
+run in simulated time, so a rerun plays the same placements, whatever --jobs.
+Episodes run in --jobs worker processes, each on a ROS domain of its own.
 """
 import argparse
+import multiprocessing
 import os
 import platform
 import statistics
@@ -38,34 +40,60 @@ def machine():
             f'Python {platform.python_version()}')
 
 
-def run(args):
+def _worker_init(domains, limit):
+    """Each worker takes a ROS domain of its own from the queue; the nodes' progress lines
+    would drown the benchmark's own."""
+    global _DOMAIN, _LIMIT
+    from rclpy.logging import LoggingSeverity, set_logger_level
+
+    from miro_ball.miro.interface import CONTROLLER_NODE_NAME, SIM_NODE_NAME
+
+    limit_discovery()
+    _DOMAIN, _LIMIT = domains.get(), limit
+    for name in (CONTROLLER_NODE_NAME, SIM_NODE_NAME):
+        set_logger_level(name, LoggingSeverity.WARN)
+
+
+def _episode(job):
+    """Runs in a worker: one episode in a fresh context; returns (job, Outcome)."""
     import rclpy
     from rclpy.context import Context
 
-    from miro_ball.lab.scenarios import placements, run_episode
+    from miro_ball.lab.scenarios import run_episode
 
-    results = {mode: [] for mode in args.modes}
-    chosen = placements(args.count, seed=args.seed)
-    for mode in args.modes:
-        for index, placement in enumerate(chosen):
-            context = Context()
-            rclpy.init(context=context, domain_id=args.domain)
-            try:
-                outcome = run_episode(context, placement, mode=mode, limit_s=args.limit,
-                                      renderer=args.renderer, seed=args.seed + index)
-            finally:
-                rclpy.try_shutdown(context=context)
-            results[mode].append(outcome)
+    mode, index, placement, seed, renderer = job
+    context = Context()
+    rclpy.init(context=context, domain_id=_DOMAIN)
+    try:
+        return job, run_episode(context, placement, mode=mode, limit_s=_LIMIT,
+                                renderer=renderer, seed=seed)
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
+def run(modes, chosen, seed, limit, renderer, jobs, report=print):
+    """{mode: [Outcome per placement]}, episodes spread over ``jobs`` processes."""
+    work = [(mode, index, placement, seed + index, renderer)
+            for mode in modes for index, placement in enumerate(chosen)]
+    context = multiprocessing.get_context('spawn')  # no fork of DDS threads
+    domains = context.Queue()
+    base = private_domain(salt=25)
+    for k in range(jobs):
+        domains.put(1 + (base + k) % 100)
+    results = {mode: [None] * len(chosen) for mode in modes}
+    with context.Pool(jobs, initializer=_worker_init, initargs=(domains, limit)) as pool:
+        for (mode, index, _, _, _), outcome in pool.imap_unordered(_episode, work):
+            results[mode][index] = outcome
             mark = 'kick' if outcome.success else ('FELL' if outcome.fell else 'miss')
             kicked = f'{outcome.time_to_kick:5.1f} s' if outcome.kicked else '   -   '
-            print(f'  {mode:<8} {index + 1:>3}/{len(chosen)}  {mark}  {kicked}  '
-                  f'(RTF {outcome.sim_time / outcome.wall_time:.2f})', flush=True)
+            report(f'  {mode:<8} {index + 1:>3}/{len(chosen)}  {mark}  {kicked}  '
+                   f'(RTF {outcome.sim_time / outcome.wall_time:.2f})')
     return results
 
 
-def table(results, count, limit):
+def table(results, count):
     lines = ['| mode | success | median time to kick | p90 time to kick | fell off | '
-             'real-time factor |', '|---|---|---|---|---|---|']
+             'real-time factor per episode |', '|---|---|---|---|---|---|']
     for mode, outcomes in results.items():
         times = [o.time_to_kick for o in outcomes if o.success]
         wins = sum(o.success for o in outcomes)
@@ -89,26 +117,30 @@ def main(argv=None):
     parser.add_argument('--limit', type=float, default=60.0, help='simulated s per try (60)')
     parser.add_argument('--modes', nargs='+', choices=MODES, default=list(MODES))
     parser.add_argument('--renderer', choices=('auto', 'tiny', 'egl'), default='auto')
+    parser.add_argument('--jobs', type=int, default=os.cpu_count() or 1,
+                        help='worker processes (default: the number of cores)')
     parser.add_argument('--output', default='BENCHMARKS.md', help='report file (BENCHMARKS.md)')
     args = parser.parse_args(argv)
-    if args.count < 1 or not args.limit > 0:
-        parser.error('--count must be >= 1 and --limit > 0')
-    limit_discovery()
-    args.domain = private_domain(salt=25)
+    if not 1 <= args.count <= 10000 or not 0 < args.limit <= 3600 or not 1 <= args.jobs <= 64:
+        parser.error('--count must be in 1..10000, --limit in (0, 3600] and --jobs in 1..64')
+    from miro_ball.lab.scenarios import placements
+
     print(f'scenario benchmark: {args.count} placements (seed {args.seed}), modes '
-          f'{", ".join(args.modes)}, limit {args.limit:g} s simulated', flush=True)
+          f'{", ".join(args.modes)}, limit {args.limit:g} s simulated, {args.jobs} jobs',
+          flush=True)
     started = time.monotonic()
-    results = run(args)
-    report = table(results, args.count, args.limit)
-    print('\n' + report)
+    results = run(args.modes, placements(args.count, seed=args.seed), args.seed, args.limit,
+                  args.renderer, args.jobs, report=lambda line: print(line, flush=True))
+    wall = (time.monotonic() - started) / 60
+    report = table(results, args.count)
+    print('\n' + report + f'\n\nwall time {wall:.1f} min')
     Path(args.output).write_text(
         '# Scenario benchmark\n\n'
-        f'`python -m miro_ball.lab.scenario_bench --count {args.count} --seed {args.seed}` '
-        f'({args.count} seeded placements of robot and ball in the default arena; success = '
-        f'ball moved >= 0.3 m within {args.limit:g} s of simulated time and the robot never '
-        f'fell; times are simulated seconds from the start of the episode).\n\n'
-        f'{report}\n\nMachine: {machine()}. Wall time of the whole run: '
-        f'{(time.monotonic() - started) / 60:.1f} min.\n')
+        f'`python -m miro_ball.lab.scenario_bench --count {args.count} --seed {args.seed} '
+        f'--jobs {args.jobs}` ({args.count} seeded placements of robot and ball in the default '
+        f'arena; success = ball moved >= 0.3 m within {args.limit:g} s of simulated time and '
+        f'the robot never fell; times are simulated seconds from the start of the episode).'
+        f'\n\n{report}\n\nMachine: {machine()}. Wall time of the whole run: {wall:.1f} min.\n')
     print(f'\nwritten to {args.output}')
 
 

@@ -16,14 +16,18 @@ from miro_sim_bullet.render.eye_workers import EyeWorkers
 from miro_sim_bullet.render.renderer import Renderer, view_matrix_from_pose
 from miro_sim_bullet.scene.world_file import BALL_NAME, MAX_ROBOTS, Shape, World, load_world
 
-# Collision groups: bit 0 for everything that is not a robot, one bit per robot, so each
-# robot's sensor rays see the world and the other robots but never itself.
-WORLD_GROUP = 1
-ALL_GROUPS = (1 << (MAX_ROBOTS + 1)) - 1
+# Collision groups. Bit 0 stays in every mask because Bullet's ray tests carry group 1.
+# Static bodies skip each other (a wall panel touching the floor is work for nothing);
+# movable objects and robots meet everything. Each robot has a bit of its own, so its
+# sensor rays see the world and the other robots but never itself.
+RAY_GROUP = 1
+STATIC_GROUP = 1 << 1
+MOVABLE_GROUP = 1 << 2
+ALL_GROUPS = (1 << (MAX_ROBOTS + 3)) - 1
 
 
 def robot_group(index):
-    return 1 << (index + 1)
+    return 1 << (index + 3)
 
 
 class SimWorld:
@@ -79,8 +83,13 @@ class SimWorld:
                 radius=ball.radius, colour=ball.colour, mass=ball.mass, friction=ball.friction,
                 restitution=ball.restitution))
             self.objects[BALL_NAME] = self.ball_id
+        movable = set(self.objects.values())
         for body in range(pb.getNumBodies(**kw)):
-            pb.setCollisionFilterGroupMask(body, -1, WORLD_GROUP, ALL_GROUPS, **kw)
+            if body in movable:
+                pb.setCollisionFilterGroupMask(body, -1, MOVABLE_GROUP, ALL_GROUPS, **kw)
+            else:
+                pb.setCollisionFilterGroupMask(body, -1, STATIC_GROUP,
+                                               ALL_GROUPS & ~STATIC_GROUP, **kw)
         self.robots = {}
         for index, spec in enumerate(world.robots):
             name = spec.name or self.robot_name
