@@ -19,7 +19,7 @@ from std_msgs.msg import Float32MultiArray
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
 from miro_ball.controller.node import build_parser, KickBlueBall, main
 from miro_ball.controller.params import ControllerParams
-from miro_ball.lab.synthetic import Disc, jpeg, render
+from miro_ball.lab.synthetic import decompression_bomb, Disc, jpeg, render
 from miro_ball.miro.camera import Intrinsics
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
 from miro_ball.miro.interface import CLOCK, default_robot_name, EYES, RobotTopics
@@ -257,11 +257,11 @@ def test_survives_bad_inputs(make_rig):
     rig.advance(0.2)
     good = ball_frame(AHEAD[0])
     small = jpeg(render(100, 80, [Disc(50, 40, 10)]))
-    for data in (b'', b'\x00garbage' * 10, good[:len(good) // 2], small):
+    for data in (b'', b'\x00garbage' * 10, good[:len(good) // 2], decompression_bomb(), small):
         rig.image(0, data)
     for values in ([1.0], [1.0, 1.0, 1.0], [float('nan'), 1.0], [1.0, 7.5]):
         rig.cliff(values)
-    assert rig.node.rejected == {'empty': 1, 'corrupt': 2, 'size': 1, 'cliff': 4}
+    assert rig.node.rejected == {'empty': 1, 'corrupt': 3, 'size': 1, 'cliff': 4}
     assert rig.node.frames_processed == 0 and rig.node.cliff.value is None
     # Still alive, still driving, and still taking good input.
     count = len(rig.twists)

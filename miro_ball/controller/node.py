@@ -15,7 +15,6 @@ from collections import Counter
 from functools import partial
 
 import cv2
-import numpy as np
 import rclpy
 from geometry_msgs.msg import TwistStamped
 from rclpy.clock import JumpThreshold
@@ -29,6 +28,7 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
 from std_msgs.msg import Float32MultiArray
 
 from miro_ball.common import params
+from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERAS, make_behaviour
@@ -44,6 +44,7 @@ NODE_NAME = CONTROLLER_NODE_NAME
 SIDES = ('left', 'right')  # of EYES, in order
 STARTUP = 'startup'
 WARN_EVERY_S = 5.0
+MAX_FRAME_SIDE = max(max(size) for size in FRAME_SIZES)
 
 # Newest frame only: a late frame is worth less than none (like queue_size=1).
 # Best effort matches both reliable and best-effort publishers.
@@ -170,12 +171,11 @@ class KickBlueBall(Node):
         if len(msg.data) == 0:
             return self._reject('empty', '%s: empty image message' % cam)
         try:
-            frame = cv2.imdecode(np.frombuffer(msg.data, np.uint8), cv2.IMREAD_COLOR)
-        except cv2.error:
-            frame = None
-        if frame is None:
-            return self._reject('corrupt', '%s: undecodable image (%d bytes, format %r)'
-                                % (cam, len(msg.data), msg.format))
+            # No frame larger than MiRo's largest is decoded (a decompression bomb costs nothing).
+            frame = decode_jpeg(msg.data, max_side=MAX_FRAME_SIDE)
+        except (ImageRejected, cv2.error) as err:
+            return self._reject('corrupt', '%s: unusable image (%d bytes, format %r): %s'
+                                % (cam, len(msg.data), msg.format, err))
         height, width = frame.shape[:2]
         if (width, height) not in FRAME_SIZES:
             return self._reject('size', '%s: frame %dx%d is not a MiRo frame size (%s)' % (

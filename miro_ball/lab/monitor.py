@@ -4,17 +4,18 @@ It only subscribes (to /clock, the simulator's ground truth and the controllers'
 annotated frames), so it can watch any run: the demo's, a grader's, a user's.
 Image callbacks are optional; they get each frame decoded to BGR.
 """
-import cv2
-import numpy as np
-
+from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.lab.judge import FELL_BELOW_M, KICK_DISTANCE_M, ball_moved
 from miro_ball.miro.constants import WHEEL_RADIUS_M
 from miro_ball.miro.interface import CLOCK, EYES, RobotTopics, SimTopics
 
 
 def decode(msg):
-    """BGR image of a CompressedImage, or None if it does not decode."""
-    return cv2.imdecode(np.frombuffer(bytes(msg.data), np.uint8), cv2.IMREAD_COLOR)
+    """BGR image of a CompressedImage, or None if it is not a sane JPEG."""
+    try:
+        return decode_jpeg(msg.data)
+    except ImageRejected:
+        return None
 
 
 class RobotWatch:

@@ -77,3 +77,11 @@ def jpeg(image, quality=90):
     if not ok:
         raise ValueError('JPEG encoding failed')
     return buf.tobytes()
+
+
+def decompression_bomb(width=20000, height=20000):
+    """A tiny JPEG whose frame header claims width x height pixels (hostile input)."""
+    data = bytearray(jpeg(np.zeros((8, 8, 3), np.uint8)))
+    at = data.index(b'\xff\xc0')  # OpenCV writes baseline frames
+    data[at + 5:at + 9] = height.to_bytes(2, 'big') + width.to_bytes(2, 'big')
+    return bytes(data)
