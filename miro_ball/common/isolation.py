@@ -10,6 +10,12 @@ def private_domain(salt=0):
     return 1 + (os.getpid() + salt) % 100
 
 
+def private_domains(count, salt=0):
+    """count distinct ROS domain ids, one per worker of a run (count <= 100)."""
+    base = private_domain(salt)
+    return [1 + (base + k) % 100 for k in range(count)]
+
+
 def limit_discovery():
     """Keep this process's discovery on this host (unless the user chose otherwise)."""
     for name, value in DISCOVERY.items():

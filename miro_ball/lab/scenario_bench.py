@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-from miro_ball.common.isolation import limit_discovery, private_domain
+from miro_ball.common.isolation import limit_discovery, private_domains
 
 MODES = ('improved', 'tutorial')
 
@@ -77,9 +77,8 @@ def run(modes, chosen, seed, limit, renderer, jobs, report=print):
             for mode in modes for index, placement in enumerate(chosen)]
     context = multiprocessing.get_context('spawn')  # no fork of DDS threads
     domains = context.Queue()
-    base = private_domain(salt=25)
-    for k in range(jobs):
-        domains.put(1 + (base + k) % 100)
+    for domain in private_domains(jobs, salt=25):
+        domains.put(domain)
     results = {mode: [None] * len(chosen) for mode in modes}
     with context.Pool(jobs, initializer=_worker_init, initargs=(domains, limit)) as pool:
         for (mode, index, _, _, _), outcome in pool.imap_unordered(_episode, work):
