@@ -26,12 +26,15 @@ class RobotWatch:
         self.start_z = None  # floor height when first seen
         self.position = None  # x, y, z of the point under its axle
         self.fell = False
+        self.distance = 0.0  # m driven over the floor since the start
 
 
 class Monitor:
     """Subscribes on ``node`` (which should use sim time) for the given robot names."""
 
-    def __init__(self, node, robots, on_eye=None, on_overhead=None, qos=10):
+    def __init__(self, node, robots, on_eye=None, on_overhead=None, qos=10, debug_frames=True):
+        """debug_frames=False: leave the controllers' annotated frames alone (a controller
+        draws them only while someone subscribes)."""
         from geometry_msgs.msg import PointStamped, PoseStamped
         from rosgraph_msgs.msg import Clock
         from sensor_msgs.msg import CompressedImage
@@ -48,7 +51,7 @@ class Monitor:
         for index, name in enumerate(robots):
             node.create_subscription(PoseStamped, sim.object_pose(name),
                                      lambda msg, n=name: self._on_robot(n, msg), qos)
-            for side, eye in enumerate(EYES):
+            for side, eye in enumerate(EYES if debug_frames else ()):
                 node.create_subscription(
                     CompressedImage, RobotTopics(name).controller_debug(eye),
                     lambda msg, n=name, i=index, s=side: self._on_debug(n, i, s, msg, on_eye),
@@ -56,6 +59,12 @@ class Monitor:
         if on_overhead is not None:
             node.create_subscription(CompressedImage, sim.overhead,
                                      lambda msg: self._on_image(msg, on_overhead), 5)
+
+    def restart(self):
+        """Judge from here on: the ball's and the robots' next positions are the start."""
+        self.ball_start = self.ball = self.kick_time = self.kicker = None
+        for watch in self.robots.values():
+            watch.start_z, watch.fell, watch.distance = None, False, 0.0
 
     @property
     def kicked(self):
@@ -84,6 +93,8 @@ class Monitor:
     def _on_robot(self, name, msg):
         watch = self.robots[name]
         p = msg.pose.position
+        if watch.position is not None and watch.start_z is not None:
+            watch.distance += ball_moved(watch.position, (p.x, p.y))
         watch.position = (p.x, p.y, p.z)
         if watch.start_z is None:
             watch.start_z = p.z
