@@ -17,7 +17,7 @@ from functools import partial
 import cv2
 import rclpy
 from geometry_msgs.msg import TwistStamped
-from rclpy.clock import JumpThreshold
+from rclpy.clock import Clock, ClockType, JumpThreshold
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -44,6 +44,7 @@ NODE_NAME = CONTROLLER_NODE_NAME
 SIDES = ('left', 'right')  # of EYES, in order
 STARTUP = 'startup'
 WARN_EVERY_S = 5.0
+NO_CLOCK_NOTICE_S = 5.0  # wall seconds
 MAX_FRAME_SIDE = max(max(size) for size in FRAME_SIZES)
 
 # Newest frame only: a late frame is worth less than none (like queue_size=1).
@@ -144,6 +145,17 @@ class KickBlueBall(Node):
             post_callback=lambda jump: self.timer.reset())
         self.get_logger().info("mode '%s', robot '%s', tick %g s"
                                % (self.config.mode, names.name, self.config.tick))
+        # On sim time nothing ticks until /clock arrives: say once what we wait for.
+        self._no_clock_timer = self.create_timer(
+            NO_CLOCK_NOTICE_S, self._on_no_clock, clock=Clock(clock_type=ClockType.STEADY_TIME))
+
+    def _on_no_clock(self):
+        self._no_clock_timer.cancel()
+        if self._last_tick is None:
+            self.get_logger().warning(
+                'no control tick after %g s: waiting for %s on ROS domain %d (is the simulator '
+                'running, with the same ROS_DOMAIN_ID?)' % (
+                    NO_CLOCK_NOTICE_S, CLOCK, self.context.get_domain_id()))
 
     def _restart(self):
         """Start afresh: new behaviour, head hold, no percepts (also after time went back)."""

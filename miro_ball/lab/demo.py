@@ -17,6 +17,7 @@ import cv2
 import numpy as np
 
 from miro_ball.common.isolation import isolated_env, private_domain
+from miro_ball.common.stopping import StopRequest
 from miro_ball.miro.interface import default_robot_name
 
 VIDEO_FPS = 10.0  # frames per simulated second in the video (= overhead rate)
@@ -124,7 +125,7 @@ class Video:
             self.writer.release()
 
 
-def watch(args, robots, procs, domain_id):
+def watch(args, robots, procs, domain_id, stop):
     """Follow the run over ROS until the ball is kicked, the limit passes or a node dies."""
     import rclpy
     from rclpy.context import Context
@@ -152,7 +153,7 @@ def watch(args, robots, procs, domain_id):
     wall_start, last_report, first_clock = time.monotonic(), 0.0, None
     outcome = 'limit'
     try:
-        while True:
+        while not stop.requested:
             executor.spin_once(timeout_sec=0.05)
             now = time.monotonic()
             if first_clock is None and monitor.sim_time > 0:
@@ -173,8 +174,8 @@ def watch(args, robots, procs, domain_id):
                 frames = sum(w.frames for w in monitor.robots.values())
                 print(f'  t = {monitor.sim_time:5.1f} s simulated, ball moved '
                       f'{monitor.moved:4.2f} m, {frames} frames processed', flush=True)
-    except KeyboardInterrupt:
-        outcome = 'interrupted'
+        else:
+            outcome = 'interrupted'
     finally:
         if video:
             video.close()
@@ -200,7 +201,7 @@ def summary(outcome, monitor, rtf, video, killed):
     if video and video.frames:
         lines.append(f'  video:                {video.path} ({video.frames} frames)')
     if killed:
-        lines.append(f'  killed after Ctrl+C:  {", ".join(killed)}')
+        lines.append(f'  FAILED to stop:       {", ".join(killed)} (killed after Ctrl+C)')
     return '\n'.join(lines)
 
 
@@ -239,14 +240,16 @@ def main(argv=None):
     print(f'miro_ball demo: mode {args.mode}, world {args.world}, robots {", ".join(robots)}, '
           f'limit {args.limit:g} s simulated, ROS domain {domain_id}; logs in {out}/',
           flush=True)
+    stop = StopRequest()  # Ctrl+C ends the run with a summary, and stops the nodes
     procs = Processes(node_commands(args, robots), isolated_env(domain_id), out)
     killed = []
     try:
-        outcome, monitor, rtf, video = watch(args, robots, procs, domain_id)
+        outcome, monitor, rtf, video = watch(args, robots, procs, domain_id, stop)
     finally:
         killed = procs.stop()
     print(summary(outcome, monitor, rtf, video, killed))
-    sys.exit(0 if monitor.kicked else 1)
+    # A node that had to be killed did not stop as it should: that is a failure too.
+    sys.exit(0 if monitor.kicked and not killed else 1)
 
 
 if __name__ == '__main__':
