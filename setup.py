@@ -23,6 +23,8 @@ setup(
         'numpy',
         'opencv-python-headless',
         'pybullet',
+        'rosbags',  # rosbag2 (MCAP) recording without a ROS install
+        'ruamel.yaml',  # rosbag2 metadata (rosbags uses it too)
     ],
     extras_require={
         # Left out for users whose ROS 2 Jazzy is installed and sourced.
@@ -39,6 +41,7 @@ setup(
             'miro_sim = miro_sim_bullet.ros.node:main',
             'kick_blue_ball = miro_ball.controller.node:main',
             'ball_mover = miro_ball.examples.ball_mover:main',
+            'record = miro_ball.record:main',
         ],
     },
 )

@@ -18,7 +18,7 @@ import numpy as np
 
 from miro_ball.common.isolation import isolated_env, private_domain
 from miro_ball.common.stopping import StopRequest
-from miro_ball.miro.interface import default_robot_name
+from miro_ball.miro.interface import EYES, RobotTopics, default_robot_name
 
 VIDEO_FPS = 10.0  # frames per simulated second in the video (= overhead rate)
 VIDEO_HEIGHT = 540
@@ -69,7 +69,8 @@ def robot_names(world):
 
 
 def node_commands(args, robots):
-    """(log name, command) of every node: controllers first, then the simulator."""
+    """(log name, command) of every node: controllers first, then the simulator (and the
+    recorder)."""
     controllers = [
         (f'{CONTROLLER}_{name}',
          [sys.executable, '-m', 'miro_ball', '--ros-args', '-p', 'use_sim_time:=true',
@@ -80,7 +81,18 @@ def node_commands(args, robots):
            '-p', f'world:={args.world}', '-p', f'renderer:={args.renderer}',
            '-p', f'real_time_factor:={args.real_time_factor}',
            '-p', f'overhead_rate:={VIDEO_FPS if args.video else 0.0}']
-    return controllers + [('miro_sim', sim)]
+    return controllers + [('miro_sim', sim)] + recorder_command(args, robots)
+
+
+def recorder_command(args, robots):
+    """The recorder, last so it stops last: every topic but the raw eye images (20 MB/s a
+    robot, the same frames as the JPEGs, and published only while someone subscribes)."""
+    if not args.record:
+        return []
+    raw_eyes = [arg for name in robots for eye in EYES
+                for arg in ('-x', RobotTopics(name).eye_raw(eye))]
+    return [('record', [sys.executable, '-m', 'miro_ball.record', '-o', args.record,
+                        *raw_eyes])]
 
 
 class Video:
@@ -186,7 +198,7 @@ def watch(args, robots, procs, domain_id, stop):
     return outcome, monitor, rtf, video
 
 
-def summary(outcome, monitor, rtf, video, killed):
+def summary(outcome, monitor, rtf, video, killed, record=None):
     lines = ['', 'summary',
              f'  kicked:               {"yes" if monitor.kicked else "no"} ({outcome})']
     if monitor.kicked:
@@ -200,6 +212,8 @@ def summary(outcome, monitor, rtf, video, killed):
                      f'{"FELL" if w.fell else "stayed up"}')
     if video and video.frames:
         lines.append(f'  video:                {video.path} ({video.frames} frames)')
+    if record:
+        lines.append(f'  recording:            {record} (rosbag2, MCAP; log in record.log)')
     if killed:
         lines.append(f'  FAILED to stop:       {", ".join(killed)} (killed after Ctrl+C)')
     return '\n'.join(lines)
@@ -222,10 +236,15 @@ def parse_args(argv):
     parser.add_argument('--seed', type=int, default=1, help='seed of the first controller (1)')
     parser.add_argument('--out', default='out', help='folder for the video and logs (out)')
     parser.add_argument('--no-video', dest='video', action='store_false')
+    parser.add_argument('--record', metavar='DIR',
+                        help='record the run into a rosbag2 (MCAP) bag DIR: every topic but '
+                             'the raw eye images (python -m miro_ball.record)')
     parser.add_argument('--startup-timeout', type=float, default=60.0, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if not 0 < args.limit <= 1e6 or not 0 <= args.real_time_factor <= 1000:
         parser.error('--limit must be in (0, 1e6] and --real-time-factor in [0, 1000]')
+    if args.record and Path(args.record).exists():
+        parser.error(f'--record: {args.record} exists already')
     return args, parser
 
 
@@ -247,7 +266,7 @@ def main(argv=None):
         outcome, monitor, rtf, video = watch(args, robots, procs, domain_id, stop)
     finally:
         killed = procs.stop()
-    print(summary(outcome, monitor, rtf, video, killed))
+    print(summary(outcome, monitor, rtf, video, killed, args.record))
     # A node that had to be killed did not stop as it should: that is a failure too.
     sys.exit(0 if monitor.kicked and not killed else 1)
 

@@ -1,0 +1,163 @@
+"""A rosbag2 directory with MCAP storage and ROS 2 Jazzy types, written with `rosbags`.
+
+An MCAP file is readable only once it is finished (its summary and footer are
+written on close), so a recording that is killed, or runs out of disk, would
+lose everything. Hence the bag is written in splits, as `ros2 bag record
+--max-bag-duration` does: every `split_s` seconds the current file is finished
+and metadata.yaml is rewritten (atomically) to list every finished file. A hard
+stop loses at most the last split; what came before stays a valid bag.
+
+Each split is written by rosbags' Writer in a directory of its own inside the
+bag (the Writer makes a fresh directory per bag) and moved up when finished.
+"""
+import os
+import shutil
+import time
+from io import StringIO
+from pathlib import Path
+
+from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, \
+    QosReliability, QosTime
+from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.typesys import Stores, get_typestore
+from ruamel.yaml import YAML
+
+TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+METADATA = 'metadata.yaml'
+INFO = 'rosbag2_bagfile_information'
+
+
+class BagError(ValueError):
+    """The bag can not be created or written; the message says why."""
+
+
+def offered_qos(reliable, transient_local, depth):
+    """The QoS profile recorded with a topic, so `ros2 bag play` offers the same."""
+    zero = QosTime(0, 0)
+    return Qos(QosHistory.KEEP_LAST, depth,
+               QosReliability.RELIABLE if reliable else QosReliability.BEST_EFFORT,
+               QosDurability.TRANSIENT_LOCAL if transient_local else QosDurability.VOLATILE,
+               zero, zero, QosLiveliness.AUTOMATIC, zero, False)
+
+
+def _yaml():
+    yaml = YAML(typ='safe')
+    yaml.default_flow_style = False
+    return yaml
+
+
+def merge_metadata(parts):
+    """One bag's metadata from the metadata of each of its files, in order."""
+    info = dict(parts[0])
+    files = [f for part in parts for f in part['files']]
+    timed = [f for f in files if f['message_count']]
+    start = min((f['starting_time']['nanoseconds_since_epoch'] for f in timed), default=0)
+    end = max((f['starting_time']['nanoseconds_since_epoch'] + f['duration']['nanoseconds']
+               for f in timed), default=0)
+    topics = {}
+    for part in parts:
+        for entry in part['topics_with_message_count']:
+            name = entry['topic_metadata']['name']
+            if name in topics:
+                topics[name]['message_count'] += entry['message_count']
+            else:
+                topics[name] = dict(entry)
+    info.update(relative_file_paths=[f['path'] for f in files], files=files,
+                starting_time={'nanoseconds_since_epoch': start},
+                duration={'nanoseconds': end - start},
+                message_count=sum(f['message_count'] for f in files),
+                topics_with_message_count=list(topics.values()))
+    return {INFO: info}
+
+
+class SplitBag:
+    """Writes messages (raw CDR bytes) into a new rosbag2 directory at `path`."""
+
+    def __init__(self, path, split_s=10.0, clock=time.monotonic):
+        self.path = Path(path)
+        self.split_s = split_s
+        self.clock = clock
+        self.topics = {}  # topic -> (msgtype, offered qos)
+        self.parts = []  # metadata of each finished file
+        self.writer = None
+        self.connections = {}
+        if self.path.exists() and (not self.path.is_dir() or any(self.path.iterdir())):
+            raise BagError(f'{self.path} exists already (and is not an empty folder)')
+        try:
+            self.path.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise BagError(f'can not create {self.path}: {err.strerror}') from None
+        self._open_split()
+
+    @property
+    def split_index(self):
+        return len(self.parts)
+
+    def _split_dir(self):
+        return self.path / f'{self.path.name}_{self.split_index}'
+
+    def _open_split(self):
+        self.writer = Writer(self._split_dir(), version=Writer.VERSION_LATEST,
+                             storage_plugin=StoragePlugin.MCAP)
+        self.writer.open()
+        self.started = self.clock()
+        self.written = 0
+        self.connections = {}
+        for topic in self.topics:
+            self._connect(topic)
+
+    def _connect(self, topic):
+        msgtype, qos = self.topics[topic]
+        self.connections[topic] = self.writer.add_connection(
+            topic, msgtype, typestore=TYPESTORE, offered_qos_profiles=[qos])
+
+    def add_topic(self, topic, msgtype, qos):
+        """Start a topic; BagError when ROS 2 Jazzy has no such message type."""
+        if msgtype not in TYPESTORE.fielddefs:
+            raise BagError(f'{topic}: type {msgtype} is not a ROS 2 Jazzy message type')
+        self.topics[topic] = (msgtype, qos)
+        self._connect(topic)
+
+    def write(self, topic, log_time_ns, data):
+        """Store one message; OSError (a full disk) leaves the finished files readable."""
+        self.writer.write(self.connections[topic], log_time_ns, data)
+        self.written += 1
+
+    def tick(self):
+        """Finish the current file once it is split_s old and holds something."""
+        if self.written and self.clock() - self.started >= self.split_s:
+            self._finish_split()
+            self._open_split()
+
+    def _finish_split(self):
+        split_dir = self._split_dir()
+        self.writer.close()
+        self.writer = None
+        (split_dir / f'{split_dir.name}.mcap').replace(self.path / f'{split_dir.name}.mcap')
+        self.parts.append(_yaml().load((split_dir / METADATA).read_text())[INFO])
+        shutil.rmtree(split_dir)
+        self._write_metadata()
+
+    def _write_metadata(self):
+        text = StringIO()
+        _yaml().dump(merge_metadata(self.parts), text)
+        tmp = self.path / (METADATA + '.tmp')
+        tmp.write_text(text.getvalue())
+        os.replace(tmp, self.path / METADATA)
+
+    def close(self):
+        """Finish the last file (unless it is empty and not the only one) and the metadata."""
+        if self.writer is None:
+            return
+        if self.written or not self.parts:
+            self._finish_split()
+        else:
+            self.abort()
+
+    def abort(self):
+        """Drop the unfinished file (after a write error); the finished ones stay a bag."""
+        if self.writer is not None:
+            split_dir = self._split_dir()
+            self.writer.abort()
+            self.writer = None
+            shutil.rmtree(split_dir, ignore_errors=True)

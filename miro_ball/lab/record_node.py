@@ -1,0 +1,206 @@
+"""miro_record: record ROS topics into a rosbag2 directory (MCAP, ROS 2 Jazzy types).
+
+    python -m miro_ball.record -o DIR [TOPIC|ROBOT ...]
+
+What `ros2 bag record` does, for a pip install without ROS tools. Every topic
+is subscribed raw: the CDR bytes that arrive are the bytes a rosbag2 stores, so
+nothing is decoded. Topics are looked up every second, so nodes that start late
+are recorded too. The recorder follows the simulator's /clock: it subscribes to
+the other topics once the first /clock has arrived, and logs each message at its
+simulated time (see miro_ball/lab/recorder.py). Ctrl+C finishes the bag.
+"""
+import argparse
+import importlib
+import sys
+import time
+
+import rclpy
+from rclpy.clock import Clock, ClockType
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
+from rosgraph_msgs.msg import Clock as ClockMsg
+
+from miro_ball.common.stopping import spin_until_stopped, StopRequest
+from miro_ball.common.throttle import Throttled
+from miro_ball.lab.bag import BagError, SplitBag, TYPESTORE, offered_qos
+from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, \
+    import_name, log_time_ns
+from miro_ball.miro.interface import CLOCK
+
+NODE_NAME = 'miro_record'
+DISCOVERY_S = 1.0  # how often new topics are looked for (wall time)
+PROGRESS_S = 5.0
+DEPTH = 100  # messages a subscription may queue while the recorder is busy
+
+
+class RecordingFailed(Exception):
+    """Writing the bag failed (a full disk); the finished files stay readable."""
+
+
+class Recorder(Node):
+    """Subscribes raw to every selected topic and writes what arrives into `bag`."""
+
+    def __init__(self, bag, selection, context=None, progress_s=PROGRESS_S):
+        super().__init__(NODE_NAME, context=context)
+        self.bag = bag
+        self.selection = selection
+        self.progress = Progress()
+        self.warn = Throttled(self.get_logger().warning)
+        self.clock_ns = None  # the latest simulated time, from /clock
+        self.subs = {}
+        self.skipped = set()  # topics whose type can not be recorded (warned once)
+        self.record_clock = selection.wants(CLOCK)
+        if self.record_clock:
+            self._add(CLOCK, 'rosgraph_msgs/msg/Clock')
+        self.create_subscription(ClockMsg, CLOCK, self._on_clock, 10, raw=True)
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.create_timer(DISCOVERY_S, self._on_timer, clock=steady)
+        self.progress_s = progress_s
+        self.last_report = time.monotonic()
+        self.get_logger().info(f'recording into {bag.path}/; waiting for {CLOCK}')
+
+    # -- what arrives ---------------------------------------------------------------------------
+    def _on_clock(self, data):
+        first = self.clock_ns is None
+        self.clock_ns = cdr_stamp_ns(data) or 0
+        if self.record_clock:
+            self._write(CLOCK, self.clock_ns, data)
+        if first:
+            self.get_logger().info('got /clock: recording')
+            self._discover()
+
+    def _on_message(self, topic, stamped, data):
+        stamp = cdr_stamp_ns(data) if stamped else None
+        self._write(topic, log_time_ns(stamp, self.clock_ns), data)
+
+    def _write(self, topic, log_time, data):
+        try:
+            self.bag.write(topic, log_time, data)
+        except OSError as err:
+            self.bag.abort()
+            raise RecordingFailed(f'writing {self.bag.path}: {err.strerror or err}') from None
+        self.progress.count(topic)
+
+    # -- topics ---------------------------------------------------------------------------------
+    def _on_timer(self):
+        if self.clock_ns is None:
+            return
+        self._discover()
+        try:
+            self.bag.tick()
+        except OSError as err:
+            self.bag.abort()
+            raise RecordingFailed(f'writing {self.bag.path}: {err.strerror or err}') from None
+        now = time.monotonic()
+        if now - self.last_report >= self.progress_s:
+            self.get_logger().info(self.progress.line(self.clock_ns * 1e-9,
+                                                      now - self.last_report))
+            self.last_report = now
+
+    def _discover(self):
+        for topic, types in self.get_topic_names_and_types():
+            if topic in self.bag.topics or topic in self.skipped or not self.selection.wants(topic):
+                continue
+            publishers = self.get_publishers_info_by_topic(topic)
+            if not publishers:
+                continue  # nobody publishes yet: its QoS is unknown, so look again later
+            if len(types) > 1:
+                self.warn(topic, f'{topic} has several types {types}: recording {types[0]}')
+            qos = [p.qos_profile for p in publishers]
+            try:
+                self._add(topic, types[0],
+                          all(q.reliability == ReliabilityPolicy.RELIABLE for q in qos),
+                          all(q.durability == DurabilityPolicy.TRANSIENT_LOCAL for q in qos),
+                          max(q.depth for q in qos) or 10)
+            except (BagError, ValueError, ImportError, AttributeError) as err:
+                self.skipped.add(topic)
+                self.get_logger().warning(f'not recording {topic}: {err}')
+
+    def _add(self, topic, msgtype, reliable=True, latched=False, depth=10):
+        """Record the topic, with the QoS its publishers offer (so that we match them)."""
+        module, name = import_name(msgtype)
+        msg_class = getattr(importlib.import_module(module), name)
+        self.bag.add_topic(topic, msgtype, offered_qos(reliable, latched, depth))
+        if topic == CLOCK:
+            return  # already subscribed: it is the time base
+        stamped = has_stamp(TYPESTORE, msgtype)
+        profile = QoSProfile(
+            depth=DEPTH,
+            reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
+        self.subs[topic] = self.create_subscription(
+            msg_class, topic, lambda data: self._on_message(topic, stamped, data), profile,
+            raw=True)
+        self.get_logger().info(f'recording {topic} ({msgtype})')
+
+    def summary(self):
+        seconds = self.clock_ns * 1e-9 if self.clock_ns is not None else 0.0
+        return [f'{self.bag.path}: {sum(self.progress.total.values())} messages on '
+                f'{len(self.progress.total)} topics, up to t = {seconds:.1f} s simulated, '
+                f'{self.bag.split_index} file(s)'] + self.progress.summary()
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(
+        prog='python -m miro_ball.record', formatter_class=argparse.RawDescriptionHelpFormatter,
+        description='Record ROS topics into a rosbag2 directory (MCAP storage, ROS 2 Jazzy '
+                    'types) that ros2 bag info/play, Foxglove and the rosbags library open.',
+        epilog='Targets: a topic (/miro/sensors/odom), a pattern (\'/miro/sensors/*\') or a '
+               'robot name (miro02: all its topics and its ground truth); none = every topic.\n'
+               'Log times are simulated time: the message stamp where it has one, else the '
+               'latest /clock;\nnothing is recorded before the first /clock. Ctrl+C finishes '
+               'the bag; a hard stop or a full disk\nloses at most the last --split-seconds.')
+    parser.add_argument('-o', '--output', required=True, metavar='DIR',
+                        help='the bag directory to create (must not exist, or be empty)')
+    parser.add_argument('targets', nargs='*', metavar='TOPIC',
+                        help='topics, patterns or robot names (default: every topic)')
+    parser.add_argument('-x', '--exclude', action='append', default=[], metavar='PATTERN',
+                        help='leave out topics matching this pattern (repeatable)')
+    parser.add_argument('--split-seconds', type=float, default=10.0,
+                        help='finish a file and start the next this often, wall time (10)')
+    args = parser.parse_args(argv)
+    if not 0.1 <= args.split_seconds <= 86400:
+        parser.error('--split-seconds must be within 0.1 and 86400')
+    try:
+        selection = Selection(args.targets, args.exclude)
+    except ValueError as err:
+        parser.error(str(err))
+    return args, selection, parser
+
+
+def main(argv=None):
+    argv = list(sys.argv if argv is None else argv)
+    try:
+        cli_args = rclpy.utilities.remove_ros_args(argv)[1:]
+    except Exception as err:  # rclpy's malformed --ros-args error has no public class
+        sys.exit(f'{NODE_NAME}: error: {err}')
+    args, selection, parser = parse_args(cli_args)
+    try:
+        bag = SplitBag(args.output, split_s=args.split_seconds)
+    except BagError as err:
+        parser.error(str(err))
+    stop = StopRequest()
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    node = Recorder(bag, selection)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    code = 0
+    try:
+        spin_until_stopped(executor, stop)
+    except RecordingFailed as err:
+        node.get_logger().error(f'{err}; the files finished before are a readable bag')
+        code = 1
+    finally:
+        try:
+            bag.close()
+        except OSError as err:
+            bag.abort()
+            node.get_logger().error(f'finishing the last file: {err}')
+            code = 1
+        for line in node.summary():
+            print(line, flush=True)
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return code

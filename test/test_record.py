@@ -1,0 +1,233 @@
+"""The recorder: what it writes is a rosbag2 (MCAP) bag that rosbags reads back, with the
+recorded topics, their ROS 2 Jazzy types, every message and simulated-time log times."""
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+from builtin_interfaces.msg import Time
+from nav_msgs.msg import Odometry
+from rclpy.parameter import Parameter
+from rclpy.serialization import serialize_message
+from rosgraph_msgs.msg import Clock
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import Stores, get_typestore
+
+from miro_ball.common.isolation import isolated_env
+from miro_ball.lab.bag import SplitBag, offered_qos
+from miro_ball.lab.record_node import Recorder
+from miro_ball.lab.recorder import Selection, cdr_stamp_ns, has_stamp, log_time_ns
+from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
+from miro_sim_bullet.ros.node import SimNode
+from rostools import drain, spin_until
+
+ROBOT = RobotTopics(default_robot_name())
+TYPES = get_typestore(Stores.ROS2_JAZZY)
+TICK_NS = 20_000_000
+
+
+def read_bag(path):
+    """{topic: (type, [(log time, message)])} of a bag."""
+    with Reader(path) as reader:
+        out = {c.topic: (c.msgtype, []) for c in reader.connections}
+        for connection, log_time, data in reader.messages():
+            out[connection.topic][1].append(
+                (log_time, TYPES.deserialize_cdr(data, connection.msgtype)))
+    return out
+
+
+def ns(stamp):
+    return stamp.sec * 10**9 + stamp.nanosec
+
+
+# -- the pure parts -------------------------------------------------------------------------------
+def test_a_robot_name_selects_its_topics_and_ground_truth_only():
+    other = RobotTopics('other')
+    selection = Selection([ROBOT.name], exclude=[ROBOT.eye_raw('caml')])
+    assert selection.wants(ROBOT.odom) and selection.wants(ROBOT.cmd_vel)
+    assert selection.wants(SimTopics().object_pose(ROBOT.name))
+    assert not selection.wants(ROBOT.eye_raw('caml'))
+    assert not selection.wants(other.odom) and not selection.wants(CLOCK)
+    everything = Selection()
+    assert everything.wants(other.odom) and everything.wants(CLOCK)
+    topics = Selection([ROBOT.odom.lstrip('/'), '/miro_sim/*'])
+    assert topics.wants(ROBOT.odom) and topics.wants(SimTopics().ball)
+    assert not topics.wants(ROBOT.cliff)
+    with pytest.raises(ValueError):
+        Selection(['9lives'])
+
+
+def test_stamps_come_from_the_first_field_when_it_is_a_time():
+    assert has_stamp(TYPES, 'nav_msgs/msg/Odometry') and has_stamp(TYPES, 'rosgraph_msgs/msg/Clock')
+    assert not has_stamp(TYPES, 'std_msgs/msg/Float32MultiArray')
+    odom = Odometry()
+    odom.header.stamp.sec, odom.header.stamp.nanosec = 12, 340_000_000
+    assert cdr_stamp_ns(serialize_message(odom)) == 12_340_000_000  # as rclpy hands it over
+    assert cdr_stamp_ns(b'\x00\x01\x00') is None
+    clock = 12 * 10**9
+    assert log_time_ns(clock + TICK_NS, clock) == clock + TICK_NS  # simulated: kept
+    assert log_time_ns(0, clock) == clock  # unset
+    assert log_time_ns(1_700_000_000 * 10**9, clock) == clock  # wall time: not simulated
+
+
+def test_a_write_error_leaves_the_finished_files_a_bag(tmp_path):
+    now = [0.0]
+    bag = SplitBag(tmp_path / 'bag', split_s=1.0, clock=lambda: now[0])
+    bag.add_topic(CLOCK, 'rosgraph_msgs/msg/Clock', offered_qos(True, False, 10))
+    for i in range(18):  # a file finished every 4 messages
+        bag.write(CLOCK, i * 10**9, serialize_message(Clock(clock=Time(sec=i))))
+        now[0] += 0.25
+        bag.tick()
+    bag.abort()  # as after a full disk: the unfinished last file is dropped
+    recorded = read_bag(tmp_path / 'bag')[CLOCK][1]
+    assert [t for t, _ in recorded] == [i * 10**9 for i in range(len(recorded))]
+    assert len(recorded) == 16 and bag.split_index == 4
+    with pytest.raises(ValueError):
+        SplitBag(tmp_path / 'bag')  # never overwrites a bag
+
+
+# -- against the simulator, in-process --------------------------------------------------------
+@pytest.fixture
+def sim_node(ros_context, executor):
+    node = SimNode(context=ros_context, parameter_overrides=[
+        Parameter('paused', value=True), Parameter('world', value='miro')])
+    executor.add_node(node)
+    yield node
+    executor.remove_node(node)
+    node.destroy_node()
+
+
+def tick(sim_node, executor, count=1):
+    for _ in range(count):
+        sim_node.advance(sim_node.sim.ticks_per_platform_tick)
+        drain(executor, rounds=30)
+
+
+def test_records_every_topic_with_types_counts_and_simulated_stamps(
+        tmp_path, ros_context, executor, sim_node):
+    bag = SplitBag(tmp_path / 'bag')
+    recorder = Recorder(bag, Selection(exclude=[ROBOT.eye_raw('cam?')]), context=ros_context)
+    executor.add_node(recorder)
+    tick(sim_node, executor)  # the first /clock starts the recording
+    interface = sim_node.robots[ROBOT.name]
+    assert spin_until(executor, lambda: interface.pub_odom.get_subscription_count()
+                      and interface.pub_cliff.get_subscription_count()
+                      and interface.pub_eyes['caml'][0].get_subscription_count())
+    start = sim_node.sim.time
+    tick(sim_node, executor, 50)  # 1 s
+    bag.close()
+    executor.remove_node(recorder)
+    recorder.destroy_node()
+
+    recorded = read_bag(tmp_path / 'bag')
+    assert recorded[ROBOT.odom][0] == 'nav_msgs/msg/Odometry'
+    assert recorded[ROBOT.cliff][0] == 'std_msgs/msg/Float32MultiArray'
+    assert recorded[ROBOT.eye_compressed('caml')][0] == 'sensor_msgs/msg/CompressedImage'
+    assert recorded[CLOCK][0] == 'rosgraph_msgs/msg/Clock'
+    assert ROBOT.eye_raw('caml') not in recorded  # excluded
+    # Every tick after the subscription was made, nothing lost, at the message's own stamp.
+    odom = recorded[ROBOT.odom][1]
+    assert len(odom) == 50
+    assert [t for t, _ in odom] == [ns(m.header.stamp) for _, m in odom]
+    assert [t for t, _ in odom] == [round((start + 0.02 * (i + 1)) * 1e9) for i in range(50)]
+    # Without a stamp: the /clock of the tick that carried it.
+    assert [t for t, _ in recorded[ROBOT.cliff][1]] == [t for t, _ in odom]
+    assert list(recorded[ROBOT.cliff][1][-1][1].data) == [1.0, 1.0]
+    images = recorded[ROBOT.eye_compressed('caml')][1]
+    assert len(images) == 15  # 15 Hz for 1 s
+    assert all(t == ns(m.header.stamp) for t, m in images)
+    assert bytes(images[-1][1].data[:2]) == b'\xff\xd8'  # a JPEG, as published
+
+
+# -- the command, as a child process --------------------------------------------------------------
+def start_recorder(*args):
+    env = isolated_env(int(os.environ['ROS_DOMAIN_ID']))
+    return subprocess.Popen([sys.executable, '-m', 'miro_ball.record', *args], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def run_until(sim_node, executor, predicate, timeout_s=30.0):
+    """Step the world tick by tick until predicate() holds; the wall-clock limit is a guard."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        assert time.monotonic() < deadline, 'timed out'
+        tick(sim_node, executor)
+
+
+def test_the_command_records_a_robot_until_ctrl_c_twice(tmp_path, executor, sim_node):
+    proc = start_recorder('-o', str(tmp_path / 'bag'), ROBOT.name, '--split-seconds', '0.5')
+    try:
+        interface = sim_node.robots[ROBOT.name]
+        run_until(sim_node, executor, lambda: interface.pub_odom.get_subscription_count())
+        for _ in range(100):
+            tick(sim_node, executor)
+        time.sleep(0.5)  # DDS delivers what is in flight; Ctrl+C then ends the recording
+        proc.send_signal(signal.SIGINT)
+        proc.send_signal(signal.SIGINT)
+        output, _ = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, output
+    assert 'Traceback' not in output
+    recorded = read_bag(tmp_path / 'bag')
+    assert set(recorded) >= {ROBOT.odom, ROBOT.cliff, SimTopics().object_pose(ROBOT.name)}
+    assert all(topic.startswith(f'/{ROBOT.name}/') or topic.endswith(f'/{ROBOT.name}')
+               for topic in recorded)
+    stamps = [t for t, _ in recorded[ROBOT.odom][1]]
+    assert len(stamps) >= 50 and all(b - a == TICK_NS for a, b in zip(stamps, stamps[1:]))
+    assert f'{tmp_path / "bag"}: ' in output  # the summary
+
+
+def test_a_killed_recorder_leaves_a_readable_bag(tmp_path, executor, sim_node):
+    bag = tmp_path / 'bag'
+    proc = start_recorder('-o', str(bag), ROBOT.odom, '--split-seconds', '0.2')
+    try:
+        run_until(sim_node, executor, lambda: (bag / 'metadata.yaml').exists())
+        for _ in range(20):
+            tick(sim_node, executor)
+    finally:
+        proc.kill()
+        proc.communicate()
+    stamps = [t for t, _ in read_bag(bag)[ROBOT.odom][1]]
+    assert stamps and all(b - a == TICK_NS for a, b in zip(stamps, stamps[1:]))
+
+
+def test_bad_arguments_are_one_line_errors(tmp_path):
+    (tmp_path / 'taken').mkdir()
+    (tmp_path / 'taken' / 'file').write_text('x')
+    for args in (['-o', str(tmp_path / 'taken')], ['-o', str(tmp_path / 'b'), 'no such'],
+                 ['-o', str(tmp_path / 'b'), '--split-seconds', 'nan'], []):
+        out = subprocess.run([sys.executable, '-m', 'miro_ball.record', *args],
+                             capture_output=True, text=True, timeout=60)
+        assert out.returncode == 2 and 'error:' in out.stderr and 'Traceback' not in out.stderr
+    help_text = subprocess.run([sys.executable, '-m', 'miro_ball.record', '--help'],
+                               capture_output=True, text=True, timeout=60).stdout
+    assert '-o DIR' in help_text and 'robot name' in help_text
+
+
+def test_the_main_job_records_every_node_of_the_run(tmp_path):
+    bag = tmp_path / 'run'
+    cmd = [sys.executable, '-m', 'miro_ball.lab.demo', '--no-video', '--limit', '3',
+           '--real-time-factor', '0', '--out', str(tmp_path), '--record', str(bag)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)
+    try:
+        output, _ = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert f'recording:            {bag}' in output and 'FAILED' not in output, output
+    recorded = read_bag(bag)
+    # The controller's commands, the simulator's sensors, eyes and ground truth, the logs.
+    assert recorded[ROBOT.cmd_vel][0] == 'geometry_msgs/msg/TwistStamped'
+    for topic in (ROBOT.odom, ROBOT.eye_compressed('camr'), SimTopics().ball, CLOCK, '/rosout'):
+        assert recorded[topic][1], topic
+    assert ROBOT.eye_raw('caml') not in recorded
+    commands = [t for t, _ in recorded[ROBOT.cmd_vel][1]]
+    assert 2.5e9 < commands[-1] < 4e9  # simulated time of the run, not wall time
+    assert 'Traceback' not in (tmp_path / 'record.log').read_text()
