@@ -42,6 +42,7 @@ setup(
             'kick_blue_ball = miro_ball.controller.node:main',
             'ball_mover = miro_ball.examples.ball_mover:main',
             'record = miro_ball.record:main',
+            'grade = miro_ball.grade:main',
         ],
     },
 )
