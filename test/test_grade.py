@@ -28,7 +28,7 @@ def test_what_went_wrong_with_the_command_is_said():
     assert result(exit_code=1, exited_after_s=0.24, ended='command exited').notes == [
         'exited with code 1 after 0.2 s']
     assert result(commands=0).notes == ['never published on control/cmd_vel']
-    assert 'flooded control/cmd_vel: 20000' in result(commands=100000).notes[0]
+    assert 'flooded control/cmd_vel: 20000 messages' in result(commands=100000).notes[0]
     assert result(killed=True).notes == ['ignored Ctrl+C, killed']
     assert result(ended='the simulator did not take the placement').notes == [
         'the simulator did not take the placement']

@@ -9,8 +9,8 @@ import math
 import statistics
 from dataclasses import asdict, dataclass, field
 
-# MiRo's platform takes one command per 20 ms tick; far more than that is a flood.
-FLOOD_PER_SIM_S = 1000.0
+# MiRo's platform takes one command per 20 ms tick (50 per s); ten times that is a flood.
+FLOOD_PER_SIM_S = 500.0
 TAIL_LINES = 5
 TAIL_WIDTH = 160
 
