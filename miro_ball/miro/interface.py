@@ -15,6 +15,7 @@ EYES = ('caml', 'camr')  # index 0 is the left eye, as the MDK's CAM_L
 EYE_SIDE = {'caml': +1, 'camr': -1}  # +1 left, -1 right: the sign of the eye's y offset
 SIM_NODE_NAME = 'miro_sim'
 CONTROLLER_NODE_NAME = 'kick_blue_ball'
+GUI_NODE_NAME = 'miro_gui'
 MAX_NAME_LENGTH = 64
 # A ROS name token: what may stand between two slashes of a topic name.
 _TOKEN = re.compile(r'[A-Za-z][A-Za-z0-9_]*\Z')
@@ -26,6 +27,18 @@ def check_name(name, what='robot name'):
         raise ValueError(f'{what} {name!r} must be a letter followed by letters, digits or '
                          f'underscores (at most {MAX_NAME_LENGTH} characters)')
     return name
+
+
+def robots_in(topic_names):
+    """Names of the robots whose odometry is among topic_names (a ROS graph listing),
+    sorted: how a viewer finds the MiRos that are running."""
+    names = set()
+    for topic in topic_names:
+        parts = topic.split('/')
+        if len(parts) > 2 and parts[0] == '' and _TOKEN.match(parts[1]) \
+                and len(parts[1]) <= MAX_NAME_LENGTH and RobotTopics(parts[1]).odom == topic:
+            names.add(parts[1])
+    return sorted(names)
 
 
 def default_robot_name(environ=None):

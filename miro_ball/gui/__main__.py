@@ -1,0 +1,3 @@
+from miro_ball.gui.app import main
+
+main()

@@ -1,0 +1,91 @@
+"""miro_gui: see and drive MiRo from a web browser (the MDK's client_gui.py as a web page).
+
+The ROS node spins in a thread of its own; the web server runs on asyncio in the
+main thread; neither waits for the other (bridge.py and server.py say how).
+"""
+import argparse
+import asyncio
+import sys
+import threading
+
+from miro_ball.common.stopping import StopRequest, spin_until_stopped
+from miro_ball.miro.interface import check_name, default_robot_name
+
+DEFAULT_HOST = '127.0.0.1'
+DEFAULT_PORT = 8080
+PROG = 'miro_gui'
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="See and drive MiRo in a web browser: both eyes, every sensor in the MDK "
+                    "GUI's units, driving (arrow keys / WASD), head, tail, ears, eyelids, LEDs, "
+                    "tone, the cliff reflex, and the simulator's pause / step / reset. It "
+                    "publishes only MiRo's control topics and prints the URL to open.")
+    parser.add_argument('--host', default=DEFAULT_HOST,
+                        help=f'address to listen on ({DEFAULT_HOST}); anything but loopback '
+                             'lets other machines drive the robot')
+    parser.add_argument('--port', type=int, default=DEFAULT_PORT,
+                        help=f'port ({DEFAULT_PORT}); 0 = any free port')
+    parser.add_argument('--robot', metavar='NAME',
+                        help='the MiRo to show (default: $MIRO_ROBOT_NAME if running, else the '
+                             'first found; the page has a picker when several run)')
+    args = parser.parse_args(argv)
+    if not 0 <= args.port <= 65535:
+        parser.error(f'--port must be in 0..65535, got {args.port}')
+    if args.robot is not None:
+        try:
+            check_name(args.robot, '--robot')
+        except ValueError as err:
+            parser.error(str(err))
+    return args, parser
+
+
+def main(argv=None):
+    argv = sys.argv if argv is None else argv
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.signals import SignalHandlerOptions
+
+    try:
+        cli_args = rclpy.utilities.remove_ros_args(argv)[1:]
+    except Exception as err:  # rclpy's malformed --ros-args error has no public class
+        sys.exit(f'{PROG}: error: {err}')
+    args, parser = parse_args(cli_args)
+    try:
+        default = check_name(default_robot_name(), '$MIRO_ROBOT_NAME')
+    except ValueError as err:
+        parser.error(str(err))
+
+    from miro_ball.gui.bridge import GuiBridge
+    from miro_ball.gui.server import GuiServer, is_loopback, listen, serve, url
+
+    try:
+        sock = listen(args.host, args.port)
+    except OSError as err:
+        parser.error(f'cannot listen on {args.host}:{args.port}: {err.strerror or err}')
+    stop = StopRequest()
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    server = None
+    bridge = GuiBridge(args.robot, on_frame=lambda channel: server.frame_arrived(channel),
+                       default_robot=default)
+    log = bridge.get_logger()
+    server = GuiServer(bridge, loopback_only=is_loopback(args.host), log=log.info,
+                       warn=log.warning)
+    if not is_loopback(args.host):
+        log.warning(f'listening on {args.host}, not only on this machine: anyone who can reach '
+                    'it can drive the robot')
+    executor = SingleThreadedExecutor()
+    executor.add_node(bridge)
+    spinner = threading.Thread(target=spin_until_stopped, args=(executor, stop), daemon=True)
+    spinner.start()
+    print(f'{PROG}: open {url(sock)}', flush=True)
+    try:
+        asyncio.run(serve(server, sock, stop))
+    finally:
+        stop.signum = stop.signum or 0  # after an error: ends the spin thread too
+        spinner.join(timeout=2.0)
+        bridge.stop_driving('miro_gui is stopping')
+        bridge.destroy_node()
+        rclpy.try_shutdown()

@@ -1,0 +1,340 @@
+"""The GUI's ROS side: one rclpy node that watches a MiRo and drives it for the pages.
+
+It runs in the ROS thread (its own executor); the web server calls the thread-safe
+methods marked so. Images are kept newest-only, one slot per channel, and handed
+over as the JPEG bytes that arrived. Commands from the pages go into a queue that a
+guard condition drains in the ROS thread at once, so they never wait behind
+images. A drive command lasts DEADMAN_S unless refreshed: a page that stops
+talking (closed, hidden, frozen, cut off) stops the robot.
+
+It publishes only MiRo's control topics and calls only the simulator's services.
+"""
+import collections
+import json
+import threading
+import time
+from dataclasses import dataclass
+
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import BatteryState, CompressedImage, Imu, JointState, Range
+from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, \
+    UInt32MultiArray
+from std_srvs.srv import SetBool, Trigger
+
+from miro_ball.common.jpeg import ImageRejected, jpeg_size
+from miro_ball.common.throttle import Throttled
+from miro_ball.gui import protocol as p
+from miro_ball.gui import readouts as r
+from miro_ball.miro.constants import JOINT_NAMES, PLATFORM_TICK_S
+from miro_ball.miro.interface import (CLOCK, EYES, GUI_NODE_NAME, RobotTopics, SimTopics,
+                                      robots_in)
+
+DEADMAN_S = 0.3  # a drive command not refreshed for this long becomes a stop
+DISCOVERY_PERIOD_S = 1.0
+READOUT_PERIOD_S = 0.05  # readouts to the pages at 20 Hz
+IMAGE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+MAX_IMAGE_SIDE = 4096
+
+
+@dataclass(frozen=True)
+class Frame:
+    seq: int
+    stamp: float
+    jpeg: bytes
+
+
+class _Watch:
+    """The subscriptions to one robot's sensors and eyes, and what they last said."""
+
+    def __init__(self, bridge, name):
+        self.bridge = bridge
+        self.topics = t = RobotTopics(name)
+        self.values = {}
+        self.last_heard = None
+        node = bridge
+
+        def sub(msg_type, topic, handler, qos=10):
+            return node.create_subscription(msg_type, topic, self._wrap(handler), qos)
+
+        self.subs = [
+            sub(BatteryState, t.battery, lambda m: {'battery': m.voltage}),
+            sub(Range, t.sonar, lambda m: {'sonar': m.range,
+                                           'sonar_text': r.sonar_text(m.range)}),
+            sub(Float32MultiArray, t.light, lambda m: {'light': r.light(m.data)}),
+            sub(UInt16, t.touch('head'), lambda m: {'touch_head': m.data}),
+            sub(UInt16, t.touch('body'), lambda m: {'touch_body': m.data}),
+            sub(Imu, t.imu('body'), lambda m: {'accel_body': r.accel(_xyz(m))}),
+            sub(Imu, t.imu('head'), lambda m: {'accel_head': r.accel(_xyz(m))}),
+            sub(Float32MultiArray, t.cliff, lambda m: {'cliff': r.cliff(m.data)}),
+            sub(Float32MultiArray, t.wheel_speed_opto,
+                lambda m: {'wheel_opto': r.wheels_mm_s(m.data)}),
+            sub(Float32MultiArray, t.wheel_speed_cmd,
+                lambda m: {'wheel_cmd': r.wheels_mm_s(m.data)}),
+            sub(Odometry, t.odom, _odometry),
+            sub(JointState, t.kinematic_joints,
+                lambda m: {'head': r.head_degrees(m.position)} if len(m.position) >= 4
+                else None),
+            sub(UInt32, t.sensor_flags, lambda m: {'flags': m.data}),
+        ]
+        for index, eye in enumerate(EYES):
+            self.subs.append(bridge.image_subscription(t.eye_compressed(eye), index))
+            self.subs.append(bridge.image_subscription(
+                t.controller_debug(eye), p.CHANNELS.index(f'debug_{eye}')))
+
+    def _wrap(self, handler):
+        def on_message(msg):
+            try:
+                values = handler(msg)
+            except (TypeError, ValueError, IndexError) as err:  # garbage from the graph
+                self.bridge.warn('sensor', f'a malformed sensor message ignored: {err}')
+                return
+            if values:
+                self.values.update(values)
+                self.last_heard = time.monotonic()
+        return on_message
+
+    def destroy(self):
+        for sub in self.subs:
+            self.bridge.destroy_subscription(sub)
+
+
+def _xyz(imu):
+    a = imu.linear_acceleration
+    return (a.x, a.y, a.z)
+
+
+def _odometry(msg):
+    pose, twist = msg.pose.pose, msg.twist.twist
+    return {'odom': [twist.linear.x, twist.angular.z],
+            'pose': [pose.position.x, pose.position.y,
+                     r.yaw_of(pose.orientation.z, pose.orientation.w)]}
+
+
+class GuiBridge(Node):
+    """See the module docstring. robot: the MiRo to watch, or None to pick one."""
+
+    def __init__(self, robot=None, *, context=None, on_frame=None, default_robot='miro'):
+        super().__init__(GUI_NODE_NAME, context=context)
+        self.warn = Throttled(self.get_logger().warning)
+        self.fixed_robot = robot
+        self.on_frame = on_frame or (lambda channel: None)
+        self._lock = threading.Lock()
+        self._frames = {}
+        self._seq = 0
+        self._commands = collections.deque(maxlen=1000)
+        self._drive = None  # (linear, angular, owner, refreshed at)
+        self.status = ''
+        self.robots = []
+        self.sim = SimTopics()
+        self._clock_samples = []  # (wall, sim) of recent /clock messages, for the real-time factor
+        self.sim_time = None
+        self.sim_paused = None
+        self._control_pubs = {}
+        self._wake = self.create_guard_condition(self._run_commands)
+        self.create_subscription(Clock, CLOCK, self._on_clock, 10)
+        self.image_subscription(self.sim.overhead, p.CHANNELS.index('overhead'))
+        self.sim_clients = {'reset': self.create_client(Trigger, self.sim.reset),
+                        'step': self.create_client(Trigger, self.sim.step),
+                        'pause': self.create_client(SetBool, self.sim.pause)}
+        self.watch = None
+        self._select(robot or default_robot)
+        self._make_state()
+        self.create_timer(PLATFORM_TICK_S, self._on_tick)
+        self.create_timer(READOUT_PERIOD_S, self._make_state)
+        self.create_timer(DISCOVERY_PERIOD_S, self._discover)
+
+    # -- thread-safe, for the web server ------------------------------------------------------
+    def submit(self, command, owner):
+        """Queue a checked command (protocol.py) from page ``owner``; sent at once."""
+        self._commands.append((command, owner))
+        self._wake.trigger()
+
+    def release(self, owner):
+        """Page ``owner`` has gone: if it was driving, stop."""
+        self.submit(p.Stop(), owner)
+
+    def frames(self):
+        """{channel: Frame}, the newest of each."""
+        with self._lock:
+            return dict(self._frames)
+
+    def state(self):
+        """JSON text of everything the page shows besides images (made in the ROS thread)."""
+        return self._state
+
+    def stop_driving(self, why):
+        """Stop the robot if a page is driving it; only once the ROS thread has ended."""
+        if self._drive is not None:
+            self._stop(why)
+
+    # -- readouts (ROS thread) -------------------------------------------------------------------
+    def _make_state(self):
+        watch = self.watch
+        heard = watch.last_heard
+        self._state = json.dumps(r.jsonable({
+            't': 'state',
+            'robot': watch.topics.name,
+            'robots': self.robots,
+            'fixed': self.fixed_robot is not None,
+            'readouts': watch.values,
+            'age': time.monotonic() - heard if heard else None,
+            'sim': {'present': self.sim_clients['reset'].service_is_ready(),
+                    'time': self.sim_time, 'rtf': self._rtf(), 'paused': self.sim_paused},
+            'status': self.status,
+        }))
+
+    # -- images ---------------------------------------------------------------------------------
+    def image_subscription(self, topic, channel):
+        def on_image(msg):
+            data = bytes(msg.data)
+            problem = None
+            if len(data) > p.MAX_FRAME_BYTES:
+                problem = f'{len(data)} bytes'
+            else:
+                try:
+                    width, height = jpeg_size(data)
+                    if not (0 < width <= MAX_IMAGE_SIDE and 0 < height <= MAX_IMAGE_SIDE):
+                        problem = f'{width}x{height} pixels'
+                except ImageRejected as err:
+                    problem = str(err)
+            if problem:
+                self.warn(f'image:{topic}', f'{topic}: image not shown: {problem}')
+                return
+            stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+            with self._lock:
+                self._seq += 1
+                self._frames[channel] = Frame(self._seq, stamp, data)
+            self.on_frame(channel)
+        return self.create_subscription(CompressedImage, topic, on_image, IMAGE_QOS)
+
+    # -- commands (ROS thread) -------------------------------------------------------------------
+    def _publisher(self, msg_type, topic):
+        if topic not in self._control_pubs:
+            self._control_pubs[topic] = self.create_publisher(msg_type, topic, 10)
+        return self._control_pubs[topic]
+
+    def _run_commands(self):
+        while self._commands:
+            command, owner = self._commands.popleft()
+            self._run(command, owner)
+
+    def _run(self, command, owner):
+        t = self.watch.topics
+        if isinstance(command, p.Drive):
+            fresh = self._drive is None
+            self._drive = (command.linear, command.angular, owner, time.monotonic())
+            self._publish_twist(command.linear, command.angular)
+            if fresh:
+                self.get_logger().info(f'driving {t.name}')
+        elif isinstance(command, p.Stop):
+            if self._drive is not None and self._drive[2] == owner:
+                self._stop('stopped by the page')
+        elif isinstance(command, p.Head):
+            self._publisher(JointState, t.kinematic_targets).publish(
+                JointState(name=list(JOINT_NAMES), position=list(command.positions)))
+        elif isinstance(command, p.Cosmetic):
+            self._publisher(Float32MultiArray, t.cosmetic_joints).publish(
+                Float32MultiArray(data=list(command.values)))
+        elif isinstance(command, p.Illum):
+            self._publisher(UInt32MultiArray, t.illum).publish(
+                UInt32MultiArray(data=list(command.leds)))
+        elif isinstance(command, p.Tone):
+            self._publisher(UInt16MultiArray, t.tone).publish(
+                UInt16MultiArray(data=list(command.values)))
+        elif isinstance(command, p.Flags):
+            self._publisher(UInt32, t.control_flags).publish(UInt32(data=command.data))
+        elif isinstance(command, p.SimAction):
+            self._call_sim(command.action)
+        elif isinstance(command, p.SelectRobot):
+            self._choose(command.name)
+
+    def _publish_twist(self, linear, angular):
+        msg = TwistStamped()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = 'base_link'
+        msg.twist.linear.x, msg.twist.angular.z = float(linear), float(angular)
+        self._publisher(TwistStamped, self.watch.topics.cmd_vel).publish(msg)
+
+    def _stop(self, why):
+        self._drive = None
+        self._publish_twist(0.0, 0.0)
+        self.get_logger().info(f'{self.watch.topics.name} stopped: {why}')
+
+    def _on_tick(self):
+        """Keep a held drive command going at MiRo's 50 Hz, until its deadman runs out."""
+        if self._drive is None:
+            return
+        linear, angular, _, refreshed = self._drive
+        if time.monotonic() - refreshed > DEADMAN_S:
+            self._stop(f'no drive command from the page for {DEADMAN_S} s')
+        else:
+            self._publish_twist(linear, angular)
+
+    def _call_sim(self, action):
+        name = 'pause' if action in ('pause', 'resume') else action
+        client = self.sim_clients[name]
+        if not client.service_is_ready():
+            self.status = f'{action}: no simulator'
+            return
+        request = client.srv_type.Request()
+        if name == 'pause':
+            request.data = action == 'pause'
+        future = client.call_async(request)
+
+        def done(future):
+            result = future.result()
+            if result is None:
+                self.status = f'{action}: no answer'
+                return
+            if name == 'pause' and result.success:
+                self.sim_paused = request.data
+            self.status = f'{action}: {result.message}'
+            self.get_logger().info(f'simulator {action}: {result.message}')
+        future.add_done_callback(done)
+
+    # -- which robot -----------------------------------------------------------------------------
+    def _select(self, name):
+        if self.watch is not None:
+            if self._drive is not None:
+                self._stop('another robot was chosen')
+            self.watch.destroy()
+        self.watch = _Watch(self, name)
+        with self._lock:
+            self._frames = {ch: f for ch, f in self._frames.items()
+                            if p.CHANNELS[ch] == 'overhead'}
+        self.get_logger().info(f'watching {name}')
+
+    def _choose(self, name):
+        if self.fixed_robot is not None:
+            self.status = f'fixed to {self.fixed_robot} by --robot'
+        elif name not in self.robots:
+            self.warn('robot', f'no robot {name!r} running; there are {self.robots}')
+        elif name != self.watch.topics.name:
+            self._select(name)
+
+    def _discover(self):
+        self.robots = robots_in(name for name, _ in self.get_topic_names_and_types())
+        if self.fixed_robot is None and self.robots and self.watch.topics.name not in self.robots:
+            self._select(self.robots[0])
+
+    # -- simulated time --------------------------------------------------------------------------
+    def _on_clock(self, msg):
+        now = time.monotonic()
+        sim = msg.clock.sec + msg.clock.nanosec * 1e-9
+        if self.sim_time is not None and sim < self.sim_time:
+            self._clock_samples.clear()  # a reset
+        self.sim_time = sim
+        self._clock_samples.append((now, sim))
+        while self._clock_samples and now - self._clock_samples[0][0] > 2.0:
+            self._clock_samples.pop(0)
+
+    def _rtf(self):
+        """Simulated seconds per wall second over the last 2 s; 0 when time stands still."""
+        if len(self._clock_samples) < 2 or time.monotonic() - self._clock_samples[-1][0] > 0.5:
+            return 0.0 if self.sim_time is not None else None
+        (w0, s0), (w1, s1) = self._clock_samples[0], self._clock_samples[-1]
+        return (s1 - s0) / (w1 - w0) if w1 > w0 else None

@@ -1,0 +1,230 @@
+"""What the page and the GUI server say to each other over the WebSocket.
+
+Page -> server: one JSON object per text message, {"t": kind, ...}. parse() turns
+it into a command with every value checked and clamped to what MiRo accepts (the
+simulator's own clamps), or raises Rejected saying why in one line. Nothing here
+knows about ROS or the web server, so it is tested on its own.
+
+Server -> page: JSON text for the readouts, and images as binary messages: a
+FRAME_HEADER (channel number, stamp in seconds) followed by the JPEG bytes as the
+robot sent them (the browser decodes them; the server never does).
+"""
+import json
+import math
+import struct
+from dataclasses import dataclass
+
+from miro_ball.miro.constants import (COSMETIC_CALIB, DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX,
+                                      JOINT_LIMITS_RAD, LIFT, LIFT_RAD_CALIB, PITCH,
+                                      PLATFORM_TICK_S, TILT_RAD, WHEEL_MAX_SPEED_M_PER_S, YAW)
+from miro_ball.miro.interface import check_name
+from miro_ball.miro.kinematics import (clamp_wheel_speeds, cmd_vel2wheel_speed,
+                                       wheel_speed2cmd_vel)
+
+# Image channels, in the order of their numbers on the wire.
+CHANNELS = ('caml', 'camr', 'overhead', 'debug_caml', 'debug_camr')
+FRAME_HEADER = struct.Struct('<Bd')  # channel, stamp (s); then the JPEG
+MAX_FRAME_BYTES = 4 << 20  # a 1280x720 eye at quality 100 is well under 1 MB
+MAX_TEXT_CHARS = 4096  # the page's longest command is a few hundred characters
+
+# The MDK GUI's slider ranges where MiRo itself has no tighter limit.
+MAX_TURN_RAD_S = 5.0
+TONE_HZ = (200, 2000)
+TONE_VOLUME = (1, 255)
+TONE_TICKS = (1, 255)
+ARGB_MAX = 0xFFFFFFFF
+SIM_ACTIONS = ('pause', 'resume', 'step', 'reset')
+
+
+class Rejected(ValueError):
+    """A message that is ignored; the text says why (for a rate-limited warning)."""
+
+
+@dataclass(frozen=True)
+class Drive:
+    linear: float  # m/s forward
+    angular: float  # rad/s, counter-clockwise
+
+
+@dataclass(frozen=True)
+class Stop:
+    pass
+
+
+@dataclass(frozen=True)
+class Head:
+    positions: tuple  # [tilt, lift, yaw, pitch] rad, as control/kinematic_joints takes them
+
+
+@dataclass(frozen=True)
+class Cosmetic:
+    values: tuple  # droop, wag, eyelid l/r, ear l/r in 0..1
+
+
+@dataclass(frozen=True)
+class Illum:
+    leds: tuple  # six 0xAARRGGBB
+
+
+@dataclass(frozen=True)
+class Tone:
+    values: tuple  # frequency Hz, volume, duration in 20 ms ticks
+
+
+@dataclass(frozen=True)
+class Flags:
+    data: int  # control/flags
+
+
+@dataclass(frozen=True)
+class SimAction:
+    action: str  # one of SIM_ACTIONS
+
+
+@dataclass(frozen=True)
+class SelectRobot:
+    name: str
+
+
+@dataclass(frozen=True)
+class Ack:
+    channel: int  # the page has drawn the last frame of this channel
+
+
+def _reject_constant(name):
+    raise Rejected(f'{name} is not a number')
+
+
+def _number(msg, key, lo, hi, clamped):
+    value = msg.get(key)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise Rejected(f'{key} must be a number, got {value!r:.40}')
+    if not math.isfinite(value):
+        raise Rejected(f'{key} must be finite')
+    if not lo <= value <= hi:
+        clamped.append(key)
+        value = min(max(value, lo), hi)
+    return value
+
+
+def _integer(msg, key, lo, hi, clamped):
+    value = _number(msg, key, lo, hi, clamped)
+    if value != int(value):
+        raise Rejected(f'{key} must be an integer, got {value!r}')
+    return int(value)
+
+
+def _numbers(msg, key, ranges, clamped, integer=False):
+    """A list with one value per (lo, hi) of ranges, each checked like _number."""
+    values = msg.get(key)
+    if not isinstance(values, list) or len(values) != len(ranges):
+        raise Rejected(f'{key} must be a list of {len(ranges)} numbers')
+    pick = _integer if integer else _number
+    return tuple(pick({key: v}, key, lo, hi, clamped) for v, (lo, hi) in zip(values, ranges))
+
+
+def _drive(msg, clamped):
+    linear = _number(msg, 'linear', -WHEEL_MAX_SPEED_M_PER_S, WHEEL_MAX_SPEED_M_PER_S, clamped)
+    angular = _number(msg, 'angular', -MAX_TURN_RAD_S, MAX_TURN_RAD_S, clamped)
+    wanted = cmd_vel2wheel_speed(linear, angular)
+    wheels = clamp_wheel_speeds(*wanted)
+    if wheels != wanted:
+        clamped.append('wheel speed')
+        linear, angular = wheel_speed2cmd_vel(wheels)
+    return Drive(linear, angular)
+
+
+def _head(msg, clamped):
+    # Degrees on the page, like the MDK GUI; radians on the topic. Tilt is fixed.
+    positions = [TILT_RAD, 0.0, 0.0, 0.0]
+    for index, key in ((LIFT, 'lift'), (YAW, 'yaw'), (PITCH, 'pitch')):
+        lo, hi = JOINT_LIMITS_RAD[index]
+        positions[index] = math.radians(
+            _number(msg, key, math.degrees(lo), math.degrees(hi), clamped))
+        positions[index] = min(max(positions[index], lo), hi)  # rounding of the degrees
+    return Head(tuple(positions))
+
+
+def _flags(msg, clamped):
+    reflex = msg.get('cliff_reflex')
+    if not isinstance(reflex, bool):
+        raise Rejected('cliff_reflex must be true or false')
+    return Flags(0 if reflex else DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX)
+
+
+def _sim(msg, clamped):
+    action = msg.get('action')
+    if action not in SIM_ACTIONS:
+        raise Rejected(f'action must be one of {", ".join(SIM_ACTIONS)}')
+    return SimAction(action)
+
+
+def _robot(msg, clamped):
+    try:
+        return SelectRobot(check_name(msg.get('name')))
+    except ValueError as err:
+        raise Rejected(str(err)) from None
+
+
+def _ack(msg, clamped):
+    return Ack(_integer(msg, 'ch', 0, len(CHANNELS) - 1, []))
+
+
+# kind: (the keys it takes besides "t", builder)
+KINDS = {
+    'drive': (('linear', 'angular'), _drive),
+    'stop': ((), lambda msg, clamped: Stop()),
+    'head': (('lift', 'yaw', 'pitch'), _head),
+    'cosmetic': (('values',), lambda msg, clamped: Cosmetic(
+        _numbers(msg, 'values', [(0.0, 1.0)] * 6, clamped))),
+    'illum': (('leds',), lambda msg, clamped: Illum(
+        _numbers(msg, 'leds', [(0, ARGB_MAX)] * 6, clamped, integer=True))),
+    'tone': (('values',), lambda msg, clamped: Tone(
+        _numbers(msg, 'values', (TONE_HZ, TONE_VOLUME, TONE_TICKS), clamped, integer=True))),
+    'flags': (('cliff_reflex',), _flags),
+    'sim': (('action',), _sim),
+    'robot': (('name',), _robot),
+    'ack': (('ch',), _ack),
+}
+
+
+def parse(text):
+    """(command, names of the values that were clamped) of one text message, or Rejected."""
+    if not isinstance(text, str):
+        raise Rejected('not a text message')
+    if len(text) > MAX_TEXT_CHARS:
+        raise Rejected(f'message of {len(text)} characters (at most {MAX_TEXT_CHARS})')
+    try:
+        msg = json.loads(text, parse_constant=_reject_constant)
+    except (ValueError, RecursionError):
+        raise Rejected('not JSON') from None
+    if not isinstance(msg, dict):
+        raise Rejected('not a JSON object')
+    kind = msg.get('t')
+    if kind not in KINDS:
+        raise Rejected(f'unknown message kind {kind!r:.40}')
+    keys, build = KINDS[kind]
+    extra = set(msg) - set(keys) - {'t'}
+    if extra:
+        raise Rejected(f'{kind}: unknown keys {", ".join(sorted(map(str, extra)))[:80]}')
+    clamped = []
+    return build(msg, clamped), clamped
+
+
+def page_config():
+    """What the page needs to build its controls: MiRo's ranges, said here once."""
+    def degrees(index):
+        return [round(math.degrees(v), 6) for v in JOINT_LIMITS_RAD[index]]
+
+    return {'t': 'config', 'channels': CHANNELS,
+            'max_linear': WHEEL_MAX_SPEED_M_PER_S, 'max_angular': MAX_TURN_RAD_S,
+            'head': {'lift': degrees(LIFT), 'yaw': degrees(YAW), 'pitch': degrees(PITCH)},
+            'head_calib': {'lift': math.degrees(LIFT_RAD_CALIB), 'yaw': 0.0, 'pitch': 0.0},
+            'cosmetic_calib': COSMETIC_CALIB,
+            'tone': {'hz': TONE_HZ, 'volume': TONE_VOLUME, 'ticks': TONE_TICKS},
+            'tick_s': PLATFORM_TICK_S}
+
+
+def frame_message(channel, stamp, jpeg):
+    """The binary WebSocket message of one image."""
+    return FRAME_HEADER.pack(channel, stamp) + jpeg
