@@ -11,7 +11,7 @@ setup(
     # worlds/ is installed as the package miro_sim_bullet.worlds, so installed
     # code finds the bundled worlds with importlib.resources, whatever the prefix.
     package_dir={'miro_sim_bullet.worlds': 'worlds'},
-    package_data={'miro_sim_bullet.worlds': ['*.toml']},
+    package_data={'miro_sim_bullet.worlds': ['*.toml'], 'miro_ball.gui': ['static/*']},
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),
@@ -20,6 +20,7 @@ setup(
     python_requires='>=3.10',
     install_requires=[
         'setuptools',
+        'aiohttp',  # miro_gui's web server
         'numpy',
         'opencv-python-headless',
         'pybullet',
@@ -29,7 +30,7 @@ setup(
     extras_require={
         # Left out for users whose ROS 2 Jazzy is installed and sourced.
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
-        'test': ['pytest'],
+        'test': ['pytest', 'playwright'],
     },
     zip_safe=False,
     maintainer='miro_ball developers',
@@ -42,6 +43,7 @@ setup(
             'kick_blue_ball = miro_ball.controller.node:main',
             'ball_mover = miro_ball.examples.ball_mover:main',
             'record = miro_ball.record:main',
+            'miro_gui = miro_ball.gui.app:main',
             'grade = miro_ball.grade:main',
         ],
     },
