@@ -18,6 +18,7 @@ system_packages() {
   local want=()
   python3 -c 'import ensurepip' 2>/dev/null || want+=(python3-venv)
   have_egl || want+=(libegl1 libgl1-mesa-dri)
+  command -v chromium >/dev/null || want+=(chromium)  # the GUI's browser tests
   [ ${#want[@]} -eq 0 ] && return 0
   local sudo=""
   if [ "$(id -u)" -ne 0 ]; then
@@ -25,6 +26,7 @@ system_packages() {
       say "missing Debian packages: ${want[*]}"
       say "install them with: sudo apt-get install -y --no-install-recommends ${want[*]}"
       say "(without libegl1/libgl1-mesa-dri the simulator falls back to the slower TinyRenderer)"
+      say "(without chromium the browser tests of miro_gui are skipped)"
       return 0
     fi
   fi
