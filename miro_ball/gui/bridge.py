@@ -175,6 +175,7 @@ class GuiBridge(Node):
     def _make_state(self):
         watch = self.watch
         heard = watch.last_heard
+        rtf = self._rtf()
         self._state = json.dumps(r.jsonable({
             't': 'state',
             'robot': watch.topics.name,
@@ -183,7 +184,9 @@ class GuiBridge(Node):
             'readouts': watch.values,
             'age': time.monotonic() - heard if heard else None,
             'sim': {'present': self.sim_clients['reset'].service_is_ready(),
-                    'time': self.sim_time, 'rtf': self._rtf(), 'paused': self.sim_paused},
+                    'time': self.sim_time, 'rtf': rtf,
+                    # Known when paused from here; else guessed from time standing still.
+                    'paused': rtf == 0.0 if self.sim_paused is None else self.sim_paused},
             'status': self.status,
         }))
 
@@ -326,7 +329,8 @@ class GuiBridge(Node):
         now = time.monotonic()
         sim = msg.clock.sec + msg.clock.nanosec * 1e-9
         if self.sim_time is not None and sim < self.sim_time:
-            self._clock_samples.clear()  # a reset
+            self._clock_samples.clear()  # a reset, or a new simulator
+            self.sim_paused = None
         self.sim_time = sim
         self._clock_samples.append((now, sim))
         while self._clock_samples and now - self._clock_samples[0][0] > 2.0:

@@ -167,7 +167,11 @@ def _robot(msg, clamped):
 
 
 def _ack(msg, clamped):
-    return Ack(_integer(msg, 'ch', 0, len(CHANNELS) - 1, []))
+    out_of_range = []
+    channel = _integer(msg, 'ch', 0, len(CHANNELS) - 1, out_of_range)
+    if out_of_range:
+        raise Rejected(f'no image channel {msg["ch"]!r:.20}')
+    return Ack(channel)
 
 
 # kind: (the keys it takes besides "t", builder)

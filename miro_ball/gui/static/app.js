@@ -151,7 +151,7 @@ function showReadouts(readouts) {
     const v = get(readouts);
     const number = barValue ? barValue(readouts) : v;
     cell.textContent = v === undefined || v === null ? '-'
-      : decimals === null ? v : `${v.toFixed(decimals)}${unit ? ' ' + unit : ''}`;
+      : decimals === null ? v : `${v.toFixed(decimals).replace(/^-(0\.?0*)$/, '$1')}${unit ? ' ' + unit : ''}`;
     // A bar from zero (or the low end when zero is off the scale) to the value.
     const clamp = (x) => Math.min(Math.max(x, lo), hi);
     const zero = clamp(0);
