@@ -21,6 +21,7 @@ setup(
     install_requires=[
         'setuptools',
         'aiohttp',  # miro_gui's web server
+        'moderngl',  # the eye renderer (OpenGL on a headless EGL context)
         'numpy',
         'opencv-python-headless',
         'pybullet',

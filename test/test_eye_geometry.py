@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from miro_ball.miro.constants import LIFT_RAD_CALIB
+from miro_ball.controller.detection import BallDetector
 from miro_ball.miro.camera import Intrinsics, project
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.renderer import probe_egl, view_matrix_from_pose
@@ -38,9 +39,14 @@ def test_eyes_sit_where_the_mdk_puts_them():
     world.close()
 
 
-def blue_centroid(rgb):
+def blue_mask(rgb):
+    """Pixels of the blue ball, lit or in the shade (ambient 0.4 alone gives b = 102)."""
     r, g, b = (rgb[:, :, i].astype(int) for i in range(3))
-    mask = (b > 100) & (r < 60) & (g < 60)
+    return (b > 80) & (r < 60) & (g < 60)
+
+
+def blue_centroid(rgb):
+    mask = blue_mask(rgb)
     if mask.sum() < 5:
         return None
     v, u = np.nonzero(mask)
@@ -75,16 +81,23 @@ def test_ball_appears_where_the_pinhole_model_predicts(sim, size, ball_xy, seen_
             assert found is None
 
 
-def test_ball_is_blue_after_jpeg(sim):
+def test_ball_is_blue_after_jpeg_and_nothing_else_is(sim):
+    """What the controller relies on: after JPEG, its own colour mask covers the ball, lit
+    side and shaded side, and nothing else (floor, walls, sky, the robot)."""
     intrinsics = Intrinsics.from_hfov(640, 360, 120.0)
-    sim.place_ball(1.0, 0.2)
-    sim.run(0.2)
-    rgb, = sim.render_eyes([(sim.robot, +1)], intrinsics)
-    ok, jpeg = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
-    bgr = cv2.imdecode(jpeg, cv2.IMREAD_COLOR)
-    u, v = (int(round(c)) for c in blue_centroid(rgb))
-    b, g, r = bgr[v, u]
-    assert b > 150 and g < 60 and r < 60
+    detector = BallDetector()
+    for xy in ((1.0, 0.2), (0.5, 0.1), (0.7, 0.4)):
+        sim.place_ball(*xy)
+        sim.run(0.2)
+        rgb, = sim.render_eyes([(sim.robot, +1)], intrinsics)
+        ok, jpeg = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+        seen = detector.mask(cv2.imdecode(jpeg, cv2.IMREAD_COLOR)) > 0
+        ball = blue_mask(rgb)
+        inner = cv2.erode(ball.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+        outside = cv2.dilate(ball.astype(np.uint8), np.ones((7, 7), np.uint8)) == 0
+        assert inner.sum() > 30, xy
+        assert seen[inner].mean() > 0.98, xy
+        assert not seen[outside].any(), xy
 
 
 def test_eye_worker_processes_render_exactly_what_the_simulator_would():

@@ -1,5 +1,5 @@
-"""Renderer geometry, colours and the EGL plugin's process-level traps."""
-import ctypes
+"""Both renderers: pinhole geometry, colours, image format, the overhead view, several
+robots, world resets, and the fallback when there is no EGL."""
 import math
 import os
 import subprocess
@@ -10,10 +10,13 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from miro_ball.miro.camera import Intrinsics, project
+from miro_sim_bullet.physics.world import SimWorld
+from miro_sim_bullet.render import gl_renderer
 from miro_sim_bullet.render import renderer as rendering
-from miro_ball.miro.camera import Intrinsics
+from miro_sim_bullet.render.overhead import overhead_camera
 from miro_sim_bullet.render.renderer import (opengl_projection, probe_egl, Renderer,
-                                       RendererUnavailable, view_matrix_from_pose)
+                                             RendererUnavailable, view_matrix_from_pose)
 
 BALL_RADIUS = 0.05
 CAMERA_POSITION = np.array([0.2, -0.1, 1.6])
@@ -32,30 +35,29 @@ SPOTS = [(0.0, 0.0, 1.0), (0.8, 0.3, 1.0), (-0.85, -0.7, 0.8), (0.5, 0.85, 1.2),
          (-0.9, 0.85, 1.0), (0.9, -0.85, 0.9)]
 SIZES = [(640, 360, 120.0), (320, 240, 90.0), (1280, 720, 120.0)]
 BLUE, RED = (0, 0, 1, 1), (1, 0, 0, 1)
-
-
-def require_egl():
-    ok, reason = probe_egl()
-    if not ok:
-        pytest.skip(reason)
+KINDS = ['tiny', pytest.param('egl', marks=pytest.mark.skipif(
+    not probe_egl()[0], reason='EGL unavailable: ' + probe_egl()[1]))]
+requires_egl = pytest.mark.skipif(not probe_egl()[0],
+                                  reason='EGL unavailable: ' + probe_egl()[1])
 
 
 class World:
     """A DIRECT client with a grey ground, a blue and a red ball, and a Renderer."""
 
-    def __init__(self, kind, **renderer_args):
+    def __init__(self, kind):
         self.client = p.connect(p.DIRECT)
         self.log = []
-        self.renderer = Renderer(self.client, kind, log=self.log.append, **renderer_args)
+        self.renderer = Renderer(self.client, kind, log=self.log.append)
         self.body(p.GEOM_BOX, (0.5, 0.5, 0.5, 1), (0, 0, -0.05), halfExtents=(20, 20, 0.05))
-        self.blue = self.body(p.GEOM_SPHERE, BLUE, (3, 0, 5), radius=BALL_RADIUS)
-        self.red = self.body(p.GEOM_SPHERE, RED, (3, 0, 6), radius=BALL_RADIUS)
+        self.blue = self.body(p.GEOM_SPHERE, BLUE, (3, 0, 5), radius=BALL_RADIUS, mass=1)
+        self.red = self.body(p.GEOM_SPHERE, RED, (3, 0, 6), radius=BALL_RADIUS, mass=1)
+        self.renderer.scene_changed()
         self.view = view_matrix_from_pose(CAMERA_POSITION, CAMERA_ROTATION)
 
-    def body(self, shape, rgba, position, **size):
+    def body(self, shape, rgba, position, mass=0, **size):
         visual = p.createVisualShape(shape, rgbaColor=rgba, physicsClientId=self.client,
                                      **size)
-        return p.createMultiBody(0, -1, visual, basePosition=position,
+        return p.createMultiBody(mass, -1, visual, basePosition=position,
                                  physicsClientId=self.client)
 
     def place(self, ball, camera_point):
@@ -67,25 +69,34 @@ class World:
                                           physicsClientId=self.client)
 
     def close(self):
-        """Close the renderer, then the client (twice is harmless)."""
         self.renderer.close()
-        if p.getConnectionInfo(self.client)['isConnected']:
-            p.disconnect(self.client)
+        p.disconnect(self.client)
 
 
 @pytest.fixture
 def worlds():
     made = []
 
-    def make(kind, **renderer_args):
-        if kind == 'egl':
-            require_egl()
-        made.append(World(kind, **renderer_args))
+    def make(kind):
+        made.append(World(kind))
         return made[-1]
 
     yield make
     for world in reversed(made):
         world.close()
+
+
+@pytest.fixture
+def sims():
+    made = []
+
+    def make(world, kind, **kw):
+        made.append(SimWorld(world, renderer=kind, log=lambda _: None, **kw))
+        return made[-1]
+
+    yield make
+    for sim in made:
+        sim.close()
 
 
 def camera_point(intrinsics, spot):
@@ -111,17 +122,22 @@ def predicted_centroid(intrinsics, point):
     return (k.cx + k.fx * middle * x / z / off_axis, k.cy + k.fy * middle * y / z / off_axis)
 
 
-def centroid(image, colour):
-    """Centroid (u, v) of the pixels that are clearly ``colour`` ('blue' or 'red')."""
+def colour_mask(image, colour):
+    """Pixels that are clearly ``colour`` ('blue' or 'red'), lit or shaded."""
     r, g, b = (image[:, :, i].astype(int) for i in range(3))
-    mask = (b > 100) & (r < 50) & (g < 50) if colour == 'blue' else \
-        (r > 100) & (g < 50) & (b < 50)
-    vs, us = np.nonzero(mask)
+    if colour == 'blue':
+        return (b > 80) & (r < 50) & (g < 50)
+    return (r > 80) & (g < 50) & (b < 50)
+
+
+def centroid(image, colour):
+    """Centroid (u, v) of the pixels that are clearly ``colour``."""
+    vs, us = np.nonzero(colour_mask(image, colour))
     assert len(us) > 20, f'no {colour} blob in the image'
     return us.mean(), vs.mean()
 
 
-@pytest.mark.parametrize('kind', ['tiny', 'egl'])
+@pytest.mark.parametrize('kind', KINDS)
 @pytest.mark.parametrize('width,height,hfov', SIZES)
 def test_ball_lands_where_the_intrinsics_say(worlds, kind, width, height, hfov):
     world = worlds(kind)
@@ -141,6 +157,7 @@ def test_ball_lands_where_the_intrinsics_say(worlds, kind, width, height, hfov):
             assert np.hypot(got[0] - want[0], got[1] - want[1]) < 1.5, (colour, spot, got, want)
 
 
+@requires_egl
 def test_tiny_and_egl_agree(worlds):
     tiny, egl = worlds('tiny'), worlds('egl')
     intrinsics = Intrinsics.from_hfov(640, 360, 120.0)
@@ -150,6 +167,184 @@ def test_tiny_and_egl_agree(worlds):
         a = centroid(tiny.renderer.render(tiny.view, intrinsics), 'blue')
         b = centroid(egl.renderer.render(egl.view, intrinsics), 'blue')
         assert np.hypot(a[0] - b[0], a[1] - b[1]) < 0.5, (spot, a, b)
+
+
+@pytest.mark.parametrize('kind', KINDS)
+def test_images_are_contiguous_rgb_bytes_of_the_asked_size(worlds, kind):
+    """What convert.py's Image and JPEG encoding take: C-contiguous (h, w, 3) uint8."""
+    world = worlds(kind)
+    sizes = [Intrinsics.from_hfov(w, h, 90.0) for w, h in ((320, 240), (640, 360), (64, 48))]
+    for intrinsics in sizes:
+        images = world.renderer.render_many([world.view] * 3, intrinsics)
+        assert len(images) == 3
+        for image in images:
+            assert image.shape == (intrinsics.height, intrinsics.width, 3)
+            assert image.dtype == np.uint8 and image.flags['C_CONTIGUOUS']
+    assert world.renderer.render_many([], sizes[0]) == []
+
+
+@requires_egl
+def test_colours_sun_and_ambient(worlds):
+    """Sky Gazebo grey; the grey ground lit by the sun (ambient 0.4 + 0.8 x the sun's
+    cosine); the blue ball blue on its sunny and its shaded side."""
+    world = worlds('egl')
+    intrinsics = Intrinsics.from_hfov(320, 240, 90.0)
+    world.place(world.blue, (0.0, 0.0, 0.5))
+    image = world.renderer.render(world.view, intrinsics).astype(int)
+    sky = np.round(255 * np.array(gl_renderer.SKY))
+    assert np.abs(image[2, 160] - sky).max() <= 1  # top row: above the horizon
+    sun_cos = 1 / np.linalg.norm(gl_renderer.SUN_DIRECTION)
+    ground = 255 * 0.5 * (gl_renderer.AMBIENT + gl_renderer.DIFFUSE * sun_cos)
+    assert np.abs(image[235, 160] - ground).max() <= 2  # bottom row: the ground
+    blue = image[colour_mask(image, 'blue')]
+    assert len(blue) > 500
+    assert blue[:, 2].max() > 230  # the side facing the sun
+    assert blue[:, 2].min() == pytest.approx(255 * gl_renderer.AMBIENT, abs=3)  # the shade
+    assert (blue[:, :2] == 0).all()
+
+
+@requires_egl
+def test_led_colour_changes_are_drawn(sims):
+    """Visual colours can change at run time (control/illum): every frame reads them."""
+    sim = sims('empty', 'egl')
+    robot = sim.robot
+    # A camera 0.5 m to the robot's left, looking at its flank.
+    rotation = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    intrinsics = Intrinsics.from_hfov(320, 240, 60.0)
+    x, y, _ = robot.pose()
+    view = (np.array([x, y + 0.5, 0.1]), rotation)
+    before = sim.render_view(*view, intrinsics)
+    robot.set_illum([0xFFFF0000] * 6)
+    after = sim.render_view(*view, intrinsics)
+    assert colour_mask(before, 'red').sum() == 0
+    assert colour_mask(after, 'red').sum() > 50
+
+
+@pytest.mark.parametrize('kind', KINDS)
+def test_overhead_view_shows_ball_and_robots_where_they_are(sims, kind):
+    """The football pitch from above: the ball where the pinhole model puts it, and the
+    white and grey robots, not the green pitch, at the three robots' poses."""
+    sim = sims('football_pitch', kind)
+    position, rotation, intrinsics = overhead_camera(sim.description)
+    image = sim.render_view(position, rotation, intrinsics)
+    assert image.shape == (intrinsics.height, intrinsics.width, 3)
+    want = project(intrinsics, position, rotation, sim.ball_position())
+    got = centroid(image, 'blue')
+    assert math.dist(got, want) < 1.5
+    for robot in sim.robots.values():
+        body, _ = robot.model.body_frame()
+        u, v = (round(c) for c in project(intrinsics, position, rotation, body))
+        r, g, b = image[v - 2:v + 3, u - 2:u + 3].astype(int).transpose(2, 0, 1)
+        assert (abs(g - r) < 10).all() and (abs(g - b) < 10).all(), robot.name
+    r, g, _ = image[intrinsics.height // 2 + 30, intrinsics.width // 2].astype(int)
+    assert g - r > 50  # between the robots: the pitch
+
+
+@requires_egl
+def test_all_eyes_in_one_pass_equal_eyes_one_by_one(sims):
+    """The six eyes of the football pitch drawn together, also split over several passes
+    when the framebuffer holds fewer, are the images each eye gets on its own."""
+    sim = sims('football_pitch', 'egl')
+    sim.run(0.3)
+    intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
+    requests = [(robot, side) for robot in sim.robots.values() for side in (1, -1)]
+    together = sim.render_eyes(requests, intrinsics)
+    alone = [sim.render_eyes([request], intrinsics)[0] for request in requests]
+    gl = sim.renderer._backend.gl
+    gl.max_height = 2 * intrinsics.height + 1  # two views per pass
+    in_passes = sim.render_eyes(requests, intrinsics)
+    for a, b, c in zip(together, alone, in_passes):
+        assert np.array_equal(a, b) and np.array_equal(a, c)
+    # Each robot sees the others: no two eyes see the same picture.
+    assert len({image.tobytes() for image in together}) == 6
+
+
+@pytest.mark.parametrize('kind', KINDS)
+def test_renderer_survives_a_world_reset(sims, kind):
+    sim = sims('miro', kind)
+    intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
+    first = sim.render_eyes([(sim.robot, -1)], intrinsics)[0]
+    sim.place_ball(0.3, 0.4)
+    sim.robot.set_cmd_vel(0.2, 1.0)
+    sim.run(1.0)
+    moved = sim.render_eyes([(sim.robot, -1)], intrinsics)[0]
+    sim.reset()
+    again = sim.render_eyes([(sim.robot, -1)], intrinsics)[0]
+    assert not np.array_equal(first, moved)
+    assert np.array_equal(first, again)
+    pos, rot = sim.robot.eye_pose(-1)
+    want = project(intrinsics, pos, rot, sim.ball_position())
+    assert math.dist(centroid(again, 'blue'), want) < 3.0
+
+
+@requires_egl
+def test_egl_renderers_coexist_and_render_from_any_thread(worlds):
+    """Two worlds in one process, each with its own context, rendered alternately and
+    from another thread, keep their own scenes."""
+    a, b = worlds('egl'), worlds('egl')
+    intrinsics = Intrinsics.from_hfov(320, 240, 90.0)
+    a.place(a.blue, (0.2, 0.0, 1.0))
+    b.place(b.blue, (-0.2, 0.0, 1.0))
+    images = []
+    thread = threading.Thread(target=lambda: images.append(a.renderer.render(a.view,
+                                                                            intrinsics)))
+    thread.start()
+    thread.join()
+    images.append(b.renderer.render(b.view, intrinsics))
+    images.append(a.renderer.render(a.view, intrinsics))
+    assert centroid(images[0], 'blue')[0] > intrinsics.cx + 20
+    assert centroid(images[1], 'blue')[0] < intrinsics.cx - 20
+    assert np.array_equal(images[0], images[2])
+
+
+def test_no_egl_falls_back_to_tiny_with_one_log_line(monkeypatch):
+    monkeypatch.setattr(rendering, 'probe_egl', lambda: (False, 'no EGL on this box'))
+    log = []
+    sim = SimWorld('miro', renderer='auto', log=log.append)
+    try:
+        assert sim.renderer.name == 'tiny'
+        assert log == ['camera renderer: tiny (no EGL on this box; falling back to '
+                       'TinyRenderer)']
+        image = sim.render_eyes([(sim.robot, 1)], Intrinsics.from_hfov(320, 240, 120.0))[0]
+        assert image.shape == (240, 320, 3)
+        client = p.connect(p.DIRECT)
+        try:
+            with pytest.raises(RendererUnavailable, match='no EGL on this box'):
+                Renderer(client, 'egl', log=lambda _: None)
+        finally:
+            p.disconnect(client)
+    finally:
+        sim.close()
+
+
+@requires_egl
+def test_egl_logs_the_device_that_renders():
+    log = []
+    sim = SimWorld('empty', renderer='auto', log=log.append)
+    try:
+        assert sim.renderer.name == 'egl' and sim.renderer.device
+        assert log == [f'camera renderer: egl (rendering on {sim.renderer.device})']
+    finally:
+        sim.close()
+
+
+def run_probe_in_child(**env_changes):
+    env = dict(os.environ, **env_changes)
+    code = 'from miro_sim_bullet.render.renderer import probe_egl; print(probe_egl())'
+    done = subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.strip().splitlines()[-1]
+
+
+def test_probe_reports_a_broken_egl_instead_of_dying():
+    result = run_probe_in_child(LIBGL_DRIVERS_PATH='/nonexistent')
+    assert result.startswith('(False, ') and 'EGL' in result, result
+
+
+@requires_egl
+def test_probe_survives_egl_platform_device():
+    assert run_probe_in_child(EGL_PLATFORM='device').startswith('(True, ')
 
 
 def test_projection_matches_pinhole_model_and_tiles():
@@ -190,143 +385,3 @@ def test_view_matrix_follows_rep103_link_axes():
     np.testing.assert_allclose(to_camera([2, 0, 0]), [0, 0, -2], atol=1e-6)
     np.testing.assert_allclose(to_camera([0, 1, 0]), [-1, 0, 0], atol=1e-6)
     np.testing.assert_allclose(to_camera([0, 0, 1]), [0, 1, 0], atol=1e-6)
-
-
-def run_probe_in_child(**env_changes):
-    env = dict(os.environ, **env_changes)
-    code = 'from miro_sim_bullet.render.renderer import probe_egl; print(probe_egl())'
-    done = subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,
-                          text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    return done.stdout.strip().splitlines()[-1]
-
-
-@pytest.mark.parametrize('env', [{'GALLIUM_DRIVER': 'softpipe'},
-                                 {'LIBGL_DRIVERS_PATH': '/nonexistent'}])
-def test_probe_reports_a_broken_egl_instead_of_dying(env):
-    result = run_probe_in_child(**env)
-    assert result.startswith('(False, ') and 'EGL' in result, result
-
-
-def test_probe_survives_egl_platform_device():
-    require_egl()
-    assert run_probe_in_child(EGL_PLATFORM='device').startswith('(True, ')
-
-
-def test_kind_egl_without_egl_raises(monkeypatch):
-    monkeypatch.setattr(rendering, 'probe_egl', lambda: (False, 'no EGL on this box'))
-    client = p.connect(p.DIRECT)
-    try:
-        with pytest.raises(RendererUnavailable, match='no EGL on this box'):
-            Renderer(client, 'egl', log=lambda _: None)
-        log = []
-        with Renderer(client, 'auto', log=log.append) as renderer:
-            assert renderer.name == 'tiny' and 'no EGL on this box' in log[0]
-    finally:
-        p.disconnect(client)
-
-
-def test_renderer_refuses_a_populated_client():
-    client = p.connect(p.DIRECT)
-    try:
-        p.createMultiBody(0, -1, p.createVisualShape(p.GEOM_SPHERE, physicsClientId=client),
-                          physicsClientId=client)
-        with pytest.raises(ValueError, match='before adding bodies'):
-            Renderer(client, 'auto', log=lambda _: None)
-        Renderer(client, 'tiny', log=lambda _: None).close()
-    finally:
-        p.disconnect(client)
-
-
-def test_egl_worlds_come_and_go(worlds):
-    """Create, render and close EGL worlds one after another, as tests and resets do; one
-    world is disconnected before its renderer is closed."""
-    require_egl()
-    intrinsics = Intrinsics.from_hfov(320, 240, 90.0)
-    for i in range(5):
-        world = World('egl')
-        assert world.renderer.name == 'egl'
-        world.place(world.blue, (0.1 * i, 0.0, 1.0))
-        centroid(world.renderer.render(world.view, intrinsics), 'blue')
-        if i == 2:
-            p.disconnect(world.client)
-            world.renderer.close()
-        else:
-            world.close()
-
-
-def test_one_egl_renderer_per_process(worlds):
-    first = worlds('egl')
-    second = worlds('auto')
-    assert second.renderer.name == 'tiny'
-    assert any('another EGL Renderer' in line for line in second.log), second.log
-    client = p.connect(p.DIRECT)
-    try:
-        with pytest.raises(RendererUnavailable, match='another EGL Renderer'):
-            Renderer(client, 'egl', log=lambda _: None)
-    finally:
-        p.disconnect(client)
-    first.close()
-    third = worlds('egl')
-    assert third.renderer.name == 'egl'
-
-
-def in_thread(function):
-    """Run ``function`` in a new thread; return what it raised, if anything."""
-    raised = []
-
-    def run():
-        try:
-            function()
-        except Exception as exc:  # noqa: B902 -- handed back to the test
-            raised.append(exc)
-
-    thread = threading.Thread(target=run)
-    thread.start()
-    thread.join()
-    return raised[0] if raised else None
-
-
-def test_egl_renderer_is_bound_to_its_thread(worlds):
-    """Rendering elsewhere would segfault in the plugin; it raises instead. Closing from
-    another thread is fine and frees the plugin for the next renderer."""
-    world = worlds('egl')
-    intrinsics = Intrinsics.from_hfov(64, 48, 90.0)
-    error = in_thread(lambda: world.renderer.render(world.view, intrinsics))
-    assert isinstance(error, RuntimeError) and 'thread' in str(error)
-    world.renderer.render(world.view, intrinsics)  # still fine in its own thread
-    assert in_thread(world.renderer.close) is None
-    with pytest.raises(RuntimeError, match='closed'):
-        world.renderer.render(world.view, intrinsics)
-    assert worlds('egl').renderer.name == 'egl'
-
-
-def test_shadow_pass_switch(worlds):
-    """The stock plugin keeps the flag set; the default clears it. Both images agree."""
-    intrinsics = Intrinsics.from_hfov(320, 240, 90.0)
-    centroids = []
-    for shadow_pass, name in ((True, 'egl (stock, shadow pass on)'), (False, 'egl')):
-        world = worlds('egl', egl_shadow_pass=shadow_pass)
-        assert world.renderer.name == name
-        assert shadow_map_flag() == int(shadow_pass)
-        world.place(world.blue, (0.1, 0.05, 1.0))
-        centroids.append(centroid(world.renderer.render(world.view, intrinsics), 'blue'))
-        world.close()
-    assert np.allclose(centroids[0], centroids[1], atol=0.3), centroids
-
-
-def shadow_map_flag():
-    path = os.path.realpath(rendering.egl_plugin_path())
-    address = rendering._runtime_address(path, *rendering._shadow_symbol(path))
-    return ctypes.c_uint8.from_address(address).value
-
-
-@pytest.mark.parametrize('path', ['/bin/true', __file__])
-def test_shadow_symbol_lookup_rejects_other_files(path):
-    with pytest.raises(rendering._PatchError):
-        rendering._shadow_symbol(path)
-
-
-def test_shadow_flag_is_only_written_inside_the_loaded_plugin():
-    with pytest.raises(rendering._PatchError, match='0 mappings'):
-        rendering._runtime_address('/nonexistent/plugin.so', 0x1000, 0)

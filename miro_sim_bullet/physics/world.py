@@ -46,7 +46,6 @@ class SimWorld:
         self.dt = physics_dt
         self.ticks_per_platform_tick = max(1, round(PLATFORM_TICK_S / physics_dt))
         self.client = pb.connect(pb.DIRECT)
-        # Before any body exists: the EGL plugin only sees bodies created after it.
         self.renderer = None if renderer is None else Renderer(self.client, kind=renderer,
                                                                log=log)
         self._build()
@@ -97,6 +96,8 @@ class SimWorld:
                               ray_mask=ALL_GROUPS & ~robot_group(index))
             robot.model.set_collision_filter(robot_group(index), ALL_GROUPS)
             self.robots[name] = robot
+        if self.renderer is not None:
+            self.renderer.scene_changed()  # new bodies (a reset rebuilds them all)
 
     def _shape(self, shape):
         kw = self._kw()
@@ -191,7 +192,7 @@ class SimWorld:
         this instant."""
         views = [view_matrix_from_pose(*robot.eye_pose(side)) for robot, side in requests]
         if self.eye_workers is None:
-            return [self.renderer.render(view, intrinsics) for view in views]
+            return self.renderer.render_many(views, intrinsics)
         return self.eye_workers.render(self.snapshot(), views, intrinsics)
 
     def render_view(self, position, rotation, intrinsics):

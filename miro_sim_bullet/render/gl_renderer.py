@@ -1,0 +1,361 @@
+"""Our own OpenGL renderer: moderngl on a headless EGL context (Mesa llvmpipe, or a GPU).
+
+PyBullet's getCameraImage spends most of its time copying pixels on the CPU and renders
+one view per call. This renderer draws the client's visual shapes itself, from the poses
+PyBullet reports, with instanced primitive meshes (box, sphere, cylinder; a capsule is a
+cylinder and two spheres) and per-vertex lighting like the MDK worlds' (a sun from
+SUN_DIRECTION, ambient 0.4). Several views (both eyes of every robot) go into one
+framebuffer, stacked vertically, and come back in one read-back.
+
+Images follow the pinhole model of :func:`renderer.opengl_projection`. The projection is
+flipped vertically so that the first row read back is the top row of the image: no copy.
+"""
+import functools
+import math
+import os
+
+import numpy as np
+import pybullet as p
+
+SUN_DIRECTION = (-0.5, 0.5, -1.0)  # where the sun's light travels (MDK worlds)
+AMBIENT = 0.4
+DIFFUSE = 0.8
+SKY = (0.7, 0.7, 0.7)  # Gazebo's background grey
+
+_VERTEX_SHADER = """
+#version 330
+uniform mat4 view_projection;
+uniform vec3 to_sun;
+in vec3 in_position;
+in vec3 in_normal;
+in vec3 in_r0;
+in vec3 in_r1;
+in vec3 in_r2;
+in vec3 in_offset;
+in vec3 in_scale;
+in vec3 in_colour;
+out vec3 v_colour;
+void main() {
+    mat3 rotation = mat3(in_r0, in_r1, in_r2);
+    vec3 world = rotation * (in_scale * in_position) + in_offset;
+    vec3 normal = normalize(rotation * (in_normal / in_scale));
+    float light = %(ambient)f + %(diffuse)f * max(dot(normal, to_sun), 0.0);
+    v_colour = min(in_colour * light, vec3(1.0));
+    gl_Position = view_projection * vec4(world, 1.0);
+}
+"""
+_FRAGMENT_SHADER = """
+#version 330
+in vec3 v_colour;
+out vec4 f_colour;
+void main() {
+    f_colour = vec4(v_colour, 1.0);
+}
+"""
+# Per instance: rotation columns, offset, scale, colour (18 floats).
+_INSTANCE_FORMAT = '3f 3f 3f 3f 3f 3f/i'
+_INSTANCE_ATTRIBUTES = ('in_r0', 'in_r1', 'in_r2', 'in_offset', 'in_scale', 'in_colour')
+_MESHES = ('box', 'sphere', 'cylinder')
+_MIN_SCALE = 1e-6  # flat shapes still get finite normals
+
+
+class GlUnavailable(RuntimeError):
+    """No usable EGL/OpenGL 3.3 context here; str() is one line for the user."""
+
+
+# --------------------------------------------------------------------------- meshes
+
+def _box_mesh():
+    """Unit cube centred on the origin: (vertices (n, 6) position+normal, indices)."""
+    vertices, indices = [], []
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            normal = np.zeros(3)
+            normal[axis] = sign
+            u = np.zeros(3)
+            u[(axis + 1) % 3] = 1.0
+            v = np.cross(normal, u)  # (u, v, normal) right-handed: counter-clockwise outside
+            base = len(vertices)
+            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                vertices.append([*(0.5 * (normal + a * u + b * v)), *normal])
+            indices += [base, base + 1, base + 2, base, base + 2, base + 3]
+    return np.array(vertices, 'f4'), np.array(indices, 'i4')
+
+
+def _sphere_mesh(slices=24, stacks=16):
+    """Unit-radius sphere."""
+    vertices = []
+    for i in range(stacks + 1):
+        polar = math.pi * i / stacks
+        for j in range(slices + 1):
+            azimuth = 2 * math.pi * j / slices
+            n = (math.sin(polar) * math.cos(azimuth), math.sin(polar) * math.sin(azimuth),
+                 math.cos(polar))
+            vertices.append([*n, *n])
+    indices = []
+    for i in range(stacks):
+        for j in range(slices):
+            a, b = i * (slices + 1) + j, (i + 1) * (slices + 1) + j
+            indices += [a, b, a + 1, a + 1, b, b + 1]
+    return np.array(vertices, 'f4'), np.array(indices, 'i4')
+
+
+def _cylinder_mesh(slices=32):
+    """Unit radius, unit length along z, centred on the origin: side and two caps."""
+    vertices, indices = [], []
+    ring = [(math.cos(2 * math.pi * j / slices), math.sin(2 * math.pi * j / slices))
+            for j in range(slices + 1)]
+    for x, y in ring:  # side: pairs (bottom, top) with radial normals
+        vertices += [[x, y, -0.5, x, y, 0.0], [x, y, 0.5, x, y, 0.0]]
+    for j in range(slices):
+        a = 2 * j
+        indices += [a, a + 2, a + 1, a + 1, a + 2, a + 3]
+    for z in (0.5, -0.5):
+        centre = len(vertices)
+        vertices.append([0.0, 0.0, z, 0.0, 0.0, 2 * z])
+        for x, y in ring:
+            vertices.append([x, y, z, 0.0, 0.0, 2 * z])
+        for j in range(slices):
+            a, b = centre + 1 + j, centre + 2 + j
+            indices += [centre, a, b] if z > 0 else [centre, b, a]
+    return np.array(vertices, 'f4'), np.array(indices, 'i4')
+
+
+# ----------------------------------------------------------------- scene description
+
+def _matrices(quaternions):
+    """(n, 3, 3) rotation matrices of (n, 4) quaternions x, y, z, w."""
+    x, y, z, w = np.asarray(quaternions, float).T
+    return np.stack([
+        1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
+        2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+        2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        axis=-1).reshape(-1, 3, 3)
+
+
+class _Body:
+    """The instances of one body's visual shapes, in its link frames.
+
+    Arrays per instance: mesh (index into _MESHES), link (-1 = base), entry (index into
+    getVisualShapeData, for colours that change), local rotation and offset, scale.
+    """
+
+    def __init__(self, client, body):
+        self.client, self.body = client, body
+        kw = {'physicsClientId': client}
+        self.links = p.getNumJoints(body, **kw)
+        info = p.getDynamicsInfo(body, -1, **kw)
+        self.static = info[0] == 0 and self.links == 0
+        # PyBullet reports a base by its centre of mass; visuals hang off the link frame.
+        inertial_rot = _matrices([info[4]])[0]
+        self.base_to_link = (inertial_rot.T, -inertial_rot.T @ np.asarray(info[3]))
+        mesh, link, entry, rot, offset, scale = [], [], [], [], [], []
+        for index, shape in enumerate(p.getVisualShapeData(body, **kw)):
+            geometry, dims, position, orientation = shape[2], shape[3], shape[5], shape[6]
+            local_rot = _matrices([orientation])[0]
+            for kind, shift, size in _parts(geometry, dims):
+                mesh.append(_MESHES.index(kind))
+                link.append(shape[1])
+                entry.append(index)
+                rot.append(local_rot)
+                offset.append(np.asarray(position) + local_rot @ shift)
+                scale.append(np.maximum(size, _MIN_SCALE))
+        self.mesh = np.array(mesh, int)
+        self.link = np.array(link, int)
+        self.entry = np.array(entry, int)
+        self.rot = np.array(rot).reshape(-1, 3, 3)
+        self.offset = np.array(offset).reshape(-1, 3)
+        self.scale = np.array(scale).reshape(-1, 3)
+
+    def instances(self):
+        """(n, 18) float32 rows in _INSTANCE_FORMAT for the body's current state."""
+        kw = {'physicsClientId': self.client}
+        position, orientation = p.getBasePositionAndOrientation(self.body, **kw)
+        com_rot = _matrices([orientation])[0]
+        to_link_rot, to_link_offset = self.base_to_link
+        positions = [np.asarray(position) + com_rot @ to_link_offset]
+        rotations = [com_rot @ to_link_rot]
+        if self.links:
+            states = p.getLinkStates(self.body, range(self.links),
+                                     computeForwardKinematics=1, **kw)
+            positions += [s[4] for s in states]
+            rotations += list(_matrices([s[5] for s in states]))
+        frame_rot = np.array(rotations)[self.link + 1]
+        frame_pos = np.array(positions)[self.link + 1]
+        colours = np.array([s[7][:3] for s in p.getVisualShapeData(self.body, **kw)])
+        rot = frame_rot @ self.rot
+        rows = np.empty((len(self.mesh), 18), 'f4')
+        rows[:, 0:9] = rot.transpose(0, 2, 1).reshape(-1, 9)  # columns of each rotation
+        rows[:, 9:12] = frame_pos + np.einsum('nij,nj->ni', frame_rot, self.offset)
+        rows[:, 12:15] = self.scale
+        rows[:, 15:18] = colours[self.entry]
+        return rows
+
+
+def _parts(geometry, dims):
+    """[(mesh, shift along the shape's frame, scale)] drawing one PyBullet visual shape."""
+    zero = np.zeros(3)
+    if geometry == p.GEOM_BOX:
+        return [('box', zero, np.asarray(dims[:3], float))]
+    if geometry == p.GEOM_SPHERE:
+        return [('sphere', zero, np.full(3, dims[0]))]
+    length, radius = dims[0], dims[1]
+    parts = [('cylinder', zero, np.array([radius, radius, length]))]
+    if geometry == p.GEOM_CAPSULE:
+        parts += [('sphere', np.array([0.0, 0.0, sign * length / 2]), np.full(3, radius))
+                  for sign in (1, -1)]
+    elif geometry != p.GEOM_CYLINDER:
+        return []  # meshes and planes do not occur in our worlds
+    return parts
+
+
+# ------------------------------------------------------------------------ the renderer
+
+@functools.lru_cache(maxsize=1)
+def probe_egl():
+    """(ok, one-line reason): whether an EGL OpenGL 3.3 context can be made here. Decided
+    once per process; a failing EGL raises in moderngl, it does not end the process."""
+    try:
+        context = _create_context()
+    except GlUnavailable as exc:
+        return False, str(exc)
+    name = context.info['GL_RENDERER']
+    context.release()
+    return True, f'EGL works: {name}'
+
+
+def _create_context():
+    try:
+        import moderngl
+    except ImportError as exc:
+        raise GlUnavailable(f'moderngl is not installed ({exc})') from None
+    if os.environ.get('EGL_PLATFORM') == 'device':
+        os.environ.pop('EGL_PLATFORM')  # breaks eglGetDisplay in Mesa's loader
+    try:
+        return moderngl.create_standalone_context(backend='egl', require=330)
+    except Exception as exc:  # glcontext raises plain Exception with EGL's words
+        reason = ' '.join(str(exc).split()) or type(exc).__name__
+        raise GlUnavailable(f'no EGL OpenGL 3.3 context: {reason}') from None
+
+
+class GlBackend:
+    """Draws one PyBullet client's visual shapes; call scene_changed() after the client's
+    bodies were rebuilt (a world reset)."""
+
+    kind = 'egl'
+
+    def __init__(self, client_id):
+        self.client_id = client_id
+        self.ctx = _create_context()
+        self.device = self.ctx.info['GL_RENDERER']
+        self.name = 'egl'
+        sun = -np.asarray(SUN_DIRECTION) / np.linalg.norm(SUN_DIRECTION)
+        self.program = self.ctx.program(
+            vertex_shader=_VERTEX_SHADER % {'ambient': AMBIENT, 'diffuse': DIFFUSE},
+            fragment_shader=_FRAGMENT_SHADER)
+        self.program['to_sun'].value = tuple(sun)
+        self.meshes = []
+        for build in (_box_mesh, _sphere_mesh, _cylinder_mesh):
+            vertices, indices = build()
+            self.meshes.append((self.ctx.buffer(vertices.tobytes()),
+                                self.ctx.buffer(indices.tobytes())))
+        self.max_height = self.ctx.info['GL_MAX_RENDERBUFFER_SIZE']
+        self.max_height = min(self.max_height, self.ctx.info['GL_MAX_VIEWPORT_DIMS'][1])
+        self._framebuffers = {}
+        self._read_scene()
+
+    def scene_changed(self):
+        """Read the client's bodies and visual shapes again."""
+        with self.ctx:
+            self._read_scene()
+
+    def _read_scene(self):
+        bodies = [_Body(self.client_id, body)
+                  for body in range(p.getNumBodies(physicsClientId=self.client_id))]
+        self.static = [b for b in bodies if b.static]
+        self.moving = [b for b in bodies if not b.static]
+        self.static_rows = np.concatenate([b.instances() for b in self.static]
+                                          or [np.empty((0, 18), 'f4')])
+        meshes = np.concatenate([b.mesh for b in self.static + self.moving]
+                                or [np.empty(0, int)])
+        self._release_vaos()
+        # The instance counts are fixed until the next rebuild: one buffer and vertex
+        # array per mesh, rewritten every frame.
+        self.by_mesh = []
+        for index, (vertices, indices) in enumerate(self.meshes):
+            chosen = np.flatnonzero(meshes == index)
+            if not len(chosen):
+                continue
+            buffer = self.ctx.buffer(reserve=len(chosen) * 18 * 4)
+            vao = self.ctx.vertex_array(
+                self.program, [(vertices, '3f 3f', 'in_position', 'in_normal'),
+                               (buffer, _INSTANCE_FORMAT, *_INSTANCE_ATTRIBUTES)],
+                index_buffer=indices)
+            self.by_mesh.append((chosen, buffer, vao))
+
+    def _release_vaos(self):
+        for _, buffer, vao in getattr(self, 'by_mesh', ()):
+            vao.release()
+            buffer.release()
+        self.by_mesh = []
+
+    def _upload_instances(self):
+        """Write this instant's poses and colours into the instance buffers."""
+        rows = np.concatenate([self.static_rows, *(b.instances() for b in self.moving)])
+        for chosen, buffer, _ in self.by_mesh:
+            buffer.write(rows[chosen].tobytes())
+
+    def _framebuffer(self, width, height):
+        key = (width, height)
+        if key not in self._framebuffers:
+            if len(self._framebuffers) >= 4:  # sizes seldom change: keep a few
+                for fbo in self._framebuffers.pop(next(iter(self._framebuffers))):
+                    fbo.release()
+            colour = self.ctx.renderbuffer((width, height), 4)
+            depth = self.ctx.depth_renderbuffer((width, height))
+            fbo = self.ctx.framebuffer(colour, depth)
+            self._framebuffers[key] = (fbo, colour, depth)
+        return self._framebuffers[key][0]
+
+    def render_views(self, view_projections, width, height):
+        """RGB images (height, width, 3) uint8, one per column-major 4x4 view-projection
+        matrix (already flipped vertically), drawn in as few passes as fit."""
+        with self.ctx:  # current in this thread for the call: any thread may render
+            return self._render_views(view_projections, width, height)
+
+    def _render_views(self, view_projections, width, height):
+        import moderngl
+        self._upload_instances()
+        per_pass = max(1, self.max_height // height)
+        images = []
+        ctx = self.ctx
+        ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        ctx.front_face = 'cw'  # the vertical flip mirrors the winding
+        for first in range(0, len(view_projections), per_pass):
+            batch = view_projections[first:first + per_pass]
+            fbo = self._framebuffer(width, height * len(batch))
+            fbo.use()
+            ctx.clear(*SKY, 1.0, depth=1.0)
+            for k, matrix in enumerate(batch):
+                ctx.viewport = (0, k * height, width, height)
+                self.program['view_projection'].write(matrix)
+                for chosen, _, vao in self.by_mesh:
+                    vao.render(instances=len(chosen))
+            pixels = np.empty((len(batch) * height, width, 3), np.uint8)
+            fbo.read_into(pixels, components=3, alignment=1)
+            images += [pixels[k * height:(k + 1) * height] for k in range(len(batch))]
+        return images
+
+    def close(self):
+        if self.ctx is not None:
+            self.ctx.release()
+            self.ctx = None
+
+
+def view_projection(view_matrix, projection):
+    """Column-major float32 bytes of projection @ view, flipped vertically so that the
+    first row read back is the image's top row."""
+    view = np.asarray(view_matrix, float).reshape(4, 4).T
+    proj = np.asarray(projection, float).reshape(4, 4).T
+    flip = np.diag([1.0, -1.0, 1.0, 1.0])
+    return (flip @ proj @ view).T.astype('f4').tobytes()
