@@ -31,7 +31,7 @@ setup(
     extras_require={
         # Left out for users whose ROS 2 Jazzy is installed and sourced.
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
-        'test': ['pytest', 'playwright'],
+        'test': ['pytest', 'playwright', 'hypothesis'],
     },
     zip_safe=False,
     maintainer='miro_ball developers',

@@ -1,8 +1,11 @@
 """ROS parameters declared from dataclasses: one field, one parameter.
 
-A field's default is the parameter's default and its metadata['help'] the
-description, so a node's declarations, its --help and the README cannot drift
-apart. The dataclass's __post_init__ validates the whole set.
+A field's default is the parameter's default, its metadata['help'] the
+description and its metadata['range'] (lowest, highest) the values it may take,
+so a node's declarations, its --help and the README cannot drift apart. The
+dataclass's __post_init__ calls check_ranges and validates the whole set.
+Every number is bounded: a value that is legal but absurd (a 1e9 s tick, a
+99999 px blur) would otherwise be accepted at start and hang or fail later.
 """
 import math
 from dataclasses import MISSING, fields
@@ -45,6 +48,20 @@ def coerce(name, value, default):
     return float(value)
 
 
+def check_ranges(values):
+    """ValueError naming the first field of a params dataclass outside its range."""
+    for f in fields(values):
+        bounds = f.metadata.get('range')
+        value = getattr(values, f.name)
+        if bounds is None:
+            continue
+        lowest, highest = bounds
+        if not all(lowest <= v <= highest for v in (value if isinstance(value, tuple)
+                                                    else (value,))):
+            raise ValueError('parameter %s must be in [%s, %s], not %s'
+                             % (f.name, _show(lowest), _show(highest), _show(value)))
+
+
 def declare(node, cls, overrides=None):
     """Declare every field of cls on the node and return the filled-in dataclass.
 
@@ -66,14 +83,20 @@ def declare(node, cls, overrides=None):
 
 def _show(value):
     if isinstance(value, tuple):
-        return '[%s]' % ','.join(str(v) for v in value)
-    return str(value)
+        return '[%s]' % ','.join(_show(v) for v in value)
+    return '%g' % value if isinstance(value, float) else str(value)
+
+
+def _help(f):
+    bounds = f.metadata.get('range')
+    if bounds is None:
+        return f.metadata['help']
+    return '%s [%s..%s]' % (f.metadata['help'], _show(bounds[0]), _show(bounds[1]))
 
 
 def table(*groups):
-    """(name, default as text, help) for every parameter of the groups, in order."""
-    return [(f.name, _show(default_of(f)), f.metadata['help'])
-            for cls in groups for f in fields(cls)]
+    """(name, default as text, help with the range) for every parameter of the groups."""
+    return [(f.name, _show(default_of(f)), _help(f)) for cls in groups for f in fields(cls)]
 
 
 def help_lines(*groups):

@@ -13,6 +13,7 @@ import random
 from dataclasses import dataclass, field
 from typing import NamedTuple, Optional, Sequence, Tuple
 
+from miro_ball.common.params import check_ranges
 from miro_ball.controller.detection import to_pixels
 from miro_ball.miro.camera import Intrinsics
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, CLIFF_THRESHOLD, WHEEL_MAX_SPEED_M_PER_S
@@ -42,48 +43,56 @@ DEFAULT_CAMERAS = (DEFAULT_CAMERA,) * len(EYES)
 class BehaviourParams:
     """Tutorial numbers first; the rest tune the improved mode."""
 
-    slow: float = field(default=0.1, metadata={'help': 'wheel speed for turning on the spot, m/s'})
-    fast: float = field(default=0.4, metadata={'help': 'wheel speed of the kick, m/s'})
-    fine: float = field(default=0.03, metadata={'help': 'wheel speed of fine centring, m/s'})
+    slow: float = field(default=0.1, metadata={'help': 'wheel speed for turning on the spot, m/s',
+                                               'range': (0.001, WHEEL_MAX_SPEED_M_PER_S)})
+    fast: float = field(default=0.4, metadata={'help': 'wheel speed of the kick, m/s',
+                                               'range': (0.001, WHEEL_MAX_SPEED_M_PER_S)})
+    fine: float = field(default=0.03, metadata={'help': 'wheel speed of fine centring, m/s',
+                                                'range': (0.001, WHEEL_MAX_SPEED_M_PER_S)})
     centre_error: float = field(
-        default=0.05, metadata={'help': 'tutorial: centred when ||left x| - |right x|| <= this'})
-    kick_duration: float = field(default=2.0, metadata={'help': 'length of a kick, s'})
+        default=0.05, metadata={'help': 'tutorial: centred when ||left x| - |right x|| <= this',
+                                'range': (0.001, 1.0)})
+    kick_duration: float = field(default=2.0, metadata={'help': 'length of a kick, s',
+                                                        'range': (0.02, 60.0)})
     cliff_threshold: float = field(
-        default=CLIFF_THRESHOLD, metadata={'help': 'improved: cliff reading below this = drop'})
-    seed: int = field(default=0, metadata={'help': 'improved: seed of the exploration RNG'})
+        default=CLIFF_THRESHOLD, metadata={'help': 'improved: cliff reading below this = drop',
+                                           'range': (0.0, 1.0)})
+    seed: int = field(default=0, metadata={'help': 'improved: seed of the exploration RNG',
+                                           'range': (0, 2147483647)})
     search_speed: float = field(
         default=0.25,
-        metadata={'help': 'improved: wheel speed when turning to search or steer, m/s'})
+        metadata={'help': 'improved: wheel speed when turning to search or steer, m/s',
+                  'range': (0.001, WHEEL_MAX_SPEED_M_PER_S)})
     approach_speed: float = field(
-        default=0.4, metadata={'help': 'improved: forward speed while approaching, m/s'})
+        default=0.4, metadata={'help': 'improved: forward speed while approaching, m/s',
+                               'range': (0.001, WHEEL_MAX_SPEED_M_PER_S)})
     steer_gain: float = field(
-        default=3.0, metadata={'help': 'improved: turn rate per rad of ball bearing, 1/s'})
+        default=3.0, metadata={'help': 'improved: turn rate per rad of ball bearing, 1/s',
+                               'range': (0.01, 100.0)})
     turn_only_deg: float = field(
-        default=70.0, metadata={'help': 'improved: turn on the spot beyond this bearing, deg'})
+        default=70.0, metadata={'help': 'improved: turn on the spot beyond this bearing, deg',
+                                'range': (0.1, 180.0)})
     kick_bearing_deg: float = field(
-        default=5.0, metadata={'help': 'improved: kick when the bearing is within this, deg'})
+        default=5.0, metadata={'help': 'improved: kick when the bearing is within this, deg',
+                               'range': (0.1, 180.0)})
     kick_radius: float = field(
-        default=0.05, metadata={'help': 'improved: kick when ball r / width reaches this'})
+        default=0.05, metadata={'help': 'improved: kick when ball r / width reaches this',
+                                'range': (0.001, 1.0)})
     lost_grace_s: float = field(
-        default=0.3, metadata={'help': 'improved: hold course this long after losing the ball, s'})
+        default=0.3, metadata={'help': 'improved: hold course this long after losing the ball, s',
+                               'range': (0.0, 60.0)})
     search_turn_deg: float = field(
-        default=360.0, metadata={'help': 'improved: turn this far before exploring, deg'})
+        default=360.0, metadata={'help': 'improved: turn this far before exploring, deg',
+                                 'range': (1.0, 3600.0)})
     explore_distance: float = field(
-        default=0.3, metadata={'help': 'improved: longest exploratory drive, m'})
+        default=0.3, metadata={'help': 'improved: longest exploratory drive, m',
+                               'range': (0.01, 10.0)})
     backoff_s: float = field(
-        default=1.0, metadata={'help': 'improved: reverse this long away from an edge, s'})
+        default=1.0, metadata={'help': 'improved: reverse this long away from an edge, s',
+                               'range': (0.02, 60.0)})
 
     def __post_init__(self):
-        speeds = (self.slow, self.fast, self.fine, self.search_speed, self.approach_speed)
-        if not all(0 < v <= WHEEL_MAX_SPEED_M_PER_S for v in speeds):
-            raise ValueError('slow, fast, fine, search_speed and approach_speed must be in '
-                             '(0, %g] m/s'
-                             % WHEEL_MAX_SPEED_M_PER_S)
-        positive = (self.centre_error, self.kick_duration, self.steer_gain, self.turn_only_deg,
-                    self.kick_bearing_deg, self.kick_radius, self.search_turn_deg,
-                    self.explore_distance, self.backoff_s)
-        if not all(v > 0 for v in positive) or self.lost_grace_s < 0:
-            raise ValueError('durations, distances, angles, gains and thresholds must be > 0')
+        check_ranges(self)
 
 
 class Command(NamedTuple):

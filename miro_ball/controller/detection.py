@@ -20,6 +20,8 @@ from typing import NamedTuple, Optional, Tuple
 import cv2
 import numpy as np
 
+from miro_ball.common.params import check_ranges
+
 HUE_PERIOD = 180  # OpenCV's 8-bit hue is degrees / 2
 
 
@@ -36,34 +38,41 @@ class DetectionParams:
     """The tutorial's numbers; pixel sizes are for a 640-wide frame and scale with width."""
 
     target_rgb: Tuple[int, int, int] = field(
-        default=(0, 0, 255), metadata={'help': 'ball colour as R, G, B'})
+        default=(0, 0, 255), metadata={'help': 'ball colour as R, G, B', 'range': (0, 255)})
     hue_window: int = field(
-        default=20, metadata={'help': 'accepted hue +- around the target (OpenCV units)'})
-    sat_min: int = field(default=70, metadata={'help': 'lowest accepted HSV saturation'})
-    val_min: int = field(default=70, metadata={'help': 'lowest accepted HSV value'})
-    blur: int = field(default=5, metadata={'help': 'Gaussian kernel size (odd, px)'})
-    erode: int = field(default=2, metadata={'help': 'erosion iterations'})
-    dilate: int = field(default=2, metadata={'help': 'dilation iterations'})
-    hough_dp: float = field(default=1.0, metadata={'help': 'Hough accumulator resolution'})
+        default=20, metadata={'help': 'accepted hue +- around the target (OpenCV units)',
+                              'range': (0, 90)})
+    sat_min: int = field(default=70, metadata={'help': 'lowest accepted HSV saturation',
+                                               'range': (0, 255)})
+    val_min: int = field(default=70, metadata={'help': 'lowest accepted HSV value',
+                                               'range': (0, 255)})
+    blur: int = field(default=5, metadata={'help': 'Gaussian kernel size (odd, px)',
+                                           'range': (1, 51)})
+    erode: int = field(default=2, metadata={'help': 'erosion iterations', 'range': (0, 20)})
+    dilate: int = field(default=2, metadata={'help': 'dilation iterations', 'range': (0, 20)})
+    hough_dp: float = field(default=1.0, metadata={'help': 'Hough accumulator resolution',
+                                                   'range': (1.0, 4.0)})
     hough_min_dist: float = field(
-        default=40.0, metadata={'help': 'min distance between circle centres (px @640)'})
-    hough_param1: float = field(default=10.0, metadata={'help': 'Hough Canny high threshold'})
+        default=40.0, metadata={'help': 'min distance between circle centres (px @640)',
+                                'range': (1.0, 2000.0)})
+    hough_param1: float = field(default=10.0, metadata={'help': 'Hough Canny high threshold',
+                                                        'range': (1.0, 1000.0)})
     hough_param2: float = field(
-        default=10.0, metadata={'help': 'Hough accumulator threshold (lower finds more)'})
-    min_radius: int = field(default=5, metadata={'help': 'smallest ball radius (px @640)'})
-    max_radius: int = field(default=50, metadata={'help': 'largest ball radius (px @640)'})
+        default=10.0, metadata={'help': 'Hough accumulator threshold (lower finds more)',
+                                'range': (1.0, 1000.0)})
+    min_radius: int = field(default=5, metadata={'help': 'smallest ball radius (px @640)',
+                                                 'range': (1, 999)})
+    max_radius: int = field(default=50, metadata={'help': 'largest ball radius (px @640)',
+                                                  'range': (2, 1000)})
 
     def __post_init__(self):
-        if len(self.target_rgb) != 3 or not all(0 <= c <= 255 for c in self.target_rgb):
-            raise ValueError('target_rgb must be three values in 0..255')
-        if self.blur < 1 or self.blur % 2 == 0:
-            raise ValueError('blur must be an odd number >= 1')
-        if not 0 < self.min_radius < self.max_radius:
-            raise ValueError('need 0 < min_radius < max_radius')
-        if self.hough_dp <= 0 or self.hough_min_dist <= 0:
-            raise ValueError('hough_dp and hough_min_dist must be > 0')
-        if min(self.hue_window, self.sat_min, self.val_min, self.erode, self.dilate) < 0:
-            raise ValueError('hue_window, sat_min, val_min, erode and dilate must be >= 0')
+        if len(self.target_rgb) != 3:
+            raise ValueError('target_rgb must be three values (R, G, B)')
+        check_ranges(self)
+        if self.blur % 2 == 0:
+            raise ValueError('blur must be odd')
+        if self.min_radius >= self.max_radius:
+            raise ValueError('need min_radius < max_radius')
 
 
 REFERENCE_WIDTH = 640  # the tutorial tuned its pixel sizes on 640x360 frames

@@ -2,6 +2,7 @@
 import math
 from dataclasses import dataclass, field
 
+from miro_ball.common.params import check_ranges
 from miro_ball.controller.behaviour import BehaviourParams, MODES
 from miro_ball.controller.detection import DetectionParams
 from miro_ball.miro.constants import LIFT_RAD_CALIB, PLATFORM_TICK_S
@@ -15,22 +16,24 @@ class ControllerParams:
         metadata={'help': 'topic prefix; default $MIRO_ROBOT_NAME, else miro'})
     mode: str = field(default='improved', metadata={'help': ' or '.join(MODES)})
     tick: float = field(default=PLATFORM_TICK_S,
-                        metadata={'help': 'control period, s (node clock)'})
+                        metadata={'help': 'control period, s (node clock)', 'range': (0.001, 1.0)})
     stale_s: float = field(
-        default=0.5, metadata={'help': 'forget detections and cliff readings older than this, s'})
+        default=0.5, metadata={'help': 'forget detections and cliff readings older than this, s',
+                               'range': (0.01, 60.0)})
     head_hold_s: float = field(
         default=1.0,
-        metadata={'help': 'hold the head pose this long at start (tutorial: wheels still), s'})
+        metadata={'help': 'hold the head pose this long at start (tutorial: wheels still), s',
+                  'range': (0.0, 60.0)})
     head_lift_deg: float = field(
         default=round(math.degrees(LIFT_RAD_CALIB), 6),
-        metadata={'help': 'lift joint of the start pose [tilt 0, lift, yaw 0, pitch 0], deg'})
+        metadata={'help': 'lift joint of the start pose [tilt 0, lift, yaw 0, pitch 0], deg',
+                  'range': (8.0, 60.0)})
 
     def __post_init__(self):
         if self.mode not in MODES:
             raise ValueError("mode must be one of %s, not '%s'" % (', '.join(MODES), self.mode))
         check_name(self.robot_name, 'robot_name')
-        if not (self.tick > 0 and self.stale_s > 0 and self.head_hold_s >= 0):
-            raise ValueError('tick and stale_s must be > 0 and head_hold_s >= 0')
+        check_ranges(self)
 
 
 GROUPS = (ControllerParams, DetectionParams, BehaviourParams)
