@@ -81,7 +81,10 @@ def node_commands(args, robots):
            '-p', f'world:={args.world}', '-p', f'renderer:={args.renderer}',
            '-p', f'real_time_factor:={args.real_time_factor}',
            '-p', f'overhead_rate:={VIDEO_FPS if args.video else 0.0}']
-    return controllers + [('miro_sim', sim)] + recorder_command(args, robots)
+    # The GUI first, so it stops first: it may be driving a robot.
+    gui = [('miro_gui', [sys.executable, '-m', 'miro_ball.gui', '--port', str(args.gui_port)])]
+    return (gui if args.gui else []) + controllers + [('miro_sim', sim)] \
+        + recorder_command(args, robots)
 
 
 def recorder_command(args, robots):
@@ -170,11 +173,15 @@ def watch(args, robots, procs, domain_id, stop):
             now = time.monotonic()
             if first_clock is None and monitor.sim_time > 0:
                 first_clock = (now, monitor.sim_time)
-            if monitor.kicked and monitor.sim_time > monitor.kick_time + 1.0:
-                outcome = 'kicked'
+            finished = ('kicked' if monitor.kicked and monitor.sim_time > monitor.kick_time + 1.0
+                        else 'limit' if monitor.sim_time >= args.limit else None)
+            if finished and not args.gui:
+                outcome = finished
                 break
-            if monitor.sim_time >= args.limit:
-                break
+            if finished and outcome != finished:  # with the GUI, the run goes on
+                outcome = finished
+                print(f'  {finished}: still running for the GUI, {gui_url(args)}; '
+                      'Ctrl+C to stop', flush=True)
             if procs.dead():
                 outcome = 'node %s exited with code %s' % procs.dead()
                 break
@@ -196,6 +203,10 @@ def watch(args, robots, procs, domain_id, stop):
     wall = time.monotonic() - first_clock[0] if first_clock else 0.0
     rtf = (monitor.sim_time - first_clock[1]) / wall if first_clock and wall > 0 else 0.0
     return outcome, monitor, rtf, video
+
+
+def gui_url(args):
+    return f'http://127.0.0.1:{args.gui_port}/'
 
 
 def summary(outcome, monitor, rtf, video, killed, record=None):
@@ -239,6 +250,10 @@ def parse_args(argv):
     parser.add_argument('--record', metavar='DIR',
                         help='record the run into a rosbag2 (MCAP) bag DIR: every topic but '
                              'the raw eye images (python -m miro_ball.record)')
+    parser.add_argument('--gui', action='store_true',
+                        help='also start miro_gui (see and drive MiRo in a browser), print its '
+                             'URL and keep running after the kick until Ctrl+C')
+    parser.add_argument('--gui-port', type=int, default=8080, help="the GUI's port (8080)")
     parser.add_argument('--startup-timeout', type=float, default=60.0, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if not 0 < args.limit <= 1e6 or not 0 <= args.real_time_factor <= 1000:
@@ -261,6 +276,9 @@ def main(argv=None):
           flush=True)
     stop = StopRequest()  # Ctrl+C ends the run with a summary, and stops the nodes
     procs = Processes(node_commands(args, robots), isolated_env(domain_id), out)
+    if args.gui:
+        print(f'miro_gui: open {gui_url(args)} in a browser (log in {out}/miro_gui.log)',
+              flush=True)
     killed = []
     try:
         outcome, monitor, rtf, video = watch(args, robots, procs, domain_id, stop)
