@@ -177,7 +177,7 @@ def test_cameras_render_only_while_subscribed(sim_node, executor):
 
 @pytest.mark.parametrize('args, message', [
     (['--world', 'nowhere'], "unknown world 'nowhere'"),
-    (['--ros-args', '-p', 'frame_width:=100'], 'frame size 100x360 is not one of'),
+    (['--ros-args', '-p', 'frame_width:=1000'], 'frame size 1000x360 is not one of'),
     (['--ros-args', '-p', 'camera_rate:=abc'], "parameter 'camera_rate' must be a number"),
 ])
 def test_bad_start_options_fail_in_one_line(args, message):
