@@ -1,0 +1,91 @@
+"""Print one of MiRo's signals as it arrives, a line a message: `ros2 topic echo` for pip users.
+
+Like the MDK's client_show. Each line starts with the simulated time.
+
+    python -m miro_ball.examples.client_show cliff            # until Ctrl+C
+    python -m miro_ball.examples.client_show odom --count 10  # ten lines, then exit
+"""
+import math
+import sys
+
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import BatteryState, Imu, JointState, Range
+from std_msgs.msg import Float32MultiArray, UInt16, UInt32
+
+from miro_ball.examples._client import Client, heading, make_parser, run
+
+
+def pair(values, unit=''):
+    return 'L %.3f  R %.3f%s' % (*values[:2], unit) if len(values) >= 2 else f'{list(values)}'
+
+
+def show_odom(m):
+    p, v = m.pose.pose.position, m.twist.twist
+    yaw = math.degrees(heading(m.pose.pose.orientation))
+    return (f'x {p.x:+.3f} m  y {p.y:+.3f} m  heading {yaw:+6.1f} deg  '
+            f'v {v.linear.x:+.3f} m/s  w {v.angular.z:+.3f} rad/s')
+
+
+def show_imu(m):
+    a = m.linear_acceleration
+    return f'acc x {a.x:+.2f}  y {a.y:+.2f}  z {a.z:+.2f} m/s2'
+
+
+def show_sonar(m):
+    return 'no echo' if math.isinf(m.range) else f'{m.range:.3f} m'
+
+
+def show_kin(m):
+    return '  '.join(f'{n} {math.degrees(p):+.1f}' for n, p in zip(m.name, m.position)) + ' deg'
+
+
+# signal: (message type, its topic given the robot's topics, one line of a message)
+SIGNALS = {
+    'cliff': (Float32MultiArray, lambda t: t.cliff, lambda m: pair(m.data)),
+    'wheels': (Float32MultiArray, lambda t: t.wheel_speed_opto, lambda m: pair(m.data, ' m/s')),
+    'wheel_cmd': (Float32MultiArray, lambda t: t.wheel_speed_cmd,
+                  lambda m: pair(m.data, ' m/s')),
+    'sonar': (Range, lambda t: t.sonar, show_sonar),
+    'odom': (Odometry, lambda t: t.odom, show_odom),
+    'imu': (Imu, lambda t: t.imu('body'), show_imu),
+    'imu_head': (Imu, lambda t: t.imu('head'), show_imu),
+    'kin': (JointState, lambda t: t.kinematic_joints, show_kin),
+    'battery': (BatteryState, lambda t: t.battery, lambda m: f'{m.voltage:.2f} V'),
+    'light': (Float32MultiArray, lambda t: t.light,
+              lambda m: '  '.join(f'{v:.2f}' for v in m.data)),
+    'touch': (UInt16, lambda t: t.touch('body'), lambda m: f'body {m.data:014b}'),
+    'flags': (UInt32, lambda t: t.sensor_flags, lambda m: f'0x{m.data:08x}'),
+    'cmd_vel': (TwistStamped, lambda t: t.cmd_vel,
+                lambda m: f'{m.twist.linear.x:+.3f} m/s  {m.twist.angular.z:+.3f} rad/s'),
+}
+
+
+class Show(Client):
+    def __init__(self, options, context=None):
+        super().__init__('client_show', options, context)
+        msg_type, topic, self.line = SIGNALS[options.signal]
+        self.create_subscription(msg_type, topic(self.topics), self.on_message, 10)
+        self.shown = 0
+
+    def on_message(self, msg):
+        self.say(f'{self.now():8.2f}  {self.options.signal}  {self.line(msg)}')
+        self.shown += 1
+        if self.shown == self.options.count:
+            raise SystemExit(0)
+
+
+def build_parser():
+    parser = make_parser('client_show', __doc__)
+    parser.add_argument('signal', choices=sorted(SIGNALS), help='what to print')
+    parser.add_argument('--count', type=int, default=0,
+                        help='exit after this many lines; 0 = until Ctrl+C (0)')
+    return parser
+
+
+def main(argv=None):
+    return run(Show, build_parser(), argv)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

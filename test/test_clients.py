@@ -1,0 +1,208 @@
+"""The example clients against the simulator, in simulated time: each does what its
+--help promises (in-process, the test stepping the world), and runs as a command."""
+import math
+import os
+import re
+import subprocess
+import sys
+import time
+
+import cv2
+import pytest
+from geometry_msgs.msg import TwistStamped
+from rclpy.parameter import Parameter
+
+from miro_ball.common.isolation import isolated_env
+from miro_ball.examples import client_follower, client_minimal, client_show, client_test, \
+    client_video
+from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
+from miro_ball.miro.interface import RobotTopics, default_robot_name
+from miro_sim_bullet.ros.node import SimNode
+from rostools import Probe, spin_until
+
+T = RobotTopics(default_robot_name())
+CLIENTS = ('client_minimal', 'client_video', 'client_show', 'client_follower', 'client_test')
+
+
+@pytest.fixture
+def sim_node(ros_context, executor):
+    node = SimNode(context=ros_context, parameter_overrides=[
+        Parameter('paused', value=True), Parameter('world', value='miro')])
+    executor.add_node(node)
+    yield node
+    executor.remove_node(node)
+    node.destroy_node()
+
+
+def tick(sim_node, executor):
+    sim_node.advance(sim_node.sim.ticks_per_platform_tick)
+    for _ in range(30):
+        executor.spin_once(timeout_sec=0)
+
+
+CLASSES = {client_minimal: client_minimal.Minimal, client_show: client_show.Show,
+           client_follower: client_follower.Follower, client_test: client_test.Bench,
+           client_video: client_video.Video}
+
+
+def run_client(module, args, sim_node, executor, context, limit_s, each_tick=None):
+    """Step the world until the client is done; its exit code (None: not done by limit_s)."""
+    client = CLASSES[module](module.build_parser().parse_args(args), context=context)
+    executor.add_node(client)
+    try:
+        for _ in range(round(limit_s / 0.02)):
+            tick(sim_node, executor)
+            if each_tick:
+                each_tick()
+    except SystemExit as done:
+        return done.code or 0
+    finally:
+        executor.remove_node(client)
+        client.destroy_node()
+    return None
+
+
+def robot(sim_node):
+    return sim_node.sim.robots[T.name]
+
+
+def test_minimal_drives_and_prints_the_battery(sim_node, executor, ros_context, capsys):
+    code = run_client(client_minimal, [], sim_node, executor, ros_context, limit_s=3.0)
+    x, y, yaw = robot(sim_node).pose()
+    out = capsys.readouterr().out
+    assert code == 0 and 'battery: 4.80 V' in out
+    assert math.hypot(x, y) > 0.1 and yaw > 0.3  # 0.2 m/s and 0.5 rad/s for 1 s
+
+
+@pytest.mark.parametrize('signal', sorted(set(client_show.SIGNALS) - {'cmd_vel'}))
+def test_show_prints_the_signal_as_it_arrives(signal, sim_node, executor, ros_context, capsys):
+    code = run_client(client_show, [signal, '--count', '3'], sim_node, executor, ros_context,
+                      limit_s=1.0)
+    lines = capsys.readouterr().out.splitlines()
+    assert code == 0 and len(lines) == 3
+    assert all(f'  {signal}  ' in line for line in lines)
+    expected = {'cliff': r'L 1\.000  R 1\.000', 'battery': r'4\.80 V', 'flags': '0x00008000',
+                'odom': r'x [+-]0\.000 m  y [+-]0\.000 m  heading +[+-]0\.0 deg'}
+    if signal in expected:
+        assert re.search(expected[signal], lines[-1]), lines[-1]
+    times = [float(line.split()[0]) for line in lines]
+    assert times == sorted(times) and times[-1] > 0  # simulated time
+
+
+def test_show_cmd_vel_prints_what_someone_commands(sim_node, executor, ros_context, capsys):
+    probe = Probe(ros_context, executor)
+    cmd = probe.publisher(TwistStamped, T.cmd_vel)
+    twist = TwistStamped()
+    twist.twist.linear.x, twist.twist.angular.z = 0.1, -0.5
+    code = run_client(client_show, ['cmd_vel', '--count', '2'], sim_node, executor,
+                      ros_context, limit_s=1.0, each_tick=lambda: cmd.publish(twist))
+    assert code == 0 and '+0.100 m/s  -0.500 rad/s' in capsys.readouterr().out
+
+
+@pytest.mark.parametrize('path, corners', [('square', 4), ('line', 2)])
+def test_follower_drives_its_path_and_comes_back(path, corners, sim_node, executor,
+                                                 ros_context, capsys):
+    farthest = []
+    code = run_client(client_follower, ['--path', path], sim_node, executor, ros_context,
+                      limit_s=30.0, each_tick=lambda: farthest.append(robot(sim_node).pose()))
+    out = capsys.readouterr().out
+    assert code == 0 and out.count('reached') == corners, out
+    x, y, _ = robot(sim_node).pose()
+    assert math.hypot(x, y) < 0.05  # back where it started
+    assert max(p[0] for p in farthest) == pytest.approx(0.5, abs=0.05)
+    assert max(p[1] for p in farthest) == pytest.approx(0.5 if path == 'square' else 0.0,
+                                                        abs=0.05)
+    assert robot(sim_node).flags & DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
+
+
+def degrees_of(out, name):
+    low, high = re.search(name + r' ([+-]\d+)\.\.([+-]\d+) deg', out).groups()
+    return int(low), int(high)
+
+
+def test_bench_kin_moves_the_head_through_its_range(sim_node, executor, ros_context, capsys):
+    code = run_client(client_test, ['kin'], sim_node, executor, ros_context, limit_s=8.0)
+    out = capsys.readouterr().out
+    assert code == 0
+    lift, yaw, pitch = (degrees_of(out, name) for name in ('lift', 'yaw', 'pitch'))
+    assert lift[0] <= 12 and lift[1] >= 56  # range 8..60
+    assert yaw[0] <= -50 and yaw[1] >= 50  # -55..55
+    assert pitch[0] <= -18 and pitch[1] >= 4  # -22..8
+
+
+def test_bench_wheels_and_spin_move_out_and_back(sim_node, executor, ros_context, capsys):
+    assert run_client(client_test, ['wheels'], sim_node, executor, ros_context, 6.0) == 0
+    assert run_client(client_test, ['spin'], sim_node, executor, ros_context, 6.0) == 0
+    out = capsys.readouterr().out
+    out_m, back_m = map(float, re.search(r'out ([\d.]+) m, back to ([\d.]+) m', out).groups())
+    assert out_m == pytest.approx(0.2, abs=0.03) and back_m < 0.03
+    turned, back = map(int, re.search(r'turned ([+-]\d+) deg, back to ([+-]\d+)', out).groups())
+    assert turned > 150 and abs(back) < 15
+
+
+def test_bench_cos_and_illum_reach_the_robot(sim_node, executor, ros_context):
+    seen = []
+
+    def sample():
+        seen.append((tuple(robot(sim_node).cosmetic), tuple(robot(sim_node).illum)))
+    assert run_client(client_test, ['cos'], sim_node, executor, ros_context, 6.0, sample) == 0
+    assert run_client(client_test, ['illum'], sim_node, executor, ros_context, 6.0,
+                      sample) == 0
+    tick(sim_node, executor)  # delivers the bench's last message
+    sample()
+    wags = {round(c[1], 1) for c, _ in seen}
+    assert min(wags) <= 0.1 and max(wags) >= 0.9  # the tail wagged side to side
+    colours = {i[0] for _, i in seen}
+    assert {0xFFFF0000, 0xFF00FF00, 0xFF0000FF, 0xFFFFFFFF} <= colours
+    assert seen[-1][1] == (0,) * 6  # LEDs off when the bench is done
+
+
+def test_video_writes_both_eyes_and_a_side_by_side_video(tmp_path, sim_node, executor,
+                                                         ros_context):
+    video = tmp_path / 'eyes.avi'
+    code = run_client(client_video, ['--out', str(tmp_path / 'eyes'), '--video', str(video),
+                                     '--frames', '5'], sim_node, executor, ros_context, 2.0)
+    assert code == 0
+    for eye in ('caml', 'camr'):
+        assert cv2.imread(str(tmp_path / 'eyes' / f'{eye}.jpg')).shape == (360, 640, 3)
+    capture = cv2.VideoCapture(str(video))
+    frames = []
+    while (frame := capture.read())[0]:
+        frames.append(frame[1])
+    assert len(frames) == 5 and frames[0].shape == (360, 1280, 3)
+    # The arena is in view of both eyes: neither half is blank.
+    assert frames[-1][:, :640].std() > 5 and frames[-1][:, 640:].std() > 5
+
+
+# -- as commands ----------------------------------------------------------------------------
+@pytest.mark.parametrize('name', CLIENTS)
+def test_every_client_has_help_and_refuses_bad_input(name):
+    module = f'miro_ball.examples.{name}'
+    out = subprocess.run([sys.executable, '-m', module, '--help'], capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 0 and 'MIRO_ROBOT_NAME' in out.stdout
+    bad = subprocess.run([sys.executable, '-m', module, '--robot', '1x', 'odom'],
+                         capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and 'error:' in bad.stderr and 'Traceback' not in bad.stderr
+
+
+def test_minimal_as_a_command_with_the_robot_from_the_environment(sim_node, executor):
+    env = dict(isolated_env(int(os.environ['ROS_DOMAIN_ID'])), MIRO_ROBOT_NAME=T.name)
+    proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.examples.client_minimal'],
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True)
+    try:
+        interface = sim_node.robots[T.name]
+        assert spin_until(executor, lambda: interface.pub_battery.get_subscription_count(),
+                          timeout_s=60.0)
+        deadline = time.monotonic() + 60.0  # a guard against a hang only
+        while proc.poll() is None and time.monotonic() < deadline:
+            tick(sim_node, executor)
+        output, _ = proc.communicate(timeout=10)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, output
+    assert 'battery: 4.80 V' in output and 'Traceback' not in output
+    assert math.hypot(*robot(sim_node).pose()[:2]) > 0.1
