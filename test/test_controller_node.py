@@ -418,3 +418,22 @@ def test_bad_robot_name_from_the_shell_is_one_line(ros_args, env):
     assert code == 2 and len(lines) == 1, lines
     assert lines[0].startswith('kick_blue_ball: error: robot_name ')
     assert 'must be a letter followed by letters, digits or underscores' in lines[0]
+
+
+def test_run_time_parameters_apply_or_are_refused_with_a_reason(make_rig):
+    rig = make_rig(*short_hold())
+    node = rig.node
+    results = node.set_parameters([Parameter('blur', value=7)])
+    assert results[0].successful and node.detector.params.blur == 7
+    # The same checks as at start: refused, and nothing changed.
+    for name, value, reason in [('hough_param2', 0.0, 'hough_param2'), ('blur', 8, 'odd'),
+                                ('tick', 0.05, 'restart'), ('robot_name', 'other', 'restart'),
+                                ('slow', 'fast', 'number')]:
+        result = node.set_parameters([Parameter(name, value=value)])[0]
+        assert not result.successful and reason in result.reason, (name, result.reason)
+    assert node.detector.params.blur == 7 and node.config.tick == pytest.approx(0.02)
+    # A new mode takes over at once: tutorial mode turns at its own speed.
+    assert node.set_parameters([Parameter('mode', value='tutorial')])[0].successful
+    rig.set_clock(10.0)
+    rig.advance(0.3)
+    assert rig.last_twist()[1] == pytest.approx(TUTORIAL_SPIN, rel=0.05)

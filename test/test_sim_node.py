@@ -194,3 +194,28 @@ def test_help_lists_the_parameters_and_worlds():
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0
     assert 'real_time_factor' in out.stdout and 'bundled worlds: cube, empty, football, football_pitch, miro, petshop, tables' in out.stdout
+
+
+def test_run_time_parameters_apply_or_are_refused_with_a_reason(sim_node, probe, executor):
+    from rclpy.parameter_client import AsyncParameterClient
+
+    client = AsyncParameterClient(probe.node, sim_node.get_name())
+    assert client.wait_for_services(timeout_sec=5.0)
+
+    def set_remotely(name, value):
+        future = client.set_parameters([Parameter(name, value=value)])
+        executor.spin_until_future_complete(future, timeout_sec=10.0)
+        return future.result().results[0]
+
+    result = set_remotely('real_time_factor', 4.0)
+    assert result.successful and sim_node.params.real_time_factor == 4.0
+    assert set_remotely('paused', False).successful and not sim_node.paused
+    for name, value, reason in [('physics_dt', 0.002, 'restart'), ('world', 'empty', 'restart'),
+                                ('real_time_factor', 5000.0, 'real_time_factor'),
+                                ('jpeg_quality', 'high', 'number')]:
+        result = set_remotely(name, value)
+        assert not result.successful and reason in result.reason, (name, result.reason)
+    assert sim_node.params.real_time_factor == 4.0 and sim_node.sim.dt == 0.001
+    # The pause service and the parameter say the same thing.
+    probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True))
+    assert sim_node.paused and sim_node.get_parameter('paused').value is True

@@ -8,7 +8,7 @@ Every number is bounded: a value that is legal but absurd (a 1e9 s tick, a
 99999 px blur) would otherwise be accepted at start and hang or fail later.
 """
 import math
-from dataclasses import MISSING, fields
+from dataclasses import fields, MISSING, replace
 
 
 def default_of(f):
@@ -105,3 +105,46 @@ def help_lines(*groups):
     width = max(len(name) for name, _, _ in rows)
     return ['parameters (--ros-args -p name:=value):'] + [
         '  %-*s  %-14s %s' % (width, name, default, text) for name, default, text in rows]
+
+
+class LiveParams:
+    """Run-time set_parameters for a node whose parameters are dataclass fields.
+
+    A change is checked exactly as at start (coerce, the ranges, the dataclass's own
+    checks) and handed to apply(updated dataclass); a change to a name in ``fixed``, or one
+    that fails a check, is refused with the reason. Never accepted and then ignored.
+    Parameters that are not fields (use_sim_time) are left to rclpy.
+    """
+
+    def __init__(self, node, values, apply, fixed=()):
+        self.values = {type(v): v for v in values}
+        self.apply = apply
+        self.log = node.get_logger().info
+        self.fixed = set(fixed)
+        self._owner = {f.name: (cls, f) for cls in self.values for f in fields(cls)}
+        node.add_on_set_parameters_callback(self._on_set)
+
+    def _on_set(self, parameters):
+        from rcl_interfaces.msg import SetParametersResult
+
+        updated, said = dict(self.values), []
+        for parameter in parameters:
+            if parameter.name not in self._owner:
+                continue
+            if parameter.name in self.fixed:
+                return SetParametersResult(successful=False, reason=(
+                    f'{parameter.name} is read at start only: restart the node to change it'))
+            cls, f = self._owner[parameter.name]
+            try:
+                value = coerce(f.name, parameter.value, default_of(f))
+                updated[cls] = replace(updated[cls], **{f.name: value})
+            except (ValueError, TypeError) as err:
+                return SetParametersResult(successful=False, reason=str(err))
+            said.append(f'{f.name} := {_show(value)}')
+        changed = [v for cls, v in updated.items() if v != self.values[cls]]
+        self.values = updated
+        for values in changed:
+            self.apply(values)
+        if said:
+            self.log('set at run time: ' + ', '.join(said))
+        return SetParametersResult(successful=True)

@@ -111,6 +111,10 @@ class KickBlueBall(Node):
         self.config = params.declare(self, ControllerParams)
         self.detector = BallDetector(params.declare(self, DetectionParams))
         self._behaviour_params = params.declare(self, BehaviourParams)
+        # The topics and the timer are made once; every tunable applies at run time.
+        self._live = params.LiveParams(
+            self, (self.config, self.detector.params, self._behaviour_params), self._apply,
+            fixed=('robot_name', 'tick'))
         self.save_debug = save_debug
         self.frames_processed = 0
         self.rejected = Counter()
@@ -148,6 +152,20 @@ class KickBlueBall(Node):
         # On sim time nothing ticks until /clock arrives: say once what we wait for.
         self._no_clock_timer = self.create_timer(
             NO_CLOCK_NOTICE_S, self._on_no_clock, clock=Clock(clock_type=ClockType.STEADY_TIME))
+
+    def _apply(self, values):
+        """A set_parameters change that passed the checks: detection changes take effect
+        at the next frame; a behaviour or mode change starts the behaviour over."""
+        if isinstance(values, DetectionParams):
+            self.detector = BallDetector(values)
+        elif isinstance(values, BehaviourParams):
+            self._behaviour_params = values
+            self.behaviour = make_behaviour(self.config.mode, values)
+        else:
+            mode_changed = values.mode != self.config.mode
+            self.config = values
+            if mode_changed:
+                self.behaviour = make_behaviour(values.mode, self._behaviour_params)
 
     def _on_no_clock(self):
         self._no_clock_timer.cancel()

@@ -22,7 +22,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import CompressedImage
 from std_srvs.srv import SetBool, Trigger
 
-from miro_ball.common.params import declare, help_lines
+from miro_ball.common.params import declare, help_lines, LiveParams
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera import Intrinsics
@@ -36,6 +36,11 @@ from miro_sim_bullet.ros.robot_interface import RobotInterface
 from miro_sim_bullet.scene.world_file import WorldError, bundled_worlds
 
 
+# Made into the world, its robots, cameras and topics at start; the rest apply at run time.
+FIXED_PARAMS = ('robot_name', 'world', 'physics_dt', 'frame_width', 'frame_height',
+                'camera_rate', 'hfov_deg', 'renderer', 'eye_workers')
+
+
 class SimNode(Node):
     """MiRo-E robots in PyBullet behind MiRo's topics; see README for the topic table."""
 
@@ -43,6 +48,7 @@ class SimNode(Node):
         super().__init__(SIM_NODE_NAME, context=context,
                          parameter_overrides=parameter_overrides)
         self.params = p = declare(self, SimParams)
+        self._live = LiveParams(self, (p,), self._apply, fixed=FIXED_PARAMS)
         self.warn = Throttled(self.get_logger().warning)
         self.sim = SimWorld(p.world, physics_dt=p.physics_dt, renderer=p.renderer,
                             log=self.get_logger().info, eye_workers=p.eye_workers,
@@ -60,9 +66,21 @@ class SimNode(Node):
             f'{p.camera_rate:g} Hz; real-time factor {p.real_time_factor:g}')
         self._restart_schedule()
         self._progress = (time.monotonic(), 0.0)
-        period = 0.005 if p.real_time_factor > 0 else 0.0
-        self.timer = self.create_timer(period, self._on_timer,
-                                       clock=Clock(clock_type=ClockType.STEADY_TIME))
+        self.timer = self._make_timer()
+
+    def _make_timer(self):
+        period = 0.005 if self.params.real_time_factor > 0 else 0.0
+        return self.create_timer(period, self._on_timer,
+                                 clock=Clock(clock_type=ClockType.STEADY_TIME))
+
+    def _apply(self, params):
+        """A set_parameters change that passed the checks (pause, speed, image quality)."""
+        old, self.params = self.params, params
+        if params.real_time_factor != old.real_time_factor:
+            self.destroy_timer(self.timer)
+            self.timer = self._make_timer()
+        self.paused = params.paused
+        self._restart_schedule(keep_time=True)
 
     def _make_sim_interface(self):
         t = SimTopics()
@@ -99,8 +117,8 @@ class SimNode(Node):
         return response
 
     def _on_pause(self, request, response):
-        self.paused = request.data
-        self._restart_schedule(keep_time=True)
+        # Through the parameter, so that it always says whether the simulator is paused.
+        self.set_parameters([Parameter('paused', value=bool(request.data))])
         response.success, response.message = True, 'paused' if self.paused else 'running'
         return response
 
