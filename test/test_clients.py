@@ -3,6 +3,7 @@
 import math
 import os
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -206,3 +207,18 @@ def test_minimal_as_a_command_with_the_robot_from_the_environment(sim_node, exec
     assert proc.returncode == 0, output
     assert 'battery: 4.80 V' in output and 'Traceback' not in output
     assert math.hypot(*robot(sim_node).pose()[:2]) > 0.1
+
+
+def test_a_client_waiting_for_the_simulator_ends_on_ctrl_c():
+    proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.examples.client_show', 'odom'],
+                            env=isolated_env(int(os.environ['ROS_DOMAIN_ID'])),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        time.sleep(2.0)  # past rclpy.init: the client's own handling is what is tested
+        proc.send_signal(signal.SIGINT)
+        output, _ = proc.communicate(timeout=10)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0 and 'Traceback' not in output, output

@@ -18,7 +18,7 @@ from rosbags.typesys import Stores, get_typestore
 from miro_ball.common.isolation import isolated_env
 from miro_ball.lab.bag import SplitBag, offered_qos
 from miro_ball.lab.record_node import Recorder
-from miro_ball.lab.recorder import Selection, cdr_stamp_ns, has_stamp, log_time_ns
+from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, log_time_ns
 from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
 from miro_sim_bullet.ros.node import SimNode
 from rostools import drain, spin_until
@@ -70,6 +70,18 @@ def test_stamps_come_from_the_first_field_when_it_is_a_time():
     assert log_time_ns(clock + TICK_NS, clock) == clock + TICK_NS  # simulated: kept
     assert log_time_ns(0, clock) == clock  # unset
     assert log_time_ns(1_700_000_000 * 10**9, clock) == clock  # wall time: not simulated
+
+
+def test_progress_says_how_many_topics_run_at_which_rate_and_which_went_silent():
+    progress = Progress()
+    for _ in range(100):
+        progress.count(ROBOT.odom)
+        progress.count(ROBOT.cliff)
+    progress.count(CLOCK)
+    assert progress.line(2.5, 2.0).endswith('per topic 50/s x 2, 0.5/s x 1')
+    progress.count(ROBOT.odom)
+    assert progress.line(3.0, 2.0).endswith(f'0.5/s x 1; silent: {CLOCK}, {ROBOT.cliff}')
+    assert progress.summary()[0].split() == [CLOCK, '1']
 
 
 def test_a_write_error_leaves_the_finished_files_a_bag(tmp_path):

@@ -91,12 +91,16 @@ class Progress:
         self.recent[topic] += 1
 
     def line(self, sim_time_s, seconds):
-        """One progress line: totals, then each topic's rate over the last `seconds`."""
-        rates = ', '.join(f'{topic} {n / seconds:.0f}/s'
-                          for topic, n in sorted(self.recent.items()))
+        """One progress line: totals, how many topics ran at which rate over the last
+        `seconds`, and which went silent (the per-topic table is in the summary)."""
+        rates = Counter(round(n / seconds, 1) for n in self.recent.values())
+        silent = sorted(set(self.total) - set(self.recent))
         self.recent.clear()
         return (f't = {sim_time_s:.1f} s simulated: {sum(self.total.values())} messages on '
-                f'{len(self.total)} topics; {rates or "nothing new"}')
+                f'{len(self.total)} topics; per topic '
+                + (', '.join(f'{rate:g}/s x {k}' for rate, k in sorted(rates.items(), reverse=True))
+                   or 'nothing new')
+                + (f'; silent: {", ".join(silent)}' if silent else ''))
 
     def summary(self):
         """Lines of the final report: each topic's count."""
