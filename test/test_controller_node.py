@@ -437,3 +437,14 @@ def test_run_time_parameters_apply_or_are_refused_with_a_reason(make_rig):
     rig.set_clock(10.0)
     rig.advance(0.3)
     assert rig.last_twist()[1] == pytest.approx(TUTORIAL_SPIN, rel=0.05)
+
+
+def test_a_negative_clock_is_ignored(make_rig):
+    rig = make_rig(*short_hold())
+    rig.set_clock(10.0)
+    rig.pub_clock.publish(Clock(clock=Time(sec=-5, nanosec=0)))
+    rig.spin()
+    assert rig.node.get_clock().now().nanoseconds == 10 * 10**9
+    count = len(rig.twists)
+    rig.advance(0.1)  # still ticking on good time
+    assert len(rig.twists) > count

@@ -28,6 +28,7 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
 from std_msgs.msg import Float32MultiArray
 
 from miro_ball.common import params
+from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
@@ -121,6 +122,7 @@ class KickBlueBall(Node):
         self.last_command = None
         self.state = STARTUP
         self._warn = Throttled(self.get_logger().warning, WARN_EVERY_S)
+        guard_clock(self, self._warn)
         self.balls = [Latest() for _ in EYES]
         self.cliff = Latest()
         self.cameras = list(DEFAULT_CAMERAS)

@@ -1,0 +1,26 @@
+"""A /clock message that rclpy's time source would raise on is dropped, not fatal.
+
+rclpy's TimeSource turns every /clock message into a Time, and Time refuses a
+negative one with a ValueError that comes out of the executor and ends the node.
+Anything on the bus may publish /clock, so each node on simulated time puts this
+check in front. rclpy has no public hook for it, hence the private _time_source.
+"""
+from miro_ball.miro.interface import CLOCK
+
+
+def guard_clock(node, warn):
+    """Check /clock before node's time source sees it; warn(key, text) says what was dropped."""
+    source = node._time_source
+    unchecked = source.clock_callback
+
+    def checked(msg):
+        if msg.clock.sec < 0:
+            warn('bad clock', f'{CLOCK}: negative time {msg.clock.sec} s ignored')
+            return
+        unchecked(msg)
+
+    # Future subscriptions (use_sim_time switched on later) and the current one.
+    source.clock_callback = checked
+    for subscription in node.subscriptions:
+        if subscription.topic_name == CLOCK and subscription.callback == unchecked:
+            subscription.callback = checked
