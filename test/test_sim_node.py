@@ -219,3 +219,13 @@ def test_run_time_parameters_apply_or_are_refused_with_a_reason(sim_node, probe,
     # The pause service and the parameter say the same thing.
     probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True))
     assert sim_node.paused and sim_node.get_parameter('paused').value is True
+
+
+def test_a_burst_of_service_calls_is_answered_in_full(sim_node, probe, executor):
+    clients = [probe.node.create_client(Trigger, SIM.step) for _ in range(20)]
+    assert all(c.wait_for_service(timeout_sec=5.0) for c in clients)
+    futures = [c.call_async(Trigger.Request()) for c in clients for _ in range(10)]
+    assert spin_until(executor, lambda: all(f.done() for f in futures), timeout_s=30.0), \
+        f'{sum(f.done() for f in futures)} of {len(futures)} answered'
+    assert all(f.result().success for f in futures)
+    assert sim_node.sim.step_index == 200 * sim_node.params.step_count

@@ -17,6 +17,7 @@ from rclpy.clock import Clock, ClockType
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import CompressedImage
@@ -36,6 +37,8 @@ from miro_sim_bullet.ros.robot_interface import RobotInterface
 from miro_sim_bullet.scene.world_file import WorldError, bundled_worlds
 
 
+# ROS's default keeps 10 requests: a burst of 200 clients lost 190 answers.
+SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 FIXED_PARAMS = ('robot_name', 'world', 'physics_dt', 'frame_width', 'frame_height',
                 'camera_rate', 'hfov_deg', 'renderer', 'eye_workers')
@@ -92,9 +95,9 @@ class SimNode(Node):
         self.pub_overhead = self.create_publisher(CompressedImage, t.overhead, 2)
         self.create_subscription(PoseStamped, t.set_pose, self._on_set_pose, 10)
         self.srvs = [
-            self.create_service(Trigger, t.reset, self._on_reset),
-            self.create_service(SetBool, t.pause, self._on_pause),
-            self.create_service(Trigger, t.step, self._on_step),
+            self.create_service(Trigger, t.reset, self._on_reset, qos_profile=SERVICE_QOS),
+            self.create_service(SetBool, t.pause, self._on_pause, qos_profile=SERVICE_QOS),
+            self.create_service(Trigger, t.step, self._on_step, qos_profile=SERVICE_QOS),
         ]
 
     # -- the simulator's own interface --------------------------------------------------------
