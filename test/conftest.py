@@ -11,6 +11,16 @@ limit_discovery()
 os.environ['ROS_DOMAIN_ID'] = str(private_domain())
 
 
+@pytest.fixture(scope='session', autouse=True)
+def shared_memory_janitor():
+    """Tests kill ROS processes on purpose: their Fast DDS files go at the end of the run."""
+    from miro_ball.common.shm import SharedMemoryJanitor
+
+    janitor = SharedMemoryJanitor()
+    yield janitor
+    janitor.clean()
+
+
 @pytest.fixture
 def ros_context():
     """A fresh, initialised rclpy Context (never the global one)."""
@@ -31,3 +41,19 @@ def executor(ros_context):
     ex = SingleThreadedExecutor(context=ros_context)
     yield ex
     ex.shutdown(timeout_sec=1.0)
+
+
+@pytest.fixture
+def paused_sim(ros_context, executor):
+    """The simulator node in-process on the default world, paused: the test steps it
+    (rostools.advance_ticks)."""
+    from rclpy.parameter import Parameter
+
+    from miro_sim_bullet.ros.node import SimNode
+
+    node = SimNode(context=ros_context, parameter_overrides=[
+        Parameter('paused', value=True), Parameter('world', value='miro')])
+    executor.add_node(node)
+    yield node
+    executor.remove_node(node)
+    node.destroy_node()

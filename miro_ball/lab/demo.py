@@ -18,6 +18,7 @@ import numpy as np
 
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.isolation import isolated_env, private_domain
+from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.interface import EYES, RobotTopics, default_robot_name
@@ -278,6 +279,7 @@ def main(argv=None):
           f'limit {args.limit:g} s simulated, ROS domain {domain_id}; logs in {out}/',
           flush=True)
     stop = StopRequest()  # Ctrl+C ends the run with a summary, and stops the nodes
+    janitor = SharedMemoryJanitor()  # for what a killed node leaves in /dev/shm
     procs = Processes(node_commands(args, robots), isolated_env(domain_id), out)
     if args.gui:
         print(f'miro_gui: open {gui_url(args)} in a browser (log in {out}/miro_gui.log)',
@@ -287,6 +289,7 @@ def main(argv=None):
         outcome, monitor, rtf, video = watch(args, robots, procs, domain_id, stop)
     finally:
         killed = procs.stop()
+        janitor.clean()
     print(summary(outcome, monitor, rtf, video, killed, args.record))
     # A node that had to be killed did not stop as it should: that is a failure too.
     sys.exit(0 if monitor.kicked and not killed else 1)
