@@ -1,0 +1,117 @@
+"""Restarts: either node killed with SIGKILL (a crash) and started again under the other.
+
+The nodes run as child processes, as a user starts them, on the test's ROS domain;
+the simulator free-runs (real_time_factor 0) and an in-process observer reads its
+ground truth, the commands and /clock. Every assertion is on simulated time;
+wall-clock limits only guard against a hang.
+"""
+import os
+import re
+import signal
+
+import pytest
+from geometry_msgs.msg import TwistStamped
+from std_msgs.msg import Float32MultiArray
+from std_srvs.srv import SetBool, Trigger
+
+from miro_ball.common.isolation import isolated_env
+from miro_ball.lab.demo import node_commands, parse_args, Processes
+from miro_ball.lab.monitor import Monitor
+from miro_ball.miro.interface import default_robot_name, RobotTopics, SimTopics
+from miro_sim_bullet.physics.robot import CMD_TIMEOUT_S
+from rostools import drain, Probe, spin_until
+
+ROBOT = default_robot_name()
+TOPICS = RobotTopics(ROBOT)
+SIM = SimTopics()
+KICK_WITHIN_S = 30.0  # simulated seconds from a controller's first command to the kick
+TICK_S = 0.02  # the platform's tick (and one ~/step with the default step_count)
+HANG_GUARD_S = 120.0
+
+
+@pytest.fixture
+def nodes(tmp_path):
+    """start(log name, 'sim' | 'controller') -> the node's Popen, started as the demo
+    starts it (free-running simulator); what still runs is stopped at the end."""
+    args, _ = parse_args(['--real-time-factor', '0', '--no-video'])
+    (_, controller), (_, sim) = node_commands(args, [ROBOT])
+    commands = {'sim': sim, 'controller': controller}
+    env = isolated_env(int(os.environ['ROS_DOMAIN_ID']))
+    started = []
+
+    def start(name, kind):
+        started.append(Processes([(name, commands[kind])], env, tmp_path))
+        return started[-1].procs[0][1]
+    yield start
+    for procs in reversed(started):
+        procs.stop()
+
+
+@pytest.fixture
+def probe(ros_context, executor):
+    return Probe(ros_context, executor, name='restart_observer')
+
+
+def watch_until_kicked(executor, probe, what):
+    """Watch from now on until the ball is kicked; fails unless that happens within
+    KICK_WITHIN_S simulated seconds of the first command a controller sends from now."""
+    drain(executor)  # what a previous run left queued is not this run's
+    monitor = Monitor(probe.node, [ROBOT])
+    commands = probe.watch(TwistStamped, TOPICS.cmd_vel)
+
+    def first_command():
+        return commands[0].header.stamp.sec + commands[0].header.stamp.nanosec * 1e-9
+
+    assert spin_until(executor, lambda: monitor.kicked or (
+        commands and monitor.sim_time > first_command() + KICK_WITHIN_S), HANG_GUARD_S), \
+        f'{what}: hung (simulated time {monitor.sim_time:.1f} s, {len(commands)} commands)'
+    assert monitor.kicked, f'{what}: not kicked {KICK_WITHIN_S} s after the first command'
+    return monitor
+
+
+def test_controller_starts_over_and_kicks_after_the_simulator_is_killed(
+        nodes, executor, probe, tmp_path):
+    sim = nodes('miro_sim_1', 'sim')
+    controller = nodes('controller', 'controller')
+    watch_until_kicked(executor, probe, 'first simulator')
+    sim.kill()
+    sim.wait()
+    nodes('miro_sim_2', 'sim')
+    watch_until_kicked(executor, probe, 'restarted simulator')
+    controller.send_signal(signal.SIGINT)
+    assert controller.wait(timeout=HANG_GUARD_S) == 0
+    log = (tmp_path / 'controller.log').read_text()
+    assert 'clock went back' in log and 'starting over' in log, log
+
+
+def test_wheels_stop_after_the_command_timeout_when_the_controller_is_killed(
+        nodes, executor, probe):
+    nodes('miro_sim', 'sim')
+    monitor = Monitor(probe.node, [ROBOT])
+    wheels = []  # (simulated time, (left, right)) of the platform's output, each tick
+    probe.node.create_subscription(
+        Float32MultiArray, TOPICS.wheel_speed_cmd,
+        lambda msg: wheels.append((monitor.sim_time, tuple(msg.data))), 1000)
+    controller = nodes('controller_1', 'controller')
+    assert spin_until(executor, lambda: wheels and any(wheels[-1][1]), HANG_GUARD_S), \
+        'the controller never drove'
+    # Paused, the simulator takes whatever command is still on its way at this very
+    # instant: so no command can reach it later than the pause.
+    assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True)).success
+    controller.kill()
+    controller.wait()
+    assert not monitor.kicked, 'kicked before it was killed: nothing left to test'
+    stepped = probe.call(executor, Trigger, SIM.step, Trigger.Request())
+    paused_at = float(re.search(r'time ([0-9.]+) s', stepped.message).group(1)) - TICK_S
+    assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=False)).success
+    assert spin_until(executor, lambda: monitor.sim_time > paused_at + 2 * CMD_TIMEOUT_S,
+                      HANG_GUARD_S)
+    # A wheel reading is tagged with the /clock seen last: at most a tick off either way.
+    driving = [w for t, w in wheels if paused_at - 0.1 <= t <= paused_at]
+    after = [w for t, w in wheels if t >= paused_at + CMD_TIMEOUT_S + 2 * TICK_S]
+    assert driving and any(driving[-1]), 'not driving when the controller was killed'
+    assert after and all(w == (0.0, 0.0) for w in after), \
+        'wheels still turning %.2f s after the last command' % (CMD_TIMEOUT_S + 2 * TICK_S)
+
+    nodes('controller_2', 'controller')
+    watch_until_kicked(executor, probe, 'new controller')
