@@ -5,7 +5,6 @@ The topics are the nodes' own subscription lists, so a topic added later is fuzz
 """
 import math
 
-import pytest
 from geometry_msgs.msg import TwistStamped
 from rclpy.parameter import Parameter
 
