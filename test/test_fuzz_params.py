@@ -1,0 +1,78 @@
+"""Every parameter of both nodes set at run time at its bounds and beyond: applied (or, for
+those read only at start, refused with the reason), never accepted and ignored, and the
+node keeps working."""
+from dataclasses import fields
+
+from rclpy.parameter import Parameter
+
+from miro_ball.controller.params import GROUPS
+from miro_sim_bullet.ros.node import FIXED_PARAMS, SimNode
+from miro_sim_bullet.ros.params import SimParams
+
+CONTROLLER_FIXED = ('robot_name', 'tick')
+
+
+def beyond(low, high):
+    step = 1 if isinstance(low, int) else abs(low) * 0.5 + 1e-3
+    return [low - step, high * 2 + 1]
+
+
+def exercise(node, groups, fixed, current):
+    """Set every bounded parameter to its bounds and beyond; current(name) reads the value
+    the node works with."""
+    for cls in groups:
+        for f in fields(cls):
+            if 'range' not in f.metadata or isinstance(f.default, tuple):
+                continue
+            low, high = f.metadata['range']
+            for value in (low, high):
+                result = node.set_parameters([Parameter(f.name, value=value)])[0]
+                if f.name in fixed:
+                    assert not result.successful and 'restart' in result.reason, f.name
+                elif result.successful:
+                    assert current(f.name) == value, f.name
+                else:  # only a rule between two parameters may refuse a value in range
+                    assert 'min_radius' in result.reason or 'odd' in result.reason, \
+                        (f.name, result.reason)
+            for value in beyond(low, high):
+                before = current(f.name)
+                result = node.set_parameters([Parameter(f.name, value=value)])[0]
+                assert not result.successful and current(f.name) == before, f.name
+
+
+def test_simulator_parameters_at_run_time(ros_context, executor):
+    node = SimNode(context=ros_context, parameter_overrides=[Parameter('paused', value=True)])
+    try:
+        exercise(node, [SimParams], FIXED_PARAMS, lambda name: getattr(node.params, name))
+        node.set_parameters([Parameter('real_time_factor', value=0.0),
+                             Parameter('step_count', value=20)])
+        before = node.sim.time
+        node.advance(100)
+        assert node.sim.time > before
+    finally:
+        node.destroy_node()
+
+
+def test_controller_parameters_at_run_time(ros_context, executor):
+    from test_controller_node import AHEAD, Rig, short_hold
+
+    rig = Rig(ros_context, executor, short_hold())
+    node = rig.node
+    try:
+        def current(name):
+            for values in (node.config, node.detector.params, node._behaviour_params):
+                if hasattr(values, name):
+                    return getattr(values, name)
+        exercise(node, GROUPS, CONTROLLER_FIXED, current)
+        # Back to the defaults, and it drives at the ball.
+        defaults = [Parameter(f.name, value=f.default) for cls in GROUPS[1:]
+                    for f in fields(cls) if not isinstance(f.default, tuple)]
+        assert all(r.successful for r in node.set_parameters(defaults))
+        node.set_parameters([Parameter('head_hold_s', value=0.1)])
+        rig.set_clock(10.0)
+        rig.advance(0.2)
+        rig.both_eyes(*AHEAD)
+        rig.advance(0.1)
+        assert rig.last_twist()[0] > 0.1
+    finally:
+        rig.close()
