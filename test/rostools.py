@@ -1,4 +1,7 @@
-"""Helpers for in-process ROS tests: collect messages, spin until something holds."""
+"""Helpers for ROS tests: collect messages, spin until something holds, step the world."""
+import os
+import signal
+import subprocess
 import time
 
 import rclpy
@@ -18,6 +21,28 @@ def drain(executor, rounds=50):
     """Deliver what is already queued (no waiting beyond a few empty spins)."""
     for _ in range(rounds):
         executor.spin_once(timeout_sec=0)
+
+
+def advance_ticks(sim_node, executor, count=1):
+    """Step an in-process simulator `count` platform ticks (20 ms), delivering what each
+    tick publishes before the next."""
+    for _ in range(count):
+        sim_node.advance(sim_node.sim.ticks_per_platform_tick)
+        drain(executor, rounds=30)
+
+
+def run_command(cmd, timeout_s=300):
+    """(exit code, output) of a command run in a session of its own, so that a hang
+    kills its child processes too."""
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)
+    try:
+        output, _ = proc.communicate(timeout=timeout_s)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    return proc.returncode, output
 
 
 class Probe:

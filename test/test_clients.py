@@ -11,34 +11,16 @@ import time
 import cv2
 import pytest
 from geometry_msgs.msg import TwistStamped
-from rclpy.parameter import Parameter
 
 from miro_ball.common.isolation import isolated_env
 from miro_ball.examples import client_follower, client_minimal, client_show, client_test, \
     client_video
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
 from miro_ball.miro.interface import RobotTopics, default_robot_name
-from miro_sim_bullet.ros.node import SimNode
-from rostools import Probe, spin_until
+from rostools import Probe, advance_ticks, spin_until
 
 T = RobotTopics(default_robot_name())
 CLIENTS = ('client_minimal', 'client_video', 'client_show', 'client_follower', 'client_test')
-
-
-@pytest.fixture
-def sim_node(ros_context, executor):
-    node = SimNode(context=ros_context, parameter_overrides=[
-        Parameter('paused', value=True), Parameter('world', value='miro')])
-    executor.add_node(node)
-    yield node
-    executor.remove_node(node)
-    node.destroy_node()
-
-
-def tick(sim_node, executor):
-    sim_node.advance(sim_node.sim.ticks_per_platform_tick)
-    for _ in range(30):
-        executor.spin_once(timeout_sec=0)
 
 
 CLASSES = {client_minimal: client_minimal.Minimal, client_show: client_show.Show,
@@ -46,13 +28,13 @@ CLASSES = {client_minimal: client_minimal.Minimal, client_show: client_show.Show
            client_video: client_video.Video}
 
 
-def run_client(module, args, sim_node, executor, context, limit_s, each_tick=None):
+def run_client(module, args, paused_sim, executor, context, limit_s, each_tick=None):
     """Step the world until the client is done; its exit code (None: not done by limit_s)."""
     client = CLASSES[module](module.build_parser().parse_args(args), context=context)
     executor.add_node(client)
     try:
         for _ in range(round(limit_s / 0.02)):
-            tick(sim_node, executor)
+            advance_ticks(paused_sim, executor)
             if each_tick:
                 each_tick()
     except SystemExit as done:
@@ -63,21 +45,21 @@ def run_client(module, args, sim_node, executor, context, limit_s, each_tick=Non
     return None
 
 
-def robot(sim_node):
-    return sim_node.sim.robots[T.name]
+def robot(paused_sim):
+    return paused_sim.sim.robots[T.name]
 
 
-def test_minimal_drives_and_prints_the_battery(sim_node, executor, ros_context, capsys):
-    code = run_client(client_minimal, [], sim_node, executor, ros_context, limit_s=3.0)
-    x, y, yaw = robot(sim_node).pose()
+def test_minimal_drives_and_prints_the_battery(paused_sim, executor, ros_context, capsys):
+    code = run_client(client_minimal, [], paused_sim, executor, ros_context, limit_s=3.0)
+    x, y, yaw = robot(paused_sim).pose()
     out = capsys.readouterr().out
     assert code == 0 and 'battery: 4.80 V' in out
     assert math.hypot(x, y) > 0.1 and yaw > 0.3  # 0.2 m/s and 0.5 rad/s for 1 s
 
 
 @pytest.mark.parametrize('signal', sorted(set(client_show.SIGNALS) - {'cmd_vel'}))
-def test_show_prints_the_signal_as_it_arrives(signal, sim_node, executor, ros_context, capsys):
-    code = run_client(client_show, [signal, '--count', '3'], sim_node, executor, ros_context,
+def test_show_prints_the_signal_as_it_arrives(signal, paused_sim, executor, ros_context, capsys):
+    code = run_client(client_show, [signal, '--count', '3'], paused_sim, executor, ros_context,
                       limit_s=1.0)
     lines = capsys.readouterr().out.splitlines()
     assert code == 0 and len(lines) == 3
@@ -90,30 +72,30 @@ def test_show_prints_the_signal_as_it_arrives(signal, sim_node, executor, ros_co
     assert times == sorted(times) and times[-1] > 0  # simulated time
 
 
-def test_show_cmd_vel_prints_what_someone_commands(sim_node, executor, ros_context, capsys):
+def test_show_cmd_vel_prints_what_someone_commands(paused_sim, executor, ros_context, capsys):
     probe = Probe(ros_context, executor)
     cmd = probe.publisher(TwistStamped, T.cmd_vel)
     twist = TwistStamped()
     twist.twist.linear.x, twist.twist.angular.z = 0.1, -0.5
-    code = run_client(client_show, ['cmd_vel', '--count', '2'], sim_node, executor,
+    code = run_client(client_show, ['cmd_vel', '--count', '2'], paused_sim, executor,
                       ros_context, limit_s=1.0, each_tick=lambda: cmd.publish(twist))
     assert code == 0 and '+0.100 m/s  -0.500 rad/s' in capsys.readouterr().out
 
 
 @pytest.mark.parametrize('path, corners', [('square', 4), ('line', 2)])
-def test_follower_drives_its_path_and_comes_back(path, corners, sim_node, executor,
+def test_follower_drives_its_path_and_comes_back(path, corners, paused_sim, executor,
                                                  ros_context, capsys):
     farthest = []
-    code = run_client(client_follower, ['--path', path], sim_node, executor, ros_context,
-                      limit_s=30.0, each_tick=lambda: farthest.append(robot(sim_node).pose()))
+    code = run_client(client_follower, ['--path', path], paused_sim, executor, ros_context,
+                      limit_s=30.0, each_tick=lambda: farthest.append(robot(paused_sim).pose()))
     out = capsys.readouterr().out
     assert code == 0 and out.count('reached') == corners, out
-    x, y, _ = robot(sim_node).pose()
+    x, y, _ = robot(paused_sim).pose()
     assert math.hypot(x, y) < 0.05  # back where it started
     assert max(p[0] for p in farthest) == pytest.approx(0.5, abs=0.05)
     assert max(p[1] for p in farthest) == pytest.approx(0.5 if path == 'square' else 0.0,
                                                         abs=0.05)
-    assert robot(sim_node).flags & DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
+    assert robot(paused_sim).flags & DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
 
 
 def degrees_of(out, name):
@@ -121,8 +103,8 @@ def degrees_of(out, name):
     return int(low), int(high)
 
 
-def test_bench_kin_moves_the_head_through_its_range(sim_node, executor, ros_context, capsys):
-    code = run_client(client_test, ['kin'], sim_node, executor, ros_context, limit_s=8.0)
+def test_bench_kin_moves_the_head_through_its_range(paused_sim, executor, ros_context, capsys):
+    code = run_client(client_test, ['kin'], paused_sim, executor, ros_context, limit_s=8.0)
     out = capsys.readouterr().out
     assert code == 0
     lift, yaw, pitch = (degrees_of(out, name) for name in ('lift', 'yaw', 'pitch'))
@@ -131,9 +113,9 @@ def test_bench_kin_moves_the_head_through_its_range(sim_node, executor, ros_cont
     assert pitch[0] <= -18 and pitch[1] >= 4  # -22..8
 
 
-def test_bench_wheels_and_spin_move_out_and_back(sim_node, executor, ros_context, capsys):
-    assert run_client(client_test, ['wheels'], sim_node, executor, ros_context, 6.0) == 0
-    assert run_client(client_test, ['spin'], sim_node, executor, ros_context, 6.0) == 0
+def test_bench_wheels_and_spin_move_out_and_back(paused_sim, executor, ros_context, capsys):
+    assert run_client(client_test, ['wheels'], paused_sim, executor, ros_context, 6.0) == 0
+    assert run_client(client_test, ['spin'], paused_sim, executor, ros_context, 6.0) == 0
     out = capsys.readouterr().out
     out_m, back_m = map(float, re.search(r'out ([\d.]+) m, back to ([\d.]+) m', out).groups())
     assert out_m == pytest.approx(0.2, abs=0.03) and back_m < 0.03
@@ -141,15 +123,15 @@ def test_bench_wheels_and_spin_move_out_and_back(sim_node, executor, ros_context
     assert turned > 150 and abs(back) < 15
 
 
-def test_bench_cos_and_illum_reach_the_robot(sim_node, executor, ros_context):
+def test_bench_cos_and_illum_reach_the_robot(paused_sim, executor, ros_context):
     seen = []
 
     def sample():
-        seen.append((tuple(robot(sim_node).cosmetic), tuple(robot(sim_node).illum)))
-    assert run_client(client_test, ['cos'], sim_node, executor, ros_context, 6.0, sample) == 0
-    assert run_client(client_test, ['illum'], sim_node, executor, ros_context, 6.0,
+        seen.append((tuple(robot(paused_sim).cosmetic), tuple(robot(paused_sim).illum)))
+    assert run_client(client_test, ['cos'], paused_sim, executor, ros_context, 6.0, sample) == 0
+    assert run_client(client_test, ['illum'], paused_sim, executor, ros_context, 6.0,
                       sample) == 0
-    tick(sim_node, executor)  # delivers the bench's last message
+    advance_ticks(paused_sim, executor)  # delivers the bench's last message
     sample()
     wags = {round(c[1], 1) for c, _ in seen}
     assert min(wags) <= 0.1 and max(wags) >= 0.9  # the tail wagged side to side
@@ -158,11 +140,11 @@ def test_bench_cos_and_illum_reach_the_robot(sim_node, executor, ros_context):
     assert seen[-1][1] == (0,) * 6  # LEDs off when the bench is done
 
 
-def test_video_writes_both_eyes_and_a_side_by_side_video(tmp_path, sim_node, executor,
+def test_video_writes_both_eyes_and_a_side_by_side_video(tmp_path, paused_sim, executor,
                                                          ros_context):
     video = tmp_path / 'eyes.avi'
     code = run_client(client_video, ['--out', str(tmp_path / 'eyes'), '--video', str(video),
-                                     '--frames', '5'], sim_node, executor, ros_context, 2.0)
+                                     '--frames', '5'], paused_sim, executor, ros_context, 2.0)
     assert code == 0
     for eye in ('caml', 'camr'):
         assert cv2.imread(str(tmp_path / 'eyes' / f'{eye}.jpg')).shape == (360, 640, 3)
@@ -187,18 +169,18 @@ def test_every_client_has_help_and_refuses_bad_input(name):
     assert bad.returncode == 2 and 'error:' in bad.stderr and 'Traceback' not in bad.stderr
 
 
-def test_minimal_as_a_command_with_the_robot_from_the_environment(sim_node, executor):
+def test_minimal_as_a_command_with_the_robot_from_the_environment(paused_sim, executor):
     env = dict(isolated_env(int(os.environ['ROS_DOMAIN_ID'])), MIRO_ROBOT_NAME=T.name)
     proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.examples.client_minimal'],
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             text=True)
     try:
-        interface = sim_node.robots[T.name]
+        interface = paused_sim.robots[T.name]
         assert spin_until(executor, lambda: interface.pub_battery.get_subscription_count(),
                           timeout_s=60.0)
         deadline = time.monotonic() + 60.0  # a guard against a hang only
         while proc.poll() is None and time.monotonic() < deadline:
-            tick(sim_node, executor)
+            advance_ticks(paused_sim, executor)
         output, _ = proc.communicate(timeout=10)
     finally:
         if proc.poll() is None:
@@ -206,7 +188,7 @@ def test_minimal_as_a_command_with_the_robot_from_the_environment(sim_node, exec
             proc.communicate()
     assert proc.returncode == 0, output
     assert 'battery: 4.80 V' in output and 'Traceback' not in output
-    assert math.hypot(*robot(sim_node).pose()[:2]) > 0.1
+    assert math.hypot(*robot(paused_sim).pose()[:2]) > 0.1
 
 
 def test_a_client_waiting_for_the_simulator_ends_on_ctrl_c():

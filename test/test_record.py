@@ -9,19 +9,18 @@ import time
 import pytest
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import Odometry
-from rclpy.parameter import Parameter
 from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore
+from ruamel.yaml import YAML
 
 from miro_ball.common.isolation import isolated_env
 from miro_ball.lab.bag import SplitBag, offered_qos
 from miro_ball.lab.record_node import Recorder
 from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, log_time_ns
 from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
-from miro_sim_bullet.ros.node import SimNode
-from rostools import drain, spin_until
+from rostools import advance_ticks, run_command, spin_until
 
 ROBOT = RobotTopics(default_robot_name())
 TYPES = get_typestore(Stores.ROS2_JAZZY)
@@ -101,34 +100,18 @@ def test_a_write_error_leaves_the_finished_files_a_bag(tmp_path):
 
 
 # -- against the simulator, in-process --------------------------------------------------------
-@pytest.fixture
-def sim_node(ros_context, executor):
-    node = SimNode(context=ros_context, parameter_overrides=[
-        Parameter('paused', value=True), Parameter('world', value='miro')])
-    executor.add_node(node)
-    yield node
-    executor.remove_node(node)
-    node.destroy_node()
-
-
-def tick(sim_node, executor, count=1):
-    for _ in range(count):
-        sim_node.advance(sim_node.sim.ticks_per_platform_tick)
-        drain(executor, rounds=30)
-
-
 def test_records_every_topic_with_types_counts_and_simulated_stamps(
-        tmp_path, ros_context, executor, sim_node):
+        tmp_path, ros_context, executor, paused_sim):
     bag = SplitBag(tmp_path / 'bag')
     recorder = Recorder(bag, Selection(exclude=[ROBOT.eye_raw('cam?')]), context=ros_context)
     executor.add_node(recorder)
-    tick(sim_node, executor)  # the first /clock starts the recording
-    interface = sim_node.robots[ROBOT.name]
+    advance_ticks(paused_sim, executor)  # the first /clock starts the recording
+    interface = paused_sim.robots[ROBOT.name]
     assert spin_until(executor, lambda: interface.pub_odom.get_subscription_count()
                       and interface.pub_cliff.get_subscription_count()
                       and interface.pub_eyes['caml'][0].get_subscription_count())
-    start = sim_node.sim.time
-    tick(sim_node, executor, 50)  # 1 s
+    start = paused_sim.sim.time
+    advance_ticks(paused_sim, executor, 50)  # 1 s
     bag.close()
     executor.remove_node(recorder)
     recorder.destroy_node()
@@ -160,22 +143,30 @@ def start_recorder(*args):
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 
 
-def run_until(sim_node, executor, predicate, timeout_s=30.0):
+def finished_count(bag, topic):
+    """Messages of topic in the files of a bag being recorded that are finished."""
+    try:
+        info = YAML(typ='safe').load((bag / 'metadata.yaml').read_text())
+    except FileNotFoundError:
+        return 0
+    return sum(entry['message_count']
+               for entry in info['rosbag2_bagfile_information']['topics_with_message_count']
+               if entry['topic_metadata']['name'] == topic)
+
+
+def run_until(paused_sim, executor, predicate, timeout_s=30.0):
     """Step the world tick by tick until predicate() holds; the wall-clock limit is a guard."""
     deadline = time.monotonic() + timeout_s
     while not predicate():
         assert time.monotonic() < deadline, 'timed out'
-        tick(sim_node, executor)
+        advance_ticks(paused_sim, executor)
 
 
-def test_the_command_records_a_robot_until_ctrl_c_twice(tmp_path, executor, sim_node):
+def test_the_command_records_a_robot_until_ctrl_c_twice(tmp_path, executor, paused_sim):
     proc = start_recorder('-o', str(tmp_path / 'bag'), ROBOT.name, '--split-seconds', '0.5')
     try:
-        interface = sim_node.robots[ROBOT.name]
-        run_until(sim_node, executor, lambda: interface.pub_odom.get_subscription_count())
-        for _ in range(100):
-            tick(sim_node, executor)
-        time.sleep(0.5)  # DDS delivers what is in flight; Ctrl+C then ends the recording
+        # Until its finished files hold a second of odometry; then Ctrl+C, twice.
+        run_until(paused_sim, executor, lambda: finished_count(tmp_path / 'bag', ROBOT.odom) >= 50)
         proc.send_signal(signal.SIGINT)
         proc.send_signal(signal.SIGINT)
         output, _ = proc.communicate(timeout=20)
@@ -194,13 +185,13 @@ def test_the_command_records_a_robot_until_ctrl_c_twice(tmp_path, executor, sim_
     assert f'{tmp_path / "bag"}: ' in output  # the summary
 
 
-def test_a_killed_recorder_leaves_a_readable_bag(tmp_path, executor, sim_node):
+def test_a_killed_recorder_leaves_a_readable_bag(tmp_path, executor, paused_sim):
     bag = tmp_path / 'bag'
     proc = start_recorder('-o', str(bag), ROBOT.odom, '--split-seconds', '0.2')
     try:
-        run_until(sim_node, executor, lambda: (bag / 'metadata.yaml').exists())
+        run_until(paused_sim, executor, lambda: (bag / 'metadata.yaml').exists())
         for _ in range(20):
-            tick(sim_node, executor)
+            advance_ticks(paused_sim, executor)
     finally:
         proc.kill()
         proc.communicate()
@@ -225,14 +216,7 @@ def test_the_main_job_records_every_node_of_the_run(tmp_path):
     bag = tmp_path / 'run'
     cmd = [sys.executable, '-m', 'miro_ball.lab.demo', '--no-video', '--limit', '3',
            '--real-time-factor', '0', '--out', str(tmp_path), '--record', str(bag)]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                            start_new_session=True)
-    try:
-        output, _ = proc.communicate(timeout=300)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
+    _, output = run_command(cmd)
     assert f'recording:            {bag}' in output and 'FAILED' not in output, output
     recorded = read_bag(bag)
     # The controller's commands, the simulator's sensors, eyes and ground truth, the logs.
