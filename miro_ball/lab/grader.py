@@ -210,12 +210,14 @@ def run_episode(index, placement, options, domain, stop, log=print):
 def _play(session, procs, placement, options, stop, log, index):
     """Start, place, wait for the command, run; returns why the episode ended."""
     def ended_early():
+        if stop.requested:  # before the children's exits: Ctrl+C in a terminal reaches them too
+            return 'interrupted'
         dead = procs.dead()
         if dead and dead[0] == 'command':
             return 'command exited'
         if dead:
             return f'the simulator exited with code {dead[1]} (see its log)'
-        return 'interrupted' if stop.requested else None
+        return None
 
     if not session.spin_until(lambda: ended_early() or (
             session.step.service_is_ready() and session.set_pose.get_subscription_count()),
