@@ -23,12 +23,12 @@ def drain(executor, rounds=50):
         executor.spin_once(timeout_sec=0)
 
 
-def advance_ticks(sim_node, executor, count=1):
+def advance_ticks(sim_node, executor, count=1, rounds=30):
     """Step an in-process simulator `count` platform ticks (20 ms), delivering what each
-    tick publishes before the next."""
+    tick publishes before the next (rounds: callbacks a tick, more for more subscribers)."""
     for _ in range(count):
         sim_node.advance(sim_node.sim.ticks_per_platform_tick)
-        drain(executor, rounds=30)
+        drain(executor, rounds=rounds)
 
 
 def run_command(cmd, timeout_s=300):

@@ -34,7 +34,7 @@ def run_client(module, args, paused_sim, executor, context, limit_s, each_tick=N
     executor.add_node(client)
     try:
         for _ in range(round(limit_s / 0.02)):
-            advance_ticks(paused_sim, executor)
+            advance_ticks(paused_sim, executor, rounds=12)  # a client and a few topics
             if each_tick:
                 each_tick()
     except SystemExit as done:
