@@ -31,7 +31,8 @@ setup(
     extras_require={
         # Left out for users whose ROS 2 Jazzy is installed and sourced.
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
-        'test': ['pytest', 'playwright', 'hypothesis'],
+        # mcap: Foxglove's reference MCAP reader, which checks our bags.
+        'test': ['pytest', 'playwright', 'hypothesis', 'mcap'],
     },
     zip_safe=False,
     maintainer='miro_ball developers',

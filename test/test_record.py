@@ -7,6 +7,7 @@ import sys
 import time
 
 import pytest
+from mcap.reader import make_reader
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import Odometry
 from rclpy.serialization import serialize_message
@@ -134,6 +135,20 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
     assert len(images) == 15  # 15 Hz for 1 s
     assert all(t == ns(m.header.stamp) for t, m in images)
     assert bytes(images[-1][1].data[:2]) == b'\xff\xd8'  # a JPEG, as published
+    # Foxglove's own MCAP reader agrees: a ROS 2 profile, CDR messages, ROS 2 schemas.
+    files = sorted((tmp_path / 'bag').glob('*.mcap'))
+    assert [f.name for f in files] == ['bag_0.mcap']
+    with open(files[0], 'rb') as stream:
+        reader = make_reader(stream)
+        assert reader.get_header().profile == 'ros2'
+        channels = {c.topic: c for c in reader.get_summary().channels.values()}
+        schemas = reader.get_summary().schemas
+        odom = channels[ROBOT.odom]
+        assert odom.message_encoding == 'cdr'
+        assert schemas[odom.schema_id].name == 'nav_msgs/msg/Odometry'
+        assert schemas[odom.schema_id].encoding == 'ros2msg'
+        counted = sum(1 for _, channel, _ in reader.iter_messages(topics=[ROBOT.odom]))
+        assert counted == 50
 
 
 # -- the command, as a child process --------------------------------------------------------------
