@@ -9,6 +9,7 @@ import time
 import pytest
 from mcap.reader import make_reader
 from builtin_interfaces.msg import Time
+from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
@@ -21,7 +22,7 @@ from miro_ball.lab.bag import SplitBag, offered_qos
 from miro_ball.lab.record_node import Recorder
 from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, log_time_ns
 from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
-from rostools import advance_ticks, run_command, spin_until
+from rostools import Probe, advance_ticks, run_command, spin_until
 
 ROBOT = RobotTopics(default_robot_name())
 TYPES = get_typestore(Stores.ROS2_JAZZY)
@@ -113,6 +114,11 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
                       and interface.pub_eyes['caml'][0].get_subscription_count())
     start = paused_sim.sim.time
     advance_ticks(paused_sim, executor, 50)  # 1 s
+    # A node that starts late is found (topics are looked up every second of wall time).
+    late = Probe(ros_context, executor, 'late').publisher(TwistStamped, ROBOT.cmd_vel)
+    assert spin_until(executor, lambda: late.get_subscription_count() >= 2)  # sim, recorder
+    late.publish(TwistStamped())  # unstamped: logged at the latest /clock
+    assert spin_until(executor, lambda: recorder.progress.total[ROBOT.cmd_vel] == 1)
     bag.close()
     executor.remove_node(recorder)
     recorder.destroy_node()
@@ -131,6 +137,7 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
     # Without a stamp: the /clock of the tick that carried it.
     assert [t for t, _ in recorded[ROBOT.cliff][1]] == [t for t, _ in odom]
     assert list(recorded[ROBOT.cliff][1][-1][1].data) == [1.0, 1.0]
+    assert [t for t, _ in recorded[ROBOT.cmd_vel][1]] == [odom[-1][0]]
     images = recorded[ROBOT.eye_compressed('caml')][1]
     assert len(images) == 15  # 15 Hz for 1 s
     assert all(t == ns(m.header.stamp) for t, m in images)
