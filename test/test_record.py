@@ -1,5 +1,6 @@
 """The recorder: what it writes is a rosbag2 (MCAP) bag that rosbags reads back, with the
 recorded topics, their ROS 2 Jazzy types, every message and simulated-time log times."""
+import errno
 import os
 import signal
 import subprocess
@@ -19,7 +20,7 @@ from ruamel.yaml import YAML
 
 from miro_ball.common.isolation import isolated_env
 from miro_ball.lab.bag import SplitBag, offered_qos
-from miro_ball.lab.record_node import Recorder
+from miro_ball.lab.record_node import Recorder, RecordingFailed
 from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, log_time_ns
 from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
 from rostools import Probe, advance_ticks, run_command, spin_until
@@ -156,6 +157,31 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
         assert schemas[odom.schema_id].encoding == 'ros2msg'
         counted = sum(1 for _, channel, _ in reader.iter_messages(topics=[ROBOT.odom]))
         assert counted == 50
+
+
+def test_a_full_disk_ends_the_recording_and_keeps_the_finished_files(
+        tmp_path, ros_context, executor, paused_sim, monkeypatch):
+    now = [0.0]  # the bag's clock for splitting, moved by hand
+    bag = SplitBag(tmp_path / 'bag', split_s=1.0, clock=lambda: now[0])
+    recorder = Recorder(bag, Selection([ROBOT.odom]), context=ros_context)
+    executor.add_node(recorder)
+    advance_ticks(paused_sim, executor)
+    interface = paused_sim.robots[ROBOT.name]
+    assert spin_until(executor, lambda: interface.pub_odom.get_subscription_count())
+    advance_ticks(paused_sim, executor, 25)
+    now[0] = 1.0
+    bag.tick()  # the first file is finished
+
+    def disk_full(*args):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    monkeypatch.setattr(bag.writer, 'write', disk_full)
+    with pytest.raises(RecordingFailed, match='No space left'):
+        advance_ticks(paused_sim, executor, 5)
+    executor.remove_node(recorder)
+    recorder.destroy_node()
+    stamps = [t for t, _ in read_bag(tmp_path / 'bag')[ROBOT.odom][1]]
+    assert len(stamps) == 25 and all(b - a == TICK_NS for a, b in zip(stamps, stamps[1:]))
+    assert not (tmp_path / 'bag' / 'bag_1').exists()  # the unfinished file is gone
 
 
 # -- the command, as a child process --------------------------------------------------------------

@@ -42,7 +42,7 @@ class RecordingFailed(Exception):
 class Recorder(Node):
     """Subscribes raw to every selected topic and writes what arrives into `bag`."""
 
-    def __init__(self, bag, selection, context=None, progress_s=PROGRESS_S):
+    def __init__(self, bag, selection, context=None):
         super().__init__(NODE_NAME, context=context)
         self.bag = bag
         self.selection = selection
@@ -57,7 +57,6 @@ class Recorder(Node):
         self.create_subscription(ClockMsg, CLOCK, self._on_clock, 10, raw=True)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.create_timer(DISCOVERY_S, self._on_timer, clock=steady)
-        self.progress_s = progress_s
         self.last_report = time.monotonic()
         self.get_logger().info(f'recording into {bag.path}/; waiting for {CLOCK}')
 
@@ -76,25 +75,26 @@ class Recorder(Node):
         self._write(topic, log_time_ns(stamp, self.clock_ns), data)
 
     def _write(self, topic, log_time, data):
+        self._guarded(self.bag.write, topic, log_time, data)
+        self.progress.count(topic)
+
+    def _guarded(self, action, *args):
+        """A write to the bag; an error (a full disk) ends the recording, and the files
+        finished before stay a readable bag."""
         try:
-            self.bag.write(topic, log_time, data)
+            action(*args)
         except OSError as err:
             self.bag.abort()
             raise RecordingFailed(f'writing {self.bag.path}: {err.strerror or err}') from None
-        self.progress.count(topic)
 
     # -- topics ---------------------------------------------------------------------------------
     def _on_timer(self):
         if self.clock_ns is None:
             return
         self._discover()
-        try:
-            self.bag.tick()
-        except OSError as err:
-            self.bag.abort()
-            raise RecordingFailed(f'writing {self.bag.path}: {err.strerror or err}') from None
+        self._guarded(self.bag.tick)
         now = time.monotonic()
-        if now - self.last_report >= self.progress_s:
+        if now - self.last_report >= PROGRESS_S:
             self.get_logger().info(self.progress.line(self.clock_ns * 1e-9,
                                                       now - self.last_report))
             self.last_report = now
