@@ -31,6 +31,15 @@ def advance_ticks(sim_node, executor, count=1, rounds=30):
         drain(executor, rounds=rounds)
 
 
+def advance_until(sim_node, executor, predicate, timeout_s=60.0):
+    """Step an in-process simulator tick by tick until predicate() holds (e.g. a child
+    process has done its job); the wall-clock limit only guards against a hang."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        assert time.monotonic() < deadline, 'timed out'
+        advance_ticks(sim_node, executor)
+
+
 def run_command(cmd, timeout_s=300):
     """(exit code, output) of a command run in a session of its own, so that a hang
     kills its child processes too."""

@@ -17,7 +17,7 @@ from miro_ball.examples import client_follower, client_minimal, client_show, cli
     client_video
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
 from miro_ball.miro.interface import RobotTopics, default_robot_name
-from rostools import Probe, advance_ticks, spin_until
+from rostools import Probe, advance_ticks, advance_until, spin_until
 
 T = RobotTopics(default_robot_name())
 CLIENTS = ('client_minimal', 'client_video', 'client_show', 'client_follower', 'client_test')
@@ -178,9 +178,7 @@ def test_minimal_as_a_command_with_the_robot_from_the_environment(paused_sim, ex
         interface = paused_sim.robots[T.name]
         assert spin_until(executor, lambda: interface.pub_battery.get_subscription_count(),
                           timeout_s=60.0)
-        deadline = time.monotonic() + 60.0  # a guard against a hang only
-        while proc.poll() is None and time.monotonic() < deadline:
-            advance_ticks(paused_sim, executor)
+        advance_until(paused_sim, executor, lambda: proc.poll() is not None)
         output, _ = proc.communicate(timeout=10)
     finally:
         if proc.poll() is None:

@@ -5,7 +5,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 
 import pytest
 from mcap.reader import make_reader
@@ -23,7 +22,7 @@ from miro_ball.lab.bag import SplitBag, offered_qos
 from miro_ball.lab.record_node import Recorder, RecordingFailed
 from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, log_time_ns
 from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
-from rostools import Probe, advance_ticks, run_command, spin_until
+from rostools import Probe, advance_ticks, advance_until, run_command, spin_until
 
 ROBOT = RobotTopics(default_robot_name())
 TYPES = get_typestore(Stores.ROS2_JAZZY)
@@ -202,19 +201,12 @@ def finished_count(bag, topic):
                if entry['topic_metadata']['name'] == topic)
 
 
-def run_until(paused_sim, executor, predicate, timeout_s=30.0):
-    """Step the world tick by tick until predicate() holds; the wall-clock limit is a guard."""
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        assert time.monotonic() < deadline, 'timed out'
-        advance_ticks(paused_sim, executor)
-
-
 def test_the_command_records_a_robot_until_ctrl_c_twice(tmp_path, executor, paused_sim):
     proc = start_recorder('-o', str(tmp_path / 'bag'), ROBOT.name, '--split-seconds', '0.5')
     try:
         # Until its finished files hold a second of odometry; then Ctrl+C, twice.
-        run_until(paused_sim, executor, lambda: finished_count(tmp_path / 'bag', ROBOT.odom) >= 50)
+        advance_until(paused_sim, executor,
+                      lambda: finished_count(tmp_path / 'bag', ROBOT.odom) >= 50)
         proc.send_signal(signal.SIGINT)
         proc.send_signal(signal.SIGINT)
         output, _ = proc.communicate(timeout=20)
@@ -237,7 +229,7 @@ def test_a_killed_recorder_leaves_a_readable_bag(tmp_path, executor, paused_sim)
     bag = tmp_path / 'bag'
     proc = start_recorder('-o', str(bag), ROBOT.odom, '--split-seconds', '0.2')
     try:
-        run_until(paused_sim, executor, lambda: (bag / 'metadata.yaml').exists())
+        advance_until(paused_sim, executor, lambda: (bag / 'metadata.yaml').exists())
         for _ in range(20):
             advance_ticks(paused_sim, executor)
     finally:
