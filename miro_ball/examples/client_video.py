@@ -8,6 +8,7 @@ frames per second, as the MDK client does.
 
     python -m miro_ball.examples.client_video [--out eyes] [--video eyes.avi] [--frames 0]
 """
+import os
 import sys
 from pathlib import Path
 
@@ -42,7 +43,9 @@ class Video(Client):
         except ImageRejected as err:
             self.warn(eye, f'{eye}: frame ignored: {err}')
             return
-        cv2.imwrite(str(self.out / f'{eye}.jpg'), image)
+        # Written aside, then renamed: a viewer never reads a half-written file.
+        cv2.imwrite(str(self.out / f'.{eye}.jpg'), image)
+        os.replace(self.out / f'.{eye}.jpg', self.out / f'{eye}.jpg')
         stamp = (msg.header.stamp.sec, msg.header.stamp.nanosec)
         self.latest[eye] = (stamp, image)
         left, right = (self.latest.get(e) for e in EYES)
