@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 from miro_ball.lab.judge import KICK_DISTANCE_M
+from miro_ball.lab.scenarios import ARENA_FREE_RADIUS
 
 EXAMPLE = 'python -m miro_ball.grade --count 5 -- python -m miro_ball --ros-args -p ' \
           'use_sim_time:=true'
@@ -27,12 +28,12 @@ def parser():
         epilog=f'example:\n  {EXAMPLE}\n\nThe command gets Ctrl+C (SIGINT) when an episode '
                'ends and is killed after the grace period. A controller on wall time needs '
                'the default real-time factor 1; one on /clock (use_sim_time) is judged the '
-               'same at any.')
+               'same at any speed the machine keeps up with.')
     p.add_argument('--count', type=int, default=5, help='placements (5)')
     p.add_argument('--seed', type=int, default=0, help='placement seed (0)')
     p.add_argument('--world', default='miro',
                    help='world with one robot and the ball: a bundled name or a .toml path '
-                        '(miro); placements are within 0.96 m of its centre')
+                        f'(miro); placements are within {ARENA_FREE_RADIUS:g} m of its centre')
     p.add_argument('--limit', type=float, default=60.0,
                    help='simulated seconds per episode (60)')
     p.add_argument('--jobs', type=int, default=1,
