@@ -53,7 +53,7 @@ def test_a_robot_name_selects_its_topics_and_ground_truth_only():
     assert not selection.wants(other.odom) and not selection.wants(CLOCK)
     everything = Selection()
     assert everything.wants(other.odom) and everything.wants(CLOCK)
-    topics = Selection([ROBOT.odom.lstrip('/'), '/miro_sim/*'])
+    topics = Selection([ROBOT.odom.lstrip('/'), SimTopics().topic('*')])
     assert topics.wants(ROBOT.odom) and topics.wants(SimTopics().ball)
     assert not topics.wants(ROBOT.cliff)
     with pytest.raises(ValueError):

@@ -16,7 +16,8 @@ from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
-from miro_ball.miro.interface import RobotTopics, check_name, default_robot_name
+from miro_ball.miro.interface import DEFAULT_ROBOT_NAME, RobotTopics, check_name, \
+    default_robot_name
 
 
 def make_parser(prog, doc):
@@ -27,7 +28,7 @@ def make_parser(prog, doc):
                '(python -m miro_sim_bullet).')
     parser.add_argument('--robot', default=default_robot_name(),
                         help='robot name, i.e. topic prefix (default: $MIRO_ROBOT_NAME or '
-                             'miro: %(default)s)')
+                             f'{DEFAULT_ROBOT_NAME}: %(default)s)')
     return parser
 
 

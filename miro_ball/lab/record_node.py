@@ -27,7 +27,7 @@ from miro_ball.common.throttle import Throttled
 from miro_ball.lab.bag import BagError, SplitBag, TYPESTORE, offered_qos
 from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, \
     import_name, log_time_ns
-from miro_ball.miro.interface import CLOCK
+from miro_ball.miro.interface import CLOCK, DEFAULT_ROBOT_NAME, RobotTopics
 
 NODE_NAME = 'miro_record'
 DISCOVERY_S = 1.0  # how often new topics are looked for (wall time)
@@ -143,15 +143,17 @@ class Recorder(Node):
 
 
 def parse_args(argv):
+    robot = RobotTopics(DEFAULT_ROBOT_NAME)  # for the examples in --help
     parser = argparse.ArgumentParser(
         prog='python -m miro_ball.record', formatter_class=argparse.RawDescriptionHelpFormatter,
-        description='Record ROS topics into a rosbag2 directory (MCAP storage, ROS 2 Jazzy '
+        description='Record ROS topics into a rosbag2 directory (MCAP storage, ROS 2 Jazzy\n'
                     'types) that ros2 bag info/play, Foxglove and the rosbags library open.',
-        epilog='Targets: a topic (/miro/sensors/odom), a pattern (\'/miro/sensors/*\') or a '
-               'robot name (miro02: all its topics and its ground truth); none = every topic.\n'
-               'Log times are simulated time: the message stamp where it has one, else the '
-               'latest /clock;\nnothing is recorded before the first /clock. Ctrl+C finishes '
-               'the bag; a hard stop or a full disk\nloses at most the last --split-seconds.')
+        epilog=f'Targets: a topic ({robot.odom}), a pattern (\'{robot.topic("sensors/*")}\') '
+               f'or a robot name\n({robot.name}: all its topics and its ground truth); none = '
+               'every topic.\nLog times are simulated time: the message stamp where it has one, '
+               'else the latest /clock;\nnothing is recorded before the first /clock. Ctrl+C '
+               'finishes the bag; a hard stop or a full\ndisk loses at most the last '
+               '--split-seconds.')
     parser.add_argument('-o', '--output', required=True, metavar='DIR',
                         help='the bag directory to create (must not exist, or be empty)')
     parser.add_argument('targets', nargs='*', metavar='TOPIC',
