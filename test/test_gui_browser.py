@@ -7,16 +7,14 @@ tests of this file; each test opens its own page.
 """
 import http.client
 import os
-import select
 import shutil
-import subprocess
 import sys
-import time
 
 import pytest
 from rclpy.parameter import Parameter
 
 from miro_ball.common.isolation import isolated_env
+from miro_ball.gui.process import GuiProcess
 from miro_ball.miro.interface import RobotTopics, default_robot_name
 
 playwright_api = pytest.importorskip('playwright.sync_api')
@@ -42,7 +40,6 @@ class Rig:
     def __init__(self, context, executor, sim, url, browser, probe):
         self.context, self.executor, self.sim = context, executor, sim
         self.url, self.browser = url, browser
-        from geometry_msgs.msg import TwistStamped  # noqa: F401 (types for the probe)
         from nav_msgs.msg import Odometry
         from sensor_msgs.msg import JointState
         from std_msgs.msg import Float32MultiArray
@@ -88,22 +85,6 @@ def frames(page, channel):
     return page.evaluate(f'window.miroGui ? (miroGui.frames[{channel!r}] || 0) : 0')
 
 
-def start_gui(domain):
-    proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.gui', '--port', '0'],
-                            env=isolated_env(domain), stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True)
-    deadline = time.monotonic() + 30.0  # a guard against a hang only
-    lines = []
-    while time.monotonic() < deadline and proc.poll() is None:
-        if select.select([proc.stdout], [], [], 0.5)[0]:
-            line = proc.stdout.readline()
-            lines.append(line)
-            if 'open http://' in line:
-                return proc, line.split('open ')[1].strip()
-    proc.kill()
-    raise AssertionError('miro_gui printed no URL:\n' + ''.join(lines))
-
-
 @pytest.fixture(scope='module')
 def rig():
     import rclpy
@@ -123,24 +104,22 @@ def rig():
         Parameter('frame_height', value=240), Parameter('overhead_rate', value=5.0)])
     executor.add_node(sim)
     probe = Probe(context, executor, name='gui_probe')
-    gui, url = start_gui(domain)
+    gui = GuiProcess(isolated_env(domain))
     pw = playwright_api.sync_playwright().start()
     browser = pw.chromium.launch(executable_path=CHROMIUM)
     try:
-        yield Rig(context, executor, sim, url, browser, probe)
+        yield Rig(context, executor, sim, gui.url, browser, probe)
     finally:
         browser.close()
         pw.stop()
-        gui.terminate()
-        try:
-            out, _ = gui.communicate(timeout=10)
-        except subprocess.TimeoutExpired:
-            gui.kill()
-            out, _ = gui.communicate()
-        sys.stdout.write(out)
+        code = gui.stop()
+        output = ''.join(gui.output)
+        sys.stdout.write(output)
         executor.shutdown(timeout_sec=1.0)
         sim.destroy_node()
         rclpy.try_shutdown(context=context)
+    # Stopped like a user's Ctrl+C: at once, cleanly.
+    assert code == 0 and 'Traceback' not in output, output
 
 
 def test_page_shows_both_eyes_live_the_ball_and_the_readouts(rig, tmp_path):

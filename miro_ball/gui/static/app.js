@@ -20,6 +20,11 @@ let channels = [];
 const frameTimes = {};
 const lastDebug = {};
 
+// A number with so many decimals, without the '-' of a '-0.0'.
+function fixed(value, decimals) {
+  return value.toFixed(decimals).replace(/^-(0\.?0*)$/, '$1');
+}
+
 function send(message) {
   if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(message));
 }
@@ -151,7 +156,7 @@ function showReadouts(readouts) {
     const v = get(readouts);
     const number = barValue ? barValue(readouts) : v;
     cell.textContent = v === undefined || v === null ? '-'
-      : decimals === null ? v : `${v.toFixed(decimals).replace(/^-(0\.?0*)$/, '$1')}${unit ? ' ' + unit : ''}`;
+      : decimals === null ? v : `${fixed(v, decimals)}${unit ? ' ' + unit : ''}`;
     // A bar from zero (or the low end when zero is off the scale) to the value.
     const clamp = (x) => Math.min(Math.max(x, lo), hi);
     const zero = clamp(0);
@@ -379,7 +384,7 @@ function showMeasured() {
   if (!r || !r.head) return;
   ['lift', 'yaw', 'pitch'].forEach((joint, i) => {
     const span = $(joint + '_measured');
-    if (span && typeof r.head[i] === 'number') span.textContent = `(${r.head[i].toFixed(1)})`;
+    if (span && typeof r.head[i] === 'number') span.textContent = `(${fixed(r.head[i], 1)})`;
   });
 }
 
