@@ -4,6 +4,7 @@
 #   ./dev.sh demo [args]   headless simulator + controller, summary and video
 #   ./dev.sh test [args]   the test suite (pytest)
 #   ./dev.sh bench         simulator, detection and scenario benchmarks
+#   ./dev.sh soak [args]   long free run: memory, open files, speed per minute (--minutes N)
 #   ./dev.sh setup         only the set-up
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -54,5 +55,6 @@ case "$cmd" in
   demo) setup; exec "$PY" -m miro_ball.lab.demo "$@" ;;
   test) setup; exec "$PY" -m pytest "$@" ;;
   bench) setup; exec "$PY" -m miro_ball.lab.sim_bench "$@" ;;
-  *) sed -n '2,8p' "$0"; exit 2 ;;
+  soak) setup; exec "$PY" -m miro_ball.lab.soak "$@" ;;
+  *) sed -n '2,9p' "$0"; exit 2 ;;
 esac

@@ -1,0 +1,116 @@
+"""The soak: its figures, its verdict, and a short run of the real thing."""
+import re
+import subprocess
+import sys
+
+import pytest
+
+from miro_ball.lab.soak import (descendants, growth, process_tree, RSS_TARGET_PCT, rss_mb,
+                                Sample, trend_pct, verdict)
+from miro_ball.miro.interface import default_robot_name
+from rostools import run_command
+
+
+def samples(rss, rtfs, minutes_per_interval=1.0):
+    """A start sample and one per interval: a process whose RSS goes through ``rss`` while
+    the simulator runs at the given real-time factors (frames: 30 per simulated s)."""
+    made = [Sample(wall=0.0, sim=0.0, frames=0, usage={'miro_sim': (rss[0], 10)})]
+    for value, rtf in zip(rss, rtfs):
+        last = made[-1]
+        wall = last.wall + 60.0 * minutes_per_interval
+        sim = last.sim + 60.0 * minutes_per_interval * rtf
+        made.append(Sample(wall, sim, int(30 * sim), {'miro_sim': (value, 10)}))
+    return made
+
+
+def test_flat_memory_and_steady_speed_pass():
+    passed, lines = verdict(samples([400.0] * 10, [2.0, 2.1, 1.9, 2.0, 2.0, 2.1, 1.9, 2.0,
+                                                   2.0, 2.0]))
+    assert passed, lines
+    assert lines[0] == 'verdict: PASS'
+
+
+def test_memory_growing_faster_than_the_target_fails():
+    # +0.5 MB per simulated minute on 400 MB: 7.5 % per simulated hour
+    rss = [400.0 + 0.5 * 2 * i for i in range(10)]
+    passed, lines = verdict(samples(rss, [2.0] * 10))
+    assert not passed and 'TOO MUCH' in lines[1], lines
+
+
+def test_growth_is_judged_per_60_simulated_minutes():
+    """1 % in 20 simulated minutes is 3 % per hour: too much; in 120 minutes, 0.5 %: fine."""
+    short = samples([400.0, 404.0], [20.0, 20.0])  # 20 simulated minutes between the two
+    long = samples([400.0, 404.0], [120.0, 120.0])
+    assert not verdict(short)[0]
+    assert verdict(long)[0]
+    assert 1.0 * 60 / 20 > RSS_TARGET_PCT > 1.0 * 60 / 120
+
+
+def test_a_slowing_simulator_fails_on_its_trend():
+    passed, lines = verdict(samples([400.0] * 10, [2.0 - 0.05 * i for i in range(10)]))
+    assert not passed and 'TREND' in lines[2], lines
+
+
+def test_trend_is_the_fitted_change_over_the_run():
+    assert trend_pct([1.0, 1.0, 1.0]) == pytest.approx(0.0)
+    assert trend_pct([1.0, 1.5, 2.0]) == pytest.approx(100.0 * 1.0 / 1.5)
+    assert trend_pct([1.0, 2.0]) is None  # two points make a line, not a trend
+
+
+def test_too_short_a_run_is_not_judged_a_pass():
+    passed, lines = verdict(samples([400.0], [2.0]))
+    assert not passed and 'too short' in lines[0]
+
+
+def test_growth_per_process_and_in_total():
+    first = Sample(0, 0, 0, {'a': (100.0, 5), 'b': (300.0, 7), 'gone': (50.0, 3)})
+    last = Sample(60, 120, 0, {'a': (110.0, 6), 'b': (300.0, 7), 'new': (80.0, 3)})
+    rows = growth(first, last)
+    assert set(rows) == {'a', 'b', 'total'}  # only processes alive in both samples
+    assert rows['a'] == pytest.approx((100.0, 110.0, 10.0, 5, 6))
+    assert rows['total'] == pytest.approx((400.0, 410.0, 2.5, 12, 13))
+
+
+def test_the_process_tree_includes_children_with_their_memory():
+    proc = subprocess.Popen(['sh', '-c', 'sleep 30 & echo forked; wait'], stdout=subprocess.PIPE,
+                            text=True)
+    try:
+        assert proc.stdout.readline() == 'forked\n'
+        tree = process_tree([('top', proc.pid)])
+        assert tree['top'] == proc.pid and len(tree) == 2, tree
+        assert all(rss_mb(pid) > 0 for pid in tree.values())
+    finally:
+        for pid in descendants(proc.pid):
+            subprocess.run(['kill', str(pid)])
+        proc.wait()
+        proc.stdout.close()
+
+
+def test_help_and_bad_minutes():
+    ok = subprocess.run([sys.executable, '-m', 'miro_ball.lab.soak', '--help'],
+                        capture_output=True, text=True)
+    assert ok.returncode == 0 and '--minutes' in ok.stdout and '--gui' in ok.stdout
+    bad = subprocess.run([sys.executable, '-m', 'miro_ball.lab.soak', '--minutes', '-1'],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.strip().splitlines()[-1].startswith(
+        'python -m miro_ball.lab.soak: error: --minutes')
+    assert 'Traceback' not in bad.stderr
+
+
+def test_a_short_soak_reports_every_process_and_the_growth(tmp_path):
+    code, output = run_command([sys.executable, '-m', 'miro_ball.lab.soak', '--minutes',
+                                '0.15', '--report-every', '3', '--out', str(tmp_path)])
+    reports = re.findall(r'^after [0-9.]+ min: simulated [0-9.]+ min, RTF ([0-9.]+), '
+                         r'(\d+) frames', output, re.M)
+    assert len(reports) == 3, output
+    assert all(float(rtf) > 0 for rtf, _ in reports), output
+    assert sum(int(frames) for _, frames in reports) > 0, output
+    for process in ('miro_sim', f'kick_blue_ball_{default_robot_name()}'):
+        assert re.search(rf'^  {process} +RSS +[0-9.]+ MB  fds +\d+$', output, re.M), output
+        assert re.search(rf'^  {process} +RSS +[0-9.]+ -> +[0-9.]+ MB +[-+][0-9.]+ %', output,
+                         re.M), output
+    assert re.search(r'^RTF per interval: [0-9.]+ [0-9.]+ [0-9.]+$', output, re.M), output
+    judged = re.search(r'^verdict: (PASS|FAIL)$', output, re.M)
+    assert judged and code == (0 if judged.group(1) == 'PASS' else 1), output
+    for log in (tmp_path / 'soak').glob('*.log'):
+        assert 'Traceback' not in log.read_text(), log
