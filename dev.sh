@@ -56,5 +56,5 @@ case "$cmd" in
   test) setup; exec "$PY" -m pytest "$@" ;;
   bench) setup; exec "$PY" -m miro_ball.lab.sim_bench "$@" ;;
   soak) setup; exec "$PY" -m miro_ball.lab.soak "$@" ;;
-  *) sed -n '2,9p' "$0"; exit 2 ;;
+  *) sed -n '2,8p' "$0"; exit 2 ;;
 esac
