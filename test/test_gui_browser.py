@@ -123,9 +123,10 @@ def rig():
 
 
 def test_page_shows_both_eyes_live_the_ball_and_the_readouts(rig, tmp_path):
-    page = rig.open_page()
-    before = {eye: frames(page, eye) for eye in ('caml', 'camr')}
-    assert rig.step(2.0, lambda: all(frames(page, e) >= before[e] + 5 for e in before))
+    page, other = rig.open_page(), rig.open_page()  # two pages at once both work
+    before = {(p, eye): frames(p, eye) for p in (page, other) for eye in ('caml', 'camr')}
+    assert rig.step(2.0, lambda: all(frames(p, e) >= n + 5 for (p, e), n in before.items()))
+    other.close()
     assert rig.step(2.0, lambda: page.evaluate(
         "miroGui.state && miroGui.state.readouts.battery > 4 && miroGui.state.sim.present"))
     ball_pixels = max(page.evaluate(BLUE_BALL_JS, eye) for eye in ('caml', 'camr'))

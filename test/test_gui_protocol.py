@@ -10,6 +10,7 @@ from miro_ball.gui import readouts as r
 from miro_ball.gui.server import is_loopback, origin_allowed
 from miro_ball.miro.constants import (DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       TILT_RAD, WHEEL_MAX_SPEED_M_PER_S)
+from miro_ball.miro.interface import RobotTopics, SimTopics, robots_in
 from miro_ball.miro.kinematics import cmd_vel2wheel_speed
 
 
@@ -151,3 +152,10 @@ def test_only_the_pages_own_origin_may_open_a_websocket(origin, host, loopback_o
 def test_loopback_addresses():
     assert is_loopback('127.0.0.1') and is_loopback('::1') and is_loopback('localhost')
     assert not is_loopback('0.0.0.0') and not is_loopback('192.168.1.2')
+
+
+def test_robots_are_found_by_their_odometry_topic():
+    graph = [RobotTopics('miro02').odom, RobotTopics('miro02').cmd_vel, RobotTopics('a1').odom,
+             SimTopics().object_pose('ball'), '/clock', '/x/y/sensors/odom', '/9x/sensors/odom',
+             '/sensors/odom', 'miro/sensors/odom']
+    assert robots_in(graph) == ['a1', 'miro02']
