@@ -229,6 +229,9 @@ def _create_context():
         import moderngl
     except ImportError as exc:
         raise GlUnavailable(f'moderngl is not installed ({exc})') from None
+    # llvmpipe (no GPU) rasterises in the calling thread: as fast here as with its own
+    # threads, and it leaves the other cores to physics and the controllers.
+    os.environ.setdefault('LP_NUM_THREADS', '0')
     if os.environ.get('EGL_PLATFORM') == 'device':
         os.environ.pop('EGL_PLATFORM')  # breaks eglGetDisplay in Mesa's loader
     try:

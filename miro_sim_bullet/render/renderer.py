@@ -11,7 +11,6 @@ Two back ends:
 ``tiny`` with one log line saying why.
 """
 import functools
-import os
 
 import cv2
 import numpy as np
@@ -24,9 +23,6 @@ _FLAGS = p.ER_NO_SEGMENTATION_MASK
 # TinyRenderer keeps shadow and light settings from the previous call (server-side state),
 # so every call sets them; the light comes from above, slightly from the front-left.
 _TINY_LIGHT_DIRECTION = (0.4, 0.3, 1.0)
-# llvmpipe rasterises in the calling thread: as fast here as its own threads, and it
-# leaves the other core to the controllers.
-_LLVMPIPE_THREADS = '0'
 
 
 class RendererUnavailable(RuntimeError):
@@ -108,7 +104,6 @@ class _GlBackend:
     kind = 'egl'
 
     def __init__(self, client_id):
-        os.environ.setdefault('LP_NUM_THREADS', _LLVMPIPE_THREADS)
         self.gl = GlBackend(client_id)
         self.name = 'egl'
         self.device = self.gl.device

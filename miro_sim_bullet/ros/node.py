@@ -14,7 +14,7 @@ import time
 import rclpy
 from geometry_msgs.msg import PointStamped, PoseStamped
 from rclpy.clock import Clock, ClockType
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -240,6 +240,14 @@ def parse_args(argv):
     return parser.parse_args(argv)
 
 
+def make_executor(context=None):
+    """What the simulator spins on: rclpy's EventsExecutor (experimental in Jazzy; the
+    simulator's use of it is covered by test/test_sim_executor.py). It takes fewer and
+    cheaper turns than SingleThreadedExecutor: real-time factor 5.7 instead of 4.9 for the
+    default world with both eyes subscribed (BENCHMARKS.md)."""
+    return EventsExecutor(context=context)
+
+
 def main(argv=None):
     argv = sys.argv if argv is None else argv
     try:
@@ -254,7 +262,7 @@ def main(argv=None):
     node = None
     try:
         node = SimNode(parameter_overrides=overrides)
-        executor = SingleThreadedExecutor()
+        executor = make_executor()
         executor.add_node(node)
         spin_until_stopped(executor, stop)
     except (WorldError, RendererUnavailable, ValueError) as err:
