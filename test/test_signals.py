@@ -21,6 +21,7 @@ SIMULATOR = ('miro_sim_bullet', 'real-time factor', ['--ros-args', '-p', 'render
 # Alone, it says what it waits for: the blocked state that used to ignore signals.
 CONTROLLER = ('miro_ball', 'waiting for /clock on ROS domain',
               ['--ros-args', '-p', 'use_sim_time:=true'])
+BALL_MOVER = ('miro_ball.examples.ball_mover', "on the simulator's /clock", [])
 # The controller's first tick on the simulator's /clock: it is running with its peer.
 CONTROLLER_WITH_PEER = ('miro_ball', 'holding the head pose', CONTROLLER[2])
 
@@ -87,7 +88,8 @@ def assert_clean_exit(result, what):
 
 
 @pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM])
-@pytest.mark.parametrize('spec', [SIMULATOR, CONTROLLER], ids=['simulator', 'controller'])
+@pytest.mark.parametrize('spec', [SIMULATOR, CONTROLLER, BALL_MOVER],
+                         ids=['simulator', 'controller', 'ball_mover'])
 def test_alone(nodes, spec, signum):
     node = nodes(spec).wait_ready()
     assert_clean_exit(node.stop(signum), spec[0])

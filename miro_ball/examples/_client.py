@@ -51,7 +51,8 @@ def parse(parser, argv):
     """The options of argv (the ROS arguments left out); errors end in one line, exit 2."""
     try:
         options = parser.parse_args(rclpy.utilities.remove_ros_args(argv)[1:])
-        check_name(options.robot)
+        if hasattr(options, 'robot'):  # not every client drives a robot (ball_mover)
+            check_name(options.robot)
     except ValueError as err:  # a bad robot name, or rclpy's malformed --ros-args
         parser.error(str(err))
     return options

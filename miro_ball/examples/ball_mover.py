@@ -11,13 +11,12 @@ import argparse
 import math
 import sys
 
-import rclpy
 from geometry_msgs.msg import PoseStamped
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from miro_ball.miro.interface import SimTopics
+from miro_ball.examples._client import number, run
+from miro_ball.miro.interface import BALL_NAME, SimTopics
 
 
 def ball_y(t, amplitude, period):
@@ -34,6 +33,9 @@ class BallMover(Node):
         self.start = None
         self.last = None  # (t, y) of the latest command
         self.timer = self.create_timer(0.02, self.tick)
+        self.get_logger().info(
+            f"moving '{options.object}' along x = {options.x:g} m: y = {options.amplitude:g} "
+            f"sin(2 pi t / {options.period:g} s), on the simulator's /clock")
 
     def tick(self):
         now = self.get_clock().now().nanoseconds * 1e-9
@@ -54,38 +56,34 @@ class BallMover(Node):
         self.last = (t, msg.pose.position.y)
 
 
-def parse_args(argv):
+    def stop(self):
+        """The ball stays where it is."""
+
+
+def build_parser():
     parser = argparse.ArgumentParser(prog='ball_mover', description=__doc__.split('\n\n')[0])
-    parser.add_argument('--x', type=float, default=0.6, help='x of the line (0.6 m)')
-    parser.add_argument('--amplitude', type=float, default=0.65, help='A, m (0.65)')
-    parser.add_argument('--period', type=float, default=1.0, help='T, simulated s (1.0)')
-    parser.add_argument('--z', type=float, default=0.1,
-                        help='height of the object\'s centre (0.1 m: the ball on the floor)')
-    parser.add_argument('--duration', type=float, default=120.0,
+    parser.add_argument('--x', type=number(-1000, 1000), default=0.6,
+                        help='x of the line (0.6 m)')
+    parser.add_argument('--amplitude', type=number(-1000, 1000), default=0.65,
+                        help='A, m (0.65)')
+    parser.add_argument('--period', type=number(0.001, 1000), default=1.0,
+                        help='T, simulated s (1.0)')
+    parser.add_argument('--z', type=number(-1000, 1000), default=0.1,
+                        help="height of the object's centre (0.1 m: the ball on the floor)")
+    parser.add_argument('--duration', type=number(0, 1e6), default=120.0,
                         help='stop after this many simulated seconds; 0 = never (120)')
-    parser.add_argument('--object', default='ball', help='name of the object to move (ball)')
-    options = parser.parse_args(argv)
-    values = (options.x, options.amplitude, options.period, options.z, options.duration)
-    if not all(math.isfinite(v) and abs(v) <= 1000 for v in values):
-        parser.error('numbers must be finite and within 1000')
-    if options.period <= 0 or options.duration < 0:
-        parser.error('--period must be > 0 and --duration >= 0')
-    return options
+    parser.add_argument('--object', default=BALL_NAME,
+                        help=f'name of the object to move ({BALL_NAME})')
+    return parser
+
+
+def parse_args(argv):
+    return build_parser().parse_args(argv)
 
 
 def main(argv=None):
-    argv = sys.argv if argv is None else argv
-    options = parse_args(rclpy.utilities.remove_ros_args(argv)[1:])
-    rclpy.init(args=argv)
-    node = BallMover(options)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException, SystemExit):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    return run(BallMover, build_parser(), argv)
 
 
 if __name__ == '__main__':
-    main()
+    sys.exit(main())

@@ -14,6 +14,7 @@ CLOCK = '/clock'
 EYES = ('caml', 'camr')  # index 0 is the left eye, as the MDK's CAM_L
 EYE_SIDE = {'caml': +1, 'camr': -1}  # +1 left, -1 right: the sign of the eye's y offset
 SIM_NODE_NAME = 'miro_sim'
+BALL_NAME = 'ball'  # the simulator's name of the ball, for set_pose and its ground truth
 CONTROLLER_NODE_NAME = 'kick_blue_ball'
 GUI_NODE_NAME = 'miro_gui'
 MAX_NAME_LENGTH = 64

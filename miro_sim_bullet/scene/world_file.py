@@ -32,10 +32,9 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from miro_ball.miro.interface import check_name
+from miro_ball.miro.interface import BALL_NAME, check_name
 
 DEFAULT_COLOUR = (0.7, 0.7, 0.7)
-BALL_NAME = 'ball'
 MAX_FILE_BYTES = 1_000_000
 MAX_MAGNITUDE = 1000.0
 MAX_ROBOTS = 16
