@@ -44,16 +44,28 @@ def executor(ros_context):
 
 
 @pytest.fixture
-def paused_sim(ros_context, executor):
-    """The simulator node in-process on the default world, paused: the test steps it
-    (rostools.advance_ticks)."""
+def make_sim(ros_context, executor):
+    """make_sim(name=value, ...): a simulator node in-process, paused (the test steps it,
+    rostools.advance_ticks), with those parameters; destroyed after the test."""
     from rclpy.parameter import Parameter
 
     from miro_sim_bullet.ros.node import SimNode
 
-    node = SimNode(context=ros_context, parameter_overrides=[
-        Parameter('paused', value=True), Parameter('world', value='miro')])
-    executor.add_node(node)
-    yield node
-    executor.remove_node(node)
-    node.destroy_node()
+    made = []
+
+    def make(**params):
+        params = {'paused': True, 'world': 'miro', **params}
+        made.append(SimNode(context=ros_context, parameter_overrides=[
+            Parameter(name, value=value) for name, value in params.items()]))
+        executor.add_node(made[-1])
+        return made[-1]
+    yield make
+    for node in made:
+        executor.remove_node(node)
+        node.destroy_node()
+
+
+@pytest.fixture
+def paused_sim(make_sim):
+    """The simulator node in-process on the default world, paused."""
+    return make_sim()

@@ -146,6 +146,15 @@ def short_hold(*more):
     return [Parameter('head_hold_s', value=0.1)] + list(more)
 
 
+def drives_at_a_ball_ahead(rig, start=10.0):
+    """After a short head hold, both eyes see the ball ahead: the node drives at it."""
+    rig.set_clock(start)
+    rig.advance(0.2)
+    rig.both_eyes(*AHEAD)
+    rig.advance(0.1)
+    return rig.last_twist()[0] > 0.1
+
+
 def test_tutorial_holds_the_head_then_searches(make_rig):
     rig = make_rig(Parameter('mode', value='tutorial'))
     rig.set_clock(10.0)
@@ -242,11 +251,7 @@ def test_detections_expire_when_a_camera_stops(make_rig):
 
 def test_stop_sends_a_zero_twist(make_rig):
     rig = make_rig(*short_hold())
-    rig.set_clock(10.0)
-    rig.advance(0.2)
-    rig.both_eyes(*AHEAD)
-    rig.advance(0.1)
-    assert rig.last_twist()[0] > 0.1
+    assert drives_at_a_ball_ahead(rig)
     rig.node.stop()
     assert rig.last_twist() == (0.0, 0.0)
 

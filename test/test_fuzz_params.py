@@ -54,7 +54,7 @@ def test_simulator_parameters_at_run_time(ros_context, executor):
 
 
 def test_controller_parameters_at_run_time(ros_context, executor):
-    from test_controller_node import AHEAD, Rig, short_hold
+    from test_controller_node import drives_at_a_ball_ahead, Rig, short_hold
 
     rig = Rig(ros_context, executor, short_hold())
     node = rig.node
@@ -69,10 +69,6 @@ def test_controller_parameters_at_run_time(ros_context, executor):
                     for f in fields(cls) if not isinstance(f.default, tuple)]
         assert all(r.successful for r in node.set_parameters(defaults))
         node.set_parameters([Parameter('head_hold_s', value=0.1)])
-        rig.set_clock(10.0)
-        rig.advance(0.2)
-        rig.both_eyes(*AHEAD)
-        rig.advance(0.1)
-        assert rig.last_twist()[0] > 0.1
+        assert drives_at_a_ball_ahead(rig)
     finally:
         rig.close()

@@ -65,7 +65,7 @@ def test_the_simulator_survives_every_topic(ros_context, executor):
 
 
 def test_the_controller_survives_every_topic(ros_context, executor):
-    from test_controller_node import AHEAD, Rig, short_hold
+    from test_controller_node import drives_at_a_ball_ahead, Rig, short_hold
 
     rig = Rig(ros_context, executor, short_hold(), robot=default_robot_name())
     try:
@@ -73,10 +73,6 @@ def test_the_controller_survives_every_topic(ros_context, executor):
         delivered = fuzz(rig.node, Probe(ros_context, executor, 'fuzzer'), executor)
         assert '/clock' in delivered and min(delivered.values()) > 2
         # Still ticking and kicking: the clock starts over from a sane time.
-        rig.set_clock(30.0)
-        rig.advance(0.2)
-        rig.both_eyes(*AHEAD)
-        rig.advance(0.1)
-        assert rig.last_twist()[0] > 0.1
+        assert drives_at_a_ball_ahead(rig, start=30.0)
     finally:
         rig.close()

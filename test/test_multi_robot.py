@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from geometry_msgs.msg import PointStamped, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
-from rclpy.parameter import Parameter
 from sensor_msgs.msg import CameraInfo, CompressedImage, Imu, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt32
 
@@ -16,7 +15,6 @@ from miro_ball.examples.ball_mover import BallMover, ball_y, parse_args
 from miro_ball.miro.camera import Intrinsics, project
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics
 from miro_sim_bullet.physics.world import SimWorld
-from miro_sim_bullet.ros.node import SimNode
 from miro_sim_bullet.scene.world_file import bundled_worlds
 from rostools import Probe, drain, spin_until
 
@@ -25,15 +23,9 @@ SIM = SimTopics()
 
 
 @pytest.fixture
-def pitch(ros_context, executor):
-    node = SimNode(context=ros_context, parameter_overrides=[
-        Parameter('paused', value=True), Parameter('world', value='football_pitch'),
-        Parameter('renderer', value='tiny'), Parameter('eye_workers', value=False),
-        Parameter('frame_width', value=320), Parameter('frame_height', value=240)])
-    executor.add_node(node)
-    yield node
-    executor.remove_node(node)
-    node.destroy_node()
+def pitch(make_sim):
+    return make_sim(world='football_pitch', renderer='tiny', eye_workers=False,
+                    frame_width=320, frame_height=240)
 
 
 @pytest.fixture

@@ -19,7 +19,6 @@ from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR
 from miro_ball.miro.interface import RobotTopics, SimTopics, default_robot_name
-from miro_sim_bullet.ros.node import SimNode
 from rostools import Probe, drain, spin_until
 
 T = RobotTopics(default_robot_name())
@@ -27,13 +26,8 @@ SIM = SimTopics()
 
 
 @pytest.fixture
-def sim_node(ros_context, executor):
-    node = SimNode(context=ros_context, parameter_overrides=[
-        Parameter('paused', value=True), Parameter('world', value='miro')])
-    executor.add_node(node)
-    yield node
-    executor.remove_node(node)
-    node.destroy_node()
+def sim_node(paused_sim):
+    return paused_sim
 
 
 @pytest.fixture
