@@ -6,7 +6,7 @@ from dataclasses import fields
 from rclpy.parameter import Parameter
 
 from miro_ball.controller.params import GROUPS
-from miro_sim_bullet.ros.node import FIXED_PARAMS, SimNode
+from miro_sim_bullet.ros.node import FIXED_PARAMS
 from miro_sim_bullet.ros.params import SimParams
 
 CONTROLLER_FIXED = ('robot_name', 'tick')
@@ -40,17 +40,14 @@ def exercise(node, groups, fixed, current):
                 assert not result.successful and current(f.name) == before, f.name
 
 
-def test_simulator_parameters_at_run_time(ros_context, executor):
-    node = SimNode(context=ros_context, parameter_overrides=[Parameter('paused', value=True)])
-    try:
-        exercise(node, [SimParams], FIXED_PARAMS, lambda name: getattr(node.params, name))
-        node.set_parameters([Parameter('real_time_factor', value=0.0),
-                             Parameter('step_count', value=20)])
-        before = node.sim.time
-        node.advance(100)
-        assert node.sim.time > before
-    finally:
-        node.destroy_node()
+def test_simulator_parameters_at_run_time(paused_sim):
+    node = paused_sim
+    exercise(node, [SimParams], FIXED_PARAMS, lambda name: getattr(node.params, name))
+    node.set_parameters([Parameter('real_time_factor', value=0.0),
+                         Parameter('step_count', value=20)])
+    before = node.sim.time
+    node.advance(100)
+    assert node.sim.time > before
 
 
 def test_controller_parameters_at_run_time(ros_context, executor):

@@ -6,11 +6,9 @@ The topics are the nodes' own subscription lists, so a topic added later is fuzz
 import math
 
 from geometry_msgs.msg import TwistStamped
-from rclpy.parameter import Parameter
 
 from fuzzmsg import hostile
 from miro_ball.miro.interface import default_robot_name, RobotTopics
-from miro_sim_bullet.ros.node import SimNode
 from rostools import drain, Probe, spin_until
 
 
@@ -39,29 +37,24 @@ def fuzz(node, probe, executor, between=lambda: None):
     return delivered
 
 
-def test_the_simulator_survives_every_topic(ros_context, executor):
-    node = SimNode(context=ros_context, parameter_overrides=[Parameter('paused', value=True)])
-    executor.add_node(node)
+def test_the_simulator_survives_every_topic(paused_sim, ros_context, executor):
+    node = paused_sim
     probe = Probe(ros_context, executor)
-    try:
-        name = next(iter(node.robots))
-        delivered = fuzz(node, probe, executor, between=lambda: node.advance(5))
-        assert RobotTopics(name).cmd_vel in delivered and min(delivered.values()) > 2
-        robot = node.sim.robots[name]
-        start = robot.ground_truth()
-        assert all(math.isfinite(v) for v in start)
-        # Still driven by a good command.
-        cmd = probe.publisher(TwistStamped, RobotTopics(name).cmd_vel)
-        for _ in range(50):
-            msg = TwistStamped()
-            msg.twist.linear.x = 0.2
-            cmd.publish(msg)
-            drain(executor, rounds=5)
-            node.advance(20)
-        assert math.dist(robot.ground_truth()[:2], start[:2]) > 0.05
-    finally:
-        executor.remove_node(node)
-        node.destroy_node()
+    name = next(iter(node.robots))
+    delivered = fuzz(node, probe, executor, between=lambda: node.advance(5))
+    assert RobotTopics(name).cmd_vel in delivered and min(delivered.values()) > 2
+    robot = node.sim.robots[name]
+    start = robot.ground_truth()
+    assert all(math.isfinite(v) for v in start)
+    # Still driven by a good command.
+    cmd = probe.publisher(TwistStamped, RobotTopics(name).cmd_vel)
+    for _ in range(50):
+        msg = TwistStamped()
+        msg.twist.linear.x = 0.2
+        cmd.publish(msg)
+        drain(executor, rounds=5)
+        node.advance(20)
+    assert math.dist(robot.ground_truth()[:2], start[:2]) > 0.05
 
 
 def test_the_controller_survives_every_topic(ros_context, executor):
