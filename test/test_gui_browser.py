@@ -199,8 +199,10 @@ def test_garbage_is_ignored_out_of_range_is_clamped_and_the_server_keeps_serving
     page.evaluate("""() => new Promise((resolve) => {
       const ws = window.rogue = new WebSocket(`ws://${location.host}/ws`);
       ws.onopen = () => {
-        for (const m of ['not json', '[1,2]', '{"t":"nope"}', '{"t":"drive","linear":"fast","angular":0}',
-                         '{"t":"drive","linear":1e999,"angular":0}', '{"t":"drive","linear":0.1,"angular":0,"x":1}',
+        for (const m of ['not json', '[1,2]', '{"t":"nope"}',
+                         '{"t":"drive","linear":"fast","angular":0}',
+                         '{"t":"drive","linear":1e999,"angular":0}',
+                         '{"t":"drive","linear":0.1,"angular":0,"x":1}',
                          'x'.repeat(200000)]) ws.send(m);
         ws.send(new Uint8Array([1, 2, 3]));
         resolve();

@@ -25,19 +25,18 @@ from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, \
     UInt32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
-from miro_ball.common.jpeg import ImageRejected, jpeg_size
+from miro_ball.common.jpeg import MAX_SIDE, ImageRejected, jpeg_size
 from miro_ball.common.throttle import Throttled
 from miro_ball.gui import protocol as p
 from miro_ball.gui import readouts as r
 from miro_ball.miro.constants import JOINT_NAMES, PLATFORM_TICK_S
-from miro_ball.miro.interface import (CLOCK, EYES, GUI_NODE_NAME, RobotTopics, SimTopics,
-                                      robots_in)
+from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYES, GUI_NODE_NAME,
+                                      RobotTopics, SimTopics, robots_in)
 
 DEADMAN_S = 0.3  # a drive command not refreshed for this long becomes a stop
 DISCOVERY_PERIOD_S = 1.0
 READOUT_PERIOD_S = 0.05  # readouts to the pages at 20 Hz
 IMAGE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
-MAX_IMAGE_SIDE = 4096
 
 
 @dataclass(frozen=True)
@@ -55,10 +54,9 @@ class _Watch:
         self.topics = t = RobotTopics(name)
         self.values = {}
         self.last_heard = None
-        node = bridge
 
         def sub(msg_type, topic, handler, qos=10):
-            return node.create_subscription(msg_type, topic, self._wrap(handler), qos)
+            return bridge.create_subscription(msg_type, topic, self._wrap(handler), qos)
 
         self.subs = [
             sub(BatteryState, t.battery, lambda m: {'battery': m.voltage}),
@@ -117,7 +115,8 @@ def _odometry(msg):
 class GuiBridge(Node):
     """See the module docstring. robot: the MiRo to watch, or None to pick one."""
 
-    def __init__(self, robot=None, *, context=None, on_frame=None, default_robot='miro'):
+    def __init__(self, robot=None, *, context=None, on_frame=None,
+                 default_robot=DEFAULT_ROBOT_NAME):
         super().__init__(GUI_NODE_NAME, context=context)
         self.warn = Throttled(self.get_logger().warning)
         self.fixed_robot = robot
@@ -130,7 +129,7 @@ class GuiBridge(Node):
         self.status = ''
         self.robots = []
         self.sim = SimTopics()
-        self._clock_samples = []  # (wall, sim) of recent /clock messages, for the real-time factor
+        self._clock_samples = []  # (wall, sim) of the last 2 s of /clock: the real-time factor
         self.sim_time = None
         self.sim_paused = None
         self._control_pubs = {}
@@ -138,8 +137,8 @@ class GuiBridge(Node):
         self.create_subscription(Clock, CLOCK, self._on_clock, 10)
         self.image_subscription(self.sim.overhead, p.CHANNELS.index('overhead'))
         self.sim_clients = {'reset': self.create_client(Trigger, self.sim.reset),
-                        'step': self.create_client(Trigger, self.sim.step),
-                        'pause': self.create_client(SetBool, self.sim.pause)}
+                            'step': self.create_client(Trigger, self.sim.step),
+                            'pause': self.create_client(SetBool, self.sim.pause)}
         self.watch = None
         self._select(robot or default_robot)
         self._make_state()
@@ -200,7 +199,7 @@ class GuiBridge(Node):
             else:
                 try:
                     width, height = jpeg_size(data)
-                    if not (0 < width <= MAX_IMAGE_SIDE and 0 < height <= MAX_IMAGE_SIDE):
+                    if not (0 < width <= MAX_SIDE and 0 < height <= MAX_SIDE):
                         problem = f'{width}x{height} pixels'
                 except ImageRejected as err:
                     problem = str(err)

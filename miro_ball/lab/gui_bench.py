@@ -115,7 +115,8 @@ def measure(args):
         mine = [d for d in drawn if d['ch'] == eye and start_wall <= d['at'] / 1000 <= end_wall]
         latency = [d['at'] / 1000 - sim.published[(eye, round(d['stamp'], 6))]
                    for d in mine if (eye, round(d['stamp'], 6)) in sim.published]
-        sent = [t for (e, _), t in sim.published.items() if e == eye and start_wall <= t <= end_wall]
+        sent = [t for (e, _), t in sim.published.items()
+                if e == eye and start_wall <= t <= end_wall]
         stamps = [d['stamp'] for d in mine]
         backwards = sum(b < a for a, b in zip(stamps, stamps[1:]))
         if not latency:
