@@ -19,6 +19,7 @@ from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR
 from miro_ball.miro.interface import RobotTopics, SimTopics, default_robot_name
+from miro_sim_bullet.physics.world import PHYSICS_DT_S
 from rostools import Probe, drain, spin_until
 
 T = RobotTopics(default_robot_name())
@@ -204,12 +205,12 @@ def test_run_time_parameters_apply_or_are_refused_with_a_reason(sim_node, probe,
     result = set_remotely('real_time_factor', 4.0)
     assert result.successful and sim_node.params.real_time_factor == 4.0
     assert set_remotely('paused', False).successful and not sim_node.paused
-    for name, value, reason in [('physics_dt', 0.002, 'restart'), ('world', 'empty', 'restart'),
+    for name, value, reason in [('physics_dt', 0.005, 'restart'), ('world', 'empty', 'restart'),
                                 ('real_time_factor', 5000.0, 'real_time_factor'),
                                 ('jpeg_quality', 'high', 'number')]:
         result = set_remotely(name, value)
         assert not result.successful and reason in result.reason, (name, result.reason)
-    assert sim_node.params.real_time_factor == 4.0 and sim_node.sim.dt == 0.001
+    assert sim_node.params.real_time_factor == 4.0 and sim_node.sim.dt == PHYSICS_DT_S
     # The pause service and the parameter say the same thing.
     probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True))
     assert sim_node.paused and sim_node.get_parameter('paused').value is True

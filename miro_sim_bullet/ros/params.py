@@ -4,6 +4,7 @@ from dataclasses import dataclass, field
 from miro_ball.common.params import check_ranges
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES
 from miro_ball.miro.interface import check_name, default_robot_name
+from miro_sim_bullet.physics.world import PHYSICS_DT_S
 
 RENDERERS = ('auto', 'tiny', 'egl')
 
@@ -22,7 +23,7 @@ class SimParams:
     paused: bool = field(default=False, metadata={'help': 'start paused (use ~/pause, ~/step)'})
     step_count: int = field(default=20, metadata={'help': 'physics steps per ~/step call',
                                                   'range': (1, 100000)})
-    physics_dt: float = field(default=0.001, metadata={'help': 'physics step, s',
+    physics_dt: float = field(default=PHYSICS_DT_S, metadata={'help': 'physics step, s',
                                                        'range': (0.0001, 0.02)})
     frame_width: int = field(default=640, metadata={'help': 'eye camera width: 1280, 640 or 320',
                                                    'range': (320, 1280)})
