@@ -232,8 +232,6 @@ def _create_context():
     # llvmpipe (no GPU) rasterises in the calling thread: as fast here as with its own
     # threads, and it leaves the other cores to physics and the controllers.
     os.environ.setdefault('LP_NUM_THREADS', '0')
-    if os.environ.get('EGL_PLATFORM') == 'device':
-        os.environ.pop('EGL_PLATFORM')  # breaks eglGetDisplay in Mesa's loader
     try:
         return moderngl.create_standalone_context(backend='egl', require=330)
     except Exception as exc:  # glcontext raises plain Exception with EGL's words
@@ -245,13 +243,10 @@ class GlBackend:
     """Draws one PyBullet client's visual shapes; call scene_changed() after the client's
     bodies were rebuilt (a world reset)."""
 
-    kind = 'egl'
-
     def __init__(self, client_id):
         self.client_id = client_id
         self.ctx = _create_context()
         self.device = self.ctx.info['GL_RENDERER']
-        self.name = 'egl'
         sun = -np.asarray(SUN_DIRECTION) / np.linalg.norm(SUN_DIRECTION)
         self.program = self.ctx.program(
             vertex_shader=_VERTEX_SHADER % {'ambient': AMBIENT, 'diffuse': DIFFUSE},
