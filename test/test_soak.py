@@ -6,7 +6,7 @@ import sys
 import pytest
 
 from miro_ball.lab.soak import (descendants, growth, process_tree, RSS_TARGET_PCT, rss_mb,
-                                Sample, trend_pct, verdict)
+                                Sample, SimulatedTime, trend_pct, verdict)
 from miro_ball.miro.interface import default_robot_name
 from rostools import run_command
 
@@ -55,6 +55,26 @@ def test_trend_is_the_fitted_change_over_the_run():
     assert trend_pct([1.0, 1.0, 1.0]) == pytest.approx(0.0)
     assert trend_pct([1.0, 1.5, 2.0]) == pytest.approx(100.0 * 1.0 / 1.5)
     assert trend_pct([1.0, 2.0]) is None  # two points make a line, not a trend
+
+
+def test_simulated_time_survives_a_reset_and_counts_it():
+    clock = SimulatedTime()
+    for t in [0.02 * k for k in range(1, 51)] + [0.02 * k for k in range(1, 26)]:
+        clock.update(t)  # 1 s, a ~/reset, 0.5 s
+    assert clock.elapsed == pytest.approx(1.0 - 0.02 + 0.5 - 0.02)
+    assert clock.jumps == 1
+
+
+def test_another_simulators_clock_on_the_domain_is_a_disturbance():
+    clock = SimulatedTime()
+    for k in range(1, 40):
+        clock.update(500.0 + 0.02 * k)
+        clock.update(0.02 * k)  # someone else's simulator, interleaved
+    assert clock.jumps > 70 and clock.elapsed < 1.0
+    disturbed = samples([400.0] * 5, [2.0] * 5)
+    disturbed[-1].jumps = clock.jumps
+    passed, lines = verdict(disturbed)
+    assert not passed and 'DISTURBED' in lines[-1], lines
 
 
 def test_too_short_a_run_is_not_judged_a_pass():

@@ -21,11 +21,13 @@ from miro_ball.common.isolation import isolated_env, limit_discovery, private_do
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
 from miro_ball.lab.demo import node_commands, Processes, robot_names
+from miro_ball.miro.interface import CLOCK
 
 RSS_TARGET_PCT = 2.0  # per 60 simulated minutes
 RTF_TREND_LIMIT_PCT = 10.0  # fitted change over the run, of the mean: the machine is shared
 GUI_MODULE = 'miro_ball.gui'  # started by the demo's node_commands
 SECONDS_PER_MINUTE = 60.0
+MAX_CLOCK_STEP_S = 1.0  # /clock moves 0.02 s a message: more is a jump, not time passing
 
 
 # -- what a process uses, from /proc ---------------------------------------------------------
@@ -91,14 +93,35 @@ def _comm(pid):
 
 # -- the figures and the verdict (plain data, tested without ROS) -----------------------------
 
+class SimulatedTime:
+    """Simulated seconds that passed, from /clock readings. A step back or a leap (a
+    ~/reset, or another simulator on the same ROS domain) adds nothing and is counted."""
+
+    def __init__(self):
+        self.elapsed = 0.0
+        self.jumps = 0
+        self.last = None
+
+    def update(self, now):
+        if self.last is not None:
+            step = now - self.last
+            if 0.0 <= step <= MAX_CLOCK_STEP_S:
+                self.elapsed += step
+            else:
+                self.jumps += 1
+        self.last = now
+
+
 @dataclass
 class Sample:
-    """One report: wall and simulated time (s), frames so far, {label: (RSS MB, fds)}."""
+    """One report: wall and simulated time (s), frames so far, {label: (RSS MB, fds)},
+    /clock jumps so far."""
 
     wall: float
     sim: float
     frames: int
     usage: dict
+    jumps: int = 0
 
 
 def interval_rates(previous, sample):
@@ -161,14 +184,17 @@ def verdict(samples):
     trend = trend_pct(rtf_series(samples))
     rtf_ok = trend is None or abs(trend) <= RTF_TREND_LIMIT_PCT
     shown = 'too few intervals for a trend' if trend is None else f'{trend:+.1f} % over the run'
-    passed = rss_ok and rtf_ok
-    return passed, [
+    passed = rss_ok and rtf_ok and not last.jumps
+    lines = [
         f'verdict: {"PASS" if passed else "FAIL"}',
         f'  RSS: {total[2]:+.2f} % over {sim_minutes:.1f} simulated minutes = '
         f'{per_hour:+.2f} % per 60 (target < {RSS_TARGET_PCT:g} %): '
         f'{"ok" if rss_ok else "TOO MUCH"}',
         f'  RTF trend: {shown} (target within +-{RTF_TREND_LIMIT_PCT:g} %): '
         f'{"ok" if rtf_ok else "TREND"}']
+    if last.jumps:
+        lines.append(f'  DISTURBED: /clock jumped {last.jumps} times')
+    return passed, lines
 
 
 # -- the report --------------------------------------------------------------------------------
@@ -180,6 +206,9 @@ def sample_lines(start, previous, sample):
              f'{(sample.sim - start.sim) / SECONDS_PER_MINUTE:.2f} min, RTF {rtf:.2f}, '
              f'{sample.frames - previous.frames} frames ({fps:.1f}/s, {per_sim:.1f} per '
              f'simulated s)']
+    if sample.jumps > previous.jumps:
+        lines.append(f'  /clock jumped {sample.jumps - previous.jumps} times: a ~/reset, or '
+                     'another simulator on this ROS domain')
     width = max(map(len, sample.usage), default=0)
     for label, (rss, fds) in sample.usage.items():
         lines.append(f'  {label:<{width}}  RSS {rss:7.1f} MB  fds {fds:4d}')
@@ -224,12 +253,18 @@ def run(args, robots, procs, domain_id, stop):
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
 
+    from rosgraph_msgs.msg import Clock
+
     from miro_ball.lab.monitor import Monitor
 
     context = Context()
     rclpy.init(context=context, domain_id=domain_id)
     node = rclpy.create_node('miro_soak_monitor', context=context)
     monitor = Monitor(node, robots)
+    simulated = SimulatedTime()
+    node.create_subscription(
+        Clock, CLOCK, lambda msg: simulated.update(msg.clock.sec + msg.clock.nanosec * 1e-9),
+        100)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
 
@@ -239,11 +274,11 @@ def run(args, robots, procs, domain_id, stop):
     samples, outcome = [], 'done'
     started = time.monotonic()
     try:
-        while monitor.sim_time == 0:  # the nodes are up once /clock runs
+        while simulated.last is None:  # the nodes are up once /clock runs
             if stop.requested or time.monotonic() - started > args.startup_timeout:
                 return samples, 'interrupted' if stop.requested else 'no /clock'
             executor.spin_once(timeout_sec=0.1)
-        start = Sample(time.monotonic(), monitor.sim_time, frames(), usage(procs))
+        start = Sample(time.monotonic(), simulated.elapsed, frames(), usage(procs))
         samples.append(start)
         end = start.wall + args.minutes * SECONDS_PER_MINUTE
         while not stop.requested:
@@ -253,7 +288,8 @@ def run(args, robots, procs, domain_id, stop):
                 outcome = 'node %s exited with code %s' % procs.dead()
                 break
             if now - samples[-1].wall >= args.report_every or now >= end:
-                sample = Sample(now, monitor.sim_time, frames(), usage(procs))
+                sample = Sample(now, simulated.elapsed, frames(), usage(procs),
+                                simulated.jumps)
                 print('\n'.join(sample_lines(start, samples[-1], sample)), flush=True)
                 samples.append(sample)
                 if now >= end:
@@ -264,6 +300,30 @@ def run(args, robots, procs, domain_id, stop):
         node.destroy_node()
         rclpy.try_shutdown(context=context)
     return samples, outcome
+
+
+def idle_domain(first, tries=10, listen_s=2.0):
+    """The first ROS domain from ``first`` on (1..100) where no node shows up within
+    listen_s, or None: another run's /clock or ~/reset would spoil the figures."""
+    import rclpy
+    from rclpy.context import Context
+
+    for k in range(tries):
+        domain = 1 + (first - 1 + k) % 100
+        context = Context()
+        rclpy.init(context=context, domain_id=domain)
+        try:
+            node = rclpy.create_node('miro_soak_domain_check', context=context)
+            time.sleep(listen_s)  # discovery runs in the middleware's own threads
+            others = sorted(set(node.get_node_names()) - {node.get_name()})
+            node.destroy_node()
+        finally:
+            rclpy.try_shutdown(context=context)
+        if not others:
+            return domain
+        print(f'soak: ROS domain {domain} is in use ({", ".join(others[:3])}), trying the next',
+              flush=True)
+    return None
 
 
 def commands(args, robots):
@@ -310,8 +370,10 @@ def main(argv=None):
         robots = robot_names(args.world)
     except ValueError as err:
         parser.error(str(err))
-    domain_id = private_domain(salt=70)
     limit_discovery()  # the observer in this process, like the nodes: this host only
+    domain_id = idle_domain(private_domain(salt=70))
+    if domain_id is None:
+        parser.exit(1, f'{parser.prog}: error: every ROS domain tried is in use\n')
     logs = Path(args.out) / 'soak'
     every = 'minute' if args.report_every == SECONDS_PER_MINUTE else f'{args.report_every:g} s'
     print(f'soak: world {args.world}, robots {", ".join(robots)}, renderer {args.renderer}, '
