@@ -133,7 +133,7 @@ def test_reset_pause_and_step_services(sim_node, probe, executor):
     assert result.success and sim_node.sim.time == 0.0
     assert sim_node.sim.robot.pose() == pytest.approx(initial)
     result = probe.call(executor, Trigger, SIM.step, Trigger.Request())
-    assert result.success and sim_node.sim.step_index == 20
+    assert result.success and sim_node.sim.time == pytest.approx(0.02)  # one platform tick
     result = probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=False))
     assert result.success and not sim_node.paused
     refused = probe.call(executor, Trigger, SIM.step, Trigger.Request())

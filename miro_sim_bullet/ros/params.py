@@ -21,10 +21,11 @@ class SimParams:
         default=1.0, metadata={'help': 'simulated seconds per wall second; 0 = as fast as possible',
                                'range': (0.0, 1000.0)})
     paused: bool = field(default=False, metadata={'help': 'start paused (use ~/pause, ~/step)'})
-    step_count: int = field(default=20, metadata={'help': 'physics steps per ~/step call',
-                                                  'range': (1, 100000)})
+    step_count: int = field(
+        default=10, metadata={'help': 'physics steps per ~/step call (10 = one 20 ms tick at 2 ms)',
+                              'range': (1, 100000)})
     physics_dt: float = field(default=PHYSICS_DT_S, metadata={'help': 'physics step, s',
-                                                       'range': (0.0001, 0.02)})
+                                                              'range': (0.0001, 0.02)})
     frame_width: int = field(default=640, metadata={'help': 'eye camera width: 1280, 640 or 320',
                                                    'range': (320, 1280)})
     frame_height: int = field(default=360,
