@@ -29,6 +29,7 @@ from miro_ball.lab import render_bench
 from miro_ball.lab.scenario_bench import machine
 from miro_ball.miro.interface import EYES, RobotTopics
 from miro_sim_bullet.render.renderer import probe_egl
+from miro_sim_bullet.ros.params import SimParams
 
 # (label, world, how many robots' eyes are subscribed, renderers)
 CASES = (('default world, 2 eyes', 'miro', 1, ('egl', 'tiny')),
@@ -216,8 +217,9 @@ def main(argv=None):
         write_section(args.output, '\n'.join([
             '# Simulator benchmark', '',
             f'`python -m miro_ball.lab.sim_bench` (`./dev.sh bench`): eyes {width}x{height} @ '
-            f'{args.rate:g} Hz, the node free-running, {args.seconds:g} simulated s x '
-            f'{args.runs} runs per case (medians). {reason if ok else "No EGL here."}', '',
+            f'{args.rate:g} Hz, physics step {1000 * SimParams().physics_dt:g} ms, the node '
+            f'free-running on its own executor, {args.seconds:g} simulated s x '
+            f'{args.runs} runs per case (medians). {reason if ok else "No EGL here"}.', '',
             *rtf, '', 'Renderers alone, same scene, taking turns: median ms per camera instant '
             '(egl = ours, pybullet-egl = PyBullet\'s eglRenderer plugin as shipped, tiny = '
             'TinyRenderer in-process).', '', *compared, '', f'Machine: {machine()}.']))
