@@ -74,3 +74,26 @@ def test_the_state_is_json_with_the_robot_and_no_simulator(bridge):
     state = json.loads(bridge.state())
     assert state['t'] == 'state' and state['robot'] == T.name
     assert state['sim']['present'] is False and state['readouts'] == {}
+
+
+def test_robots_are_found_and_picked_by_what_publishes(ros_context, executor):
+    from nav_msgs.msg import Odometry
+
+    probe = Probe(ros_context, executor)
+    for name in ('robot_b', 'robot_a'):
+        probe.publisher(Odometry, RobotTopics(name).odom)
+    # Asked for a robot that is not running: its topics have our subscribers only.
+    node = GuiBridge(None, context=ros_context, default_robot='absent')
+    executor.add_node(node)
+    try:
+        assert spin_until(executor, lambda: node.robots == ['robot_a', 'robot_b'])
+        assert spin_until(executor, lambda: node.watch.topics.name == 'robot_a')
+        node.submit(p.SelectRobot('robot_b'), owner=1)
+        assert spin_until(executor, lambda: node.watch.topics.name == 'robot_b')
+        node.submit(p.SelectRobot('ghost'), owner=1)  # not running: refused
+        node.submit(p.Stop(), owner=1)
+        assert spin_until(executor, lambda: not node._commands)
+        assert node.watch.topics.name == 'robot_b'
+    finally:
+        executor.remove_node(node)
+        node.destroy_node()

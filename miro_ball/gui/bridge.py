@@ -319,7 +319,9 @@ class GuiBridge(Node):
             self._select(name)
 
     def _discover(self):
-        self.robots = robots_in(name for name, _ in self.get_topic_names_and_types())
+        # The graph lists topics that only have subscribers too, like our own watch's.
+        self.robots = [name for name in robots_in(n for n, _ in self.get_topic_names_and_types())
+                       if self.count_publishers(RobotTopics(name).odom)]
         if self.fixed_robot is None and self.robots and self.watch.topics.name not in self.robots:
             self._select(self.robots[0])
 
