@@ -7,6 +7,7 @@ import sys
 import pytest
 
 from miro_ball.grade import parse_args
+from miro_ball.lab.grader import last_bytes
 from miro_ball.lab.grading import EpisodeResult, printable_tail, report, to_json, total_line
 
 PY = sys.executable
@@ -137,3 +138,10 @@ def test_a_command_that_dies_printing_garbage_is_reported(tmp_path):
     assert episode['output_tail'] and 'score 0/1 (0 %)' in stdout
     assert 'the last lines of its output:' in stdout
     assert all(c.isprintable() for line in stdout.splitlines() for c in line)
+
+
+def test_only_the_end_of_a_huge_output_is_read(tmp_path):
+    log = tmp_path / 'command.log'
+    log.write_bytes(b'x' * 200_000 + b'\nthe end\n')
+    assert last_bytes(log, 100).endswith(b'\nthe end\n') and len(last_bytes(log, 100)) == 100
+    assert last_bytes(log) == log.read_bytes()[-65536:]

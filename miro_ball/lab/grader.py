@@ -27,6 +27,7 @@ PLACED_WITHIN_M = 0.02  # ground truth this close to the placement: it took
 PLACE_TRIES = 20
 SERVICE_TIMEOUT_S = 10.0
 PROGRESS_EVERY_S = 10.0
+TAIL_BYTES = 65536  # of the command's output, for its last lines
 
 
 @dataclass
@@ -203,8 +204,15 @@ def run_episode(index, placement, options, domain, stop, log=print):
         if video:
             video.close()
     if result.exit_code is not None or result.commands == 0 or result.killed:
-        result.output_tail = printable_tail((folder / 'command.log').read_bytes())
+        result.output_tail = printable_tail(last_bytes(folder / 'command.log'))
     return result
+
+
+def last_bytes(path, size=TAIL_BYTES):
+    """The end of a file: a command may have written gigabytes of garbage."""
+    with open(path, 'rb') as log:
+        log.seek(max(0, log.seek(0, 2) - size))
+        return log.read()
 
 
 def _play(session, procs, placement, options, stop, log, index):
