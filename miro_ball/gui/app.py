@@ -51,7 +51,8 @@ def main(argv=None):
     try:
         cli_args = rclpy.utilities.remove_ros_args(argv)[1:]
     except Exception as err:  # rclpy's malformed --ros-args error has no public class
-        sys.exit(f'{PROG}: error: {err}')
+        print(f'{PROG}: error: {err}', file=sys.stderr)
+        sys.exit(2)
     args, parser = parse_args(cli_args)
     try:
         default = check_name(default_robot_name(), '$MIRO_ROBOT_NAME')

@@ -200,6 +200,8 @@ def listen(host, port):
 
 def url(sock):
     host, port = sock.getsockname()[:2]
+    if ipaddress.ip_address(host).is_unspecified:  # every address: name one that works
+        host = socket.gethostname()
     return f'http://[{host}]:{port}/' if ':' in host else f'http://{host}:{port}/'
 
 
