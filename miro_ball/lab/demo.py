@@ -184,8 +184,7 @@ def watch(args, robots, procs, domain_id, stop):
                 break
             if finished and outcome != finished:  # with the GUI, the run goes on
                 outcome = finished
-                print(f'  {finished}: still running for the GUI, {gui_url(args)}; '
-                      'Ctrl+C to stop', flush=True)
+                print(f'  {finished}: still running for the GUI; Ctrl+C to stop', flush=True)
             if procs.dead():
                 outcome = 'node %s exited with code %s' % procs.dead()
                 break
@@ -209,8 +208,16 @@ def watch(args, robots, procs, domain_id, stop):
     return outcome, monitor, rtf, video
 
 
-def gui_url(args):
-    return f'http://127.0.0.1:{args.gui_port}/'
+def gui_url(log, procs, wait_s=20.0):
+    """The URL the GUI printed in its log once it listens (its port may be any free one),
+    or None if it did not say within wait_s or stopped."""
+    deadline = time.monotonic() + wait_s
+    while time.monotonic() < deadline and not procs.dead():
+        for line in log.read_text(errors='replace').splitlines() if log.exists() else []:
+            if line.startswith('miro_gui: open '):
+                return line.split('open ', 1)[1].strip()
+        time.sleep(0.2)
+    return None
 
 
 def summary(outcome, monitor, rtf, video, killed, record=None):
@@ -282,8 +289,9 @@ def main(argv=None):
     janitor = SharedMemoryJanitor()  # for what a killed node leaves in /dev/shm
     procs = Processes(node_commands(args, robots), isolated_env(domain_id), out)
     if args.gui:
-        print(f'miro_gui: open {gui_url(args)} in a browser (log in {out}/miro_gui.log)',
-              flush=True)
+        url = gui_url(out / 'miro_gui.log', procs)
+        print(f'miro_gui: open {url} in a browser' if url else 'miro_gui did not start',
+              f'(log in {out}/miro_gui.log)', flush=True)
     killed = []
     try:
         outcome, monitor, rtf, video = watch(args, robots, procs, domain_id, stop)
