@@ -9,13 +9,12 @@ Episodes run in --jobs worker processes, each on a ROS domain of its own.
 import argparse
 import multiprocessing
 import os
-import platform
 import statistics
 import sys
 import time
-from pathlib import Path
 
 from miro_ball.common.isolation import limit_discovery, private_domains
+from miro_ball.lab.report import machine, write_section
 
 MODES = ('improved', 'tutorial')
 
@@ -25,19 +24,6 @@ def percentile(values, q):
         return None
     ordered = sorted(values)
     return ordered[min(len(ordered) - 1, round(q * (len(ordered) - 1)))]
-
-
-def machine():
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path('/proc/cpuinfo').read_text().splitlines():
-            if line.startswith('model name'):
-                cpu = line.split(':', 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return (f'{platform.system()} {platform.release()}, {os.cpu_count()} cores ({cpu}), '
-            f'Python {platform.python_version()}')
 
 
 def _worker_init(domains, limit):
@@ -133,13 +119,13 @@ def main(argv=None):
     wall = (time.monotonic() - started) / 60
     report = table(results, args.count)
     print('\n' + report + f'\n\nwall time {wall:.1f} min')
-    Path(args.output).write_text(
+    write_section(args.output, 'scenario_bench', (
         '# Scenario benchmark\n\n'
         f'`python -m miro_ball.lab.scenario_bench --count {args.count} --seed {args.seed} '
         f'--jobs {args.jobs}` ({args.count} seeded placements of robot and ball in the default '
         f'arena; success = ball moved >= 0.3 m within {args.limit:g} s of simulated time and '
         f'the robot never fell; times are simulated seconds from the start of the episode).'
-        f'\n\n{report}\n\nMachine: {machine()}. Wall time of the whole run: {wall:.1f} min.\n')
+        f'\n\n{report}\n\nMachine: {machine()}. Wall time of the whole run: {wall:.1f} min.'))
     print(f'\nwritten to {args.output}')
 
 

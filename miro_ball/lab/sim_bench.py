@@ -26,7 +26,7 @@ from pathlib import Path
 
 from miro_ball.common.isolation import isolated_env, private_domain
 from miro_ball.lab import render_bench
-from miro_ball.lab.scenario_bench import machine
+from miro_ball.lab.report import machine, write_section
 from miro_ball.miro.interface import EYES, RobotTopics
 from miro_sim_bullet.render.renderer import probe_egl
 from miro_sim_bullet.ros.params import SimParams
@@ -36,8 +36,6 @@ CASES = (('default world, 2 eyes', 'miro', 1, ('egl', 'tiny')),
          ('football_pitch, 6 eyes', 'football_pitch', 3, ('egl',)),
          ('football_pitch, 2 of 6 eyes', 'football_pitch', 1, ('egl',)))
 COMPARED = (('miro', 1), ('football_pitch', 3))
-SECTION_START = '<!-- sim_bench: written by python -m miro_ball.lab.sim_bench --output -->'
-SECTION_END = '<!-- end of sim_bench -->'
 
 
 def measure(renderer, world, watched, sim_seconds, width, height, rate):
@@ -158,18 +156,6 @@ def comparison(args, kinds, width, height):
     return rows
 
 
-def write_section(path, text):
-    """Put text between the section markers of path, replacing what was there."""
-    old = path.read_text() if path.exists() else ''
-    section = f'{SECTION_START}\n{text}\n{SECTION_END}\n'
-    if SECTION_START in old and SECTION_END in old:
-        head, _, rest = old.partition(SECTION_START)
-        _, _, tail = rest.partition(SECTION_END + '\n')
-        path.write_text(head + section + tail)
-    else:
-        path.write_text(old + ('\n' if old and not old.endswith('\n\n') else '') + section)
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(prog='python -m miro_ball.lab.sim_bench',
                                      description=__doc__,
@@ -214,7 +200,7 @@ def main(argv=None):
     compared = comparison(args, kinds, width, height)
     report('\n'.join(compared))
     if args.output:
-        write_section(args.output, '\n'.join([
+        write_section(args.output, 'sim_bench', '\n'.join([
             '# Simulator benchmark', '',
             f'`python -m miro_ball.lab.sim_bench` (`./dev.sh bench`): eyes {width}x{height} @ '
             f'{args.rate:g} Hz, physics step {1000 * SimParams().physics_dt:g} ms, the node '
