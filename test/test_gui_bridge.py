@@ -56,14 +56,14 @@ def test_a_drive_that_is_not_renewed_stops_and_another_page_cannot_stop_it(
         bridge, ros_context, executor):
     probe = Probe(ros_context, executor)
     twists = probe.watch(TwistStamped, T.cmd_vel)
+    sent = time.monotonic()
     bridge.submit(p.Drive(0.2, 0.0), owner=1)
     assert spin_until(executor, lambda: twists)
     bridge.submit(p.Stop(), owner=2)  # a page that is not driving
     bridge.release(2)
-    sent = time.monotonic()
     # The deadman is wall-clock time by design: a page that stopped talking.
     assert spin_until(executor, lambda: twists[-1].twist.linear.x == 0.0, timeout_s=5.0)
-    assert time.monotonic() - sent >= DEADMAN_S * 0.9
+    assert time.monotonic() - sent >= DEADMAN_S
     assert len([t for t in twists if t.twist.linear.x > 0]) > 3  # renewed at 50 Hz meanwhile
     count = len(twists)
     assert not spin_until(executor, lambda: len(twists) > count, timeout_s=0.3), \
