@@ -184,6 +184,17 @@ def test_closing_the_page_with_a_key_held_stops_the_robot(rig):
     assert stopped_after is not None and stopped_after < 0.4
 
 
+def test_the_page_losing_focus_with_a_key_held_stops_the_robot(rig):
+    page = rig.open_page()
+    page.keyboard.down('ArrowUp')
+    assert rig.until(rig.moving)
+    page.evaluate("window.dispatchEvent(new Event('blur'))")  # the key-up goes elsewhere
+    stopped_after = rig.run(1.0, rig.stopped)
+    assert stopped_after is not None and stopped_after < 0.4
+    page.keyboard.up('ArrowUp')
+    page.close()
+
+
 def test_head_slider_moves_the_head(rig):
     import math
     page = rig.open_page()
