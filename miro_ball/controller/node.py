@@ -23,10 +23,10 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
-from rclpy.utilities import remove_ros_args
 from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
 from std_msgs.msg import Float32MultiArray
 
+from miro_ball.common.cli import user_args
 from miro_ball.common import params
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
@@ -370,11 +370,7 @@ def _fail(parser, err):
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
     parser = build_parser()
-    try:
-        cli_args = remove_ros_args(argv)[1:]
-    except Exception as err:  # rclpy's malformed --ros-args error has no public class
-        _fail(parser, err)
-    options = parser.parse_args(cli_args)
+    options = parser.parse_args(user_args(argv, parser.prog))
     if options.save_debug:
         try:
             os.makedirs(options.save_debug, exist_ok=True)

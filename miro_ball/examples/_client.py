@@ -15,6 +15,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
+from miro_ball.common.cli import user_args
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.miro.interface import DEFAULT_ROBOT_NAME, RobotTopics, check_name, \
     default_robot_name
@@ -50,7 +51,7 @@ def heading(q):
 def parse(parser, argv):
     """The options of argv (the ROS arguments left out); errors end in one line, exit 2."""
     try:
-        options = parser.parse_args(rclpy.utilities.remove_ros_args(argv)[1:])
+        options = parser.parse_args(user_args(argv, parser.prog))
         if hasattr(options, 'robot'):  # not every client drives a robot (ball_mover)
             check_name(options.robot)
     except ValueError as err:  # a bad robot name, or rclpy's malformed --ros-args

@@ -8,6 +8,7 @@ import asyncio
 import sys
 import threading
 
+from miro_ball.common.cli import user_args
 from miro_ball.common.stopping import StopRequest, spin_until_stopped
 from miro_ball.miro.interface import check_name, default_robot_name
 
@@ -48,12 +49,7 @@ def main(argv=None):
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
 
-    try:
-        cli_args = rclpy.utilities.remove_ros_args(argv)[1:]
-    except Exception as err:  # rclpy's malformed --ros-args error has no public class
-        print(f'{PROG}: error: {err}', file=sys.stderr)
-        sys.exit(2)
-    args, parser = parse_args(cli_args)
+    args, parser = parse_args(user_args(argv, PROG))
     try:
         default = check_name(default_robot_name(), '$MIRO_ROBOT_NAME')
     except ValueError as err:

@@ -22,6 +22,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock as ClockMsg
 
+from miro_ball.common.cli import user_args
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.lab.bag import BagError, SplitBag, TYPESTORE, offered_qos
@@ -174,11 +175,7 @@ def parse_args(argv):
 
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
-    try:
-        cli_args = rclpy.utilities.remove_ros_args(argv)[1:]
-    except Exception as err:  # rclpy's malformed --ros-args error has no public class
-        sys.exit(f'{NODE_NAME}: error: {err}')
-    args, selection, parser = parse_args(cli_args)
+    args, selection, parser = parse_args(user_args(argv, NODE_NAME))
     try:
         bag = SplitBag(args.output, split_s=args.split_seconds)
     except BagError as err:

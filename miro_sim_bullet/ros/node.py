@@ -23,6 +23,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import CompressedImage
 from std_srvs.srv import SetBool, Trigger
 
+from miro_ball.common.cli import user_args
 from miro_ball.common.params import declare, help_lines, LiveParams
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
@@ -250,11 +251,7 @@ def make_executor(context=None):
 
 def main(argv=None):
     argv = sys.argv if argv is None else argv
-    try:
-        cli_args = rclpy.utilities.remove_ros_args(argv)[1:]
-    except Exception as err:  # rclpy's malformed --ros-args error has no public class
-        sys.exit(f'miro_sim: error: {err}')
-    args = parse_args(cli_args)
+    args = parse_args(user_args(argv, SIM_NODE_NAME))
     overrides = [] if args.world is None else [Parameter('world', value=args.world)]
     # Ctrl+C and SIGTERM end the spin with the context still up (see stopping.py).
     stop = StopRequest()
@@ -266,7 +263,7 @@ def main(argv=None):
         executor.add_node(node)
         spin_until_stopped(executor, stop)
     except (WorldError, RendererUnavailable, ValueError) as err:
-        print(f'miro_sim: error: {err}', file=sys.stderr)
+        print(f'{SIM_NODE_NAME}: error: {err}', file=sys.stderr)
         sys.exit(2)
     finally:
         if node is not None:
