@@ -54,6 +54,13 @@ def run_command(cmd, timeout_s=300):
     return proc.returncode, output
 
 
+def kill_if_running(proc):
+    """A test's last word on a child process: killed if it still runs, its pipes drained."""
+    if proc.poll() is None:
+        proc.kill()
+        proc.communicate()
+
+
 class Probe:
     """A node that records every message on the topics it is asked to watch."""
 

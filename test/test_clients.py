@@ -17,7 +17,7 @@ from miro_ball.examples import client_follower, client_minimal, client_show, cli
     client_video
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
 from miro_ball.miro.interface import RobotTopics, default_robot_name
-from rostools import Probe, advance_ticks, advance_until, spin_until
+from rostools import Probe, advance_ticks, advance_until, kill_if_running, spin_until
 
 T = RobotTopics(default_robot_name())
 CLIENTS = ('client_minimal', 'client_video', 'client_show', 'client_follower', 'client_test')
@@ -181,9 +181,7 @@ def test_minimal_as_a_command_with_the_robot_from_the_environment(paused_sim, ex
         advance_until(paused_sim, executor, lambda: proc.poll() is not None)
         output, _ = proc.communicate(timeout=10)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+        kill_if_running(proc)
     assert proc.returncode == 0, output
     assert 'battery: 4.80 V' in output and 'Traceback' not in output
     assert math.hypot(*robot(paused_sim).pose()[:2]) > 0.1
@@ -198,7 +196,5 @@ def test_a_client_waiting_for_the_simulator_ends_on_ctrl_c():
         proc.send_signal(signal.SIGINT)
         output, _ = proc.communicate(timeout=10)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+        kill_if_running(proc)
     assert proc.returncode == 0 and 'Traceback' not in output, output

@@ -22,7 +22,7 @@ from miro_ball.lab.bag import SplitBag, offered_qos
 from miro_ball.lab.record_node import Recorder, RecordingFailed
 from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, log_time_ns
 from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
-from rostools import Probe, advance_ticks, advance_until, run_command, spin_until
+from rostools import Probe, advance_ticks, advance_until, kill_if_running, run_command, spin_until
 
 ROBOT = RobotTopics(default_robot_name())
 TYPES = get_typestore(Stores.ROS2_JAZZY)
@@ -211,9 +211,7 @@ def test_the_command_records_a_robot_until_ctrl_c_twice(tmp_path, executor, paus
         proc.send_signal(signal.SIGINT)
         output, _ = proc.communicate(timeout=20)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+        kill_if_running(proc)
     assert proc.returncode == 0, output
     assert 'Traceback' not in output
     recorded = read_bag(tmp_path / 'bag')

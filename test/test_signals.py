@@ -13,6 +13,7 @@ import time
 import pytest
 
 from miro_ball.common.isolation import isolated_env
+from rostools import kill_if_running
 
 # Long enough for a slow CI machine; a node that ignores signals never gets there.
 GUARD_S = 10.0
@@ -62,9 +63,7 @@ class Node:
         return self.proc.returncode, time.monotonic() - sent, ''.join(self.output) + rest
 
     def kill(self):
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.communicate()
+        kill_if_running(self.proc)
 
 
 @pytest.fixture
