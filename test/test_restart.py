@@ -31,11 +31,12 @@ HANG_GUARD_S = 120.0
 
 @pytest.fixture
 def nodes(tmp_path):
-    """start(log name, 'sim' | 'controller') -> the node's Popen, started as the demo
-    starts it (free-running simulator); what still runs is stopped at the end."""
+    """start(log name, 'sim' | 'paused sim' | 'controller') -> the node's Popen, started
+    as the demo starts it (free-running simulator); what still runs is stopped at the end."""
     args, _ = parse_args(['--real-time-factor', '0', '--no-video'])
     (_, controller), (_, sim) = node_commands(args, [ROBOT])
-    commands = {'sim': sim, 'controller': controller}
+    commands = {'sim': sim, 'paused sim': sim + ['-p', 'paused:=true'],
+                'controller': controller}
     env = isolated_env(int(os.environ['ROS_DOMAIN_ID']))
     started = []
 
@@ -59,24 +60,50 @@ def watch_until_kicked(executor, probe, what):
     monitor = Monitor(probe.node, [ROBOT])
     commands = probe.watch(TwistStamped, TOPICS.cmd_vel)
 
-    def first_command():
-        return commands[0].header.stamp.sec + commands[0].header.stamp.nanosec * 1e-9
-
     assert spin_until(executor, lambda: monitor.kicked or (
-        commands and monitor.sim_time > first_command() + KICK_WITHIN_S), HANG_GUARD_S), \
+        commands and monitor.sim_time > seconds(commands[0].header.stamp) + KICK_WITHIN_S),
+        HANG_GUARD_S), \
         f'{what}: hung (simulated time {monitor.sim_time:.1f} s, {len(commands)} commands)'
     assert monitor.kicked, f'{what}: not kicked {KICK_WITHIN_S} s after the first command'
     return monitor
+
+
+def seconds(stamp):
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def step_until(executor, probe, predicate, max_steps=500):
+    """Step the paused simulator a platform tick at a time until predicate() holds."""
+    client = probe.node.create_client(Trigger, SIM.step)
+    assert client.wait_for_service(timeout_sec=HANG_GUARD_S), 'no simulator'
+    for _ in range(max_steps):
+        future = client.call_async(Trigger.Request())
+        # An answer can be lost while the service's reply path is still being matched:
+        # then this tick is asked for again.
+        executor.spin_until_future_complete(future, timeout_sec=2.0)
+        assert future.result() is None or future.result().success, future.result().message
+        # Time for the controller to answer this tick; the limit only bounds each try.
+        if spin_until(executor, predicate, timeout_s=0.2):
+            return
+    pytest.fail(f'nothing after {max_steps} ticks')
 
 
 def test_controller_starts_over_and_kicks_after_the_simulator_is_killed(
         nodes, executor, probe, tmp_path):
     sim = nodes('miro_sim_1', 'sim')
     controller = nodes('controller', 'controller')
-    watch_until_kicked(executor, probe, 'first simulator')
+    first = watch_until_kicked(executor, probe, 'first simulator')
     sim.kill()
     sim.wait()
-    nodes('miro_sim_2', 'sim')
+    killed_at = first.sim_time
+    # The new simulator starts paused and is stepped until the controller commands on its
+    # timeline: free-running, it could be past killed_at before the controller hears it.
+    nodes('miro_sim_2', 'paused sim')
+    drain(executor)
+    commands = probe.watch(TwistStamped, TOPICS.cmd_vel)
+    step_until(executor, probe, lambda: any(
+        seconds(c.header.stamp) < killed_at for c in commands))
+    assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=False)).success
     watch_until_kicked(executor, probe, 'restarted simulator')
     controller.send_signal(signal.SIGINT)
     assert controller.wait(timeout=HANG_GUARD_S) == 0
