@@ -79,16 +79,25 @@ def process_tree(named):
     for name, pid in named:
         tree[name] = pid
         for child in descendants(pid):
-            tree[f'{name}/{_comm(child)} {child}'] = child
+            tree[f'{name}/{_kind(child)} {child}'] = child
     return tree
 
 
-def _comm(pid):
+def _kind(pid):
+    """What a child process is: Python's multiprocessing children (the simulator's eye
+    workers) all call themselves 'python', so their command line tells."""
     try:
+        with open(f'/proc/{pid}/cmdline', 'rb') as cmdline:
+            command = cmdline.read().replace(b'\0', b' ').decode(errors='replace')
         with open(f'/proc/{pid}/comm') as comm:
-            return comm.read().strip()
+            name = comm.read().strip()
     except OSError:
         return '?'
+    if 'multiprocessing.resource_tracker' in command:
+        return 'resource_tracker'
+    if 'multiprocessing.spawn' in command:
+        return 'worker'
+    return name
 
 
 # -- the figures and the verdict (plain data, tested without ROS) -----------------------------
