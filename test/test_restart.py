@@ -53,23 +53,22 @@ def probe(ros_context, executor):
     return Probe(ros_context, executor, name='restart_observer')
 
 
+def seconds(stamp):
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
 def watch_until_kicked(executor, probe, what):
     """Watch from now on until the ball is kicked; fails unless that happens within
     KICK_WITHIN_S simulated seconds of the first command a controller sends from now."""
     drain(executor)  # what a previous run left queued is not this run's
     monitor = Monitor(probe.node, [ROBOT])
     commands = probe.watch(TwistStamped, TOPICS.cmd_vel)
-
     assert spin_until(executor, lambda: monitor.kicked or (
         commands and monitor.sim_time > seconds(commands[0].header.stamp) + KICK_WITHIN_S),
         HANG_GUARD_S), \
         f'{what}: hung (simulated time {monitor.sim_time:.1f} s, {len(commands)} commands)'
     assert monitor.kicked, f'{what}: not kicked {KICK_WITHIN_S} s after the first command'
     return monitor
-
-
-def seconds(stamp):
-    return stamp.sec + stamp.nanosec * 1e-9
 
 
 def step_until(executor, probe, predicate, max_steps=500):
