@@ -3,11 +3,15 @@ each message is delivered and handled without an exception, and the node works a
 
 The topics are the nodes' own subscription lists, so a topic added later is fuzzed too.
 """
+import json
 import math
+
+import pytest
 
 from geometry_msgs.msg import TwistStamped
 
 from fuzzmsg import hostile
+from miro_ball.examples.client_show import build_parser, Show, SIGNALS
 from miro_ball.miro.interface import default_robot_name, RobotTopics
 from rostools import drain, Probe, spin_until
 
@@ -69,3 +73,31 @@ def test_the_controller_survives_every_topic(ros_context, executor):
         assert drives_at_a_ball_ahead(rig, start=30.0)
     finally:
         rig.close()
+
+
+def test_the_gui_survives_every_topic(ros_context, executor):
+    from miro_ball.gui.bridge import GuiBridge
+
+    bridge = GuiBridge(default_robot_name(), context=ros_context)
+    executor.add_node(bridge)
+    try:
+        delivered = fuzz(bridge, Probe(ros_context, executor, 'fuzzer'), executor)
+        assert RobotTopics(default_robot_name()).odom in delivered
+        assert min(delivered.values()) > 2
+        json.loads(bridge.state())  # the page's readouts still make valid JSON
+    finally:
+        executor.remove_node(bridge)
+        bridge.destroy_node()
+
+
+@pytest.mark.parametrize('signal', sorted(SIGNALS))
+def test_client_show_survives_its_topic(ros_context, executor, capsys, signal):
+    client = Show(build_parser().parse_args([signal, '--count', '0']), context=ros_context)
+    executor.add_node(client)
+    try:
+        delivered = fuzz(client, Probe(ros_context, executor, 'fuzzer'), executor)
+        assert max(delivered.values()) > 2
+        assert signal in capsys.readouterr().out  # it printed them
+    finally:
+        executor.remove_node(client)
+        client.destroy_node()

@@ -16,7 +16,9 @@ from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
 from miro_ball.common.cli import user_args
+from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
+from miro_ball.common.throttle import Throttled
 from miro_ball.miro.interface import DEFAULT_ROBOT_NAME, RobotTopics, check_name, \
     default_robot_name
 
@@ -67,6 +69,7 @@ class Client(Node):
                          parameter_overrides=[Parameter('use_sim_time', value=True)])
         self.options = options
         self.topics = RobotTopics(options.robot)
+        guard_clock(self, Throttled(self.get_logger().warning))
 
     def now(self):
         """Simulated seconds (0 until the first /clock)."""

@@ -15,6 +15,8 @@ from geometry_msgs.msg import PoseStamped
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from miro_ball.common.clock_guard import guard_clock
+from miro_ball.common.throttle import Throttled
 from miro_ball.examples._client import number, run
 from miro_ball.miro.interface import BALL_NAME, SimTopics
 
@@ -29,6 +31,7 @@ class BallMover(Node):
         super().__init__('ball_mover', context=context,
                          parameter_overrides=[Parameter('use_sim_time', value=True)])
         self.options = options
+        guard_clock(self, Throttled(self.get_logger().warning))
         self.pub = self.create_publisher(PoseStamped, SimTopics().set_pose, 10)
         self.start = None
         self.last = None  # (t, y) of the latest command

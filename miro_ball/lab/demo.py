@@ -16,11 +16,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.isolation import isolated_env, private_domain
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
-from miro_ball.common.throttle import Throttled
 from miro_ball.miro.interface import EYES, RobotTopics, default_robot_name
 
 VIDEO_FPS = 10.0  # frames per simulated second in the video (= overhead rate)
@@ -156,7 +154,6 @@ def watch(args, robots, procs, domain_id, stop):
     rclpy.init(context=context, domain_id=domain_id)
     node = rclpy.create_node('miro_demo_monitor', context=context, parameter_overrides=[
         Parameter('use_sim_time', value=True)])
-    guard_clock(node, Throttled(node.get_logger().warning))
     name = args.world if len(robots) > 1 else args.mode
     video = Video(Path(args.out) / f'demo_{name}.mp4', robots) if args.video else None
     monitor = None

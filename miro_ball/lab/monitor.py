@@ -4,7 +4,9 @@ It only subscribes (to /clock, the simulator's ground truth and the controllers'
 annotated frames), so it can watch any run: the demo's, a grader's, a user's.
 Image callbacks are optional; they get each frame decoded to BGR.
 """
+from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
+from miro_ball.common.throttle import Throttled
 from miro_ball.lab.judge import FELL_BELOW_M, KICK_DISTANCE_M, ball_moved
 from miro_ball.miro.constants import WHEEL_RADIUS_M
 from miro_ball.miro.interface import CLOCK, EYES, RobotTopics, SimTopics
@@ -46,6 +48,8 @@ class Monitor:
         self.kicker = None  # the robot nearest the ball when it was kicked
         self.robots = {name: RobotWatch() for name in robots}
         sim = SimTopics()
+        # The node is on sim time: a negative /clock from anyone must not end it.
+        guard_clock(node, Throttled(node.get_logger().warning))
         node.create_subscription(Clock, CLOCK, self._on_clock, qos)
         node.create_subscription(PointStamped, sim.ball, self._on_ball, qos)
         for index, name in enumerate(robots):
