@@ -2,7 +2,7 @@
 # One entry point for a new user: sets up .venv (and, as root, the Debian
 # packages) on first use, then runs what was asked.
 #   ./dev.sh demo [args]   headless simulator + controller, summary and video
-#   ./dev.sh test [args]   the test suite (pytest)
+#   ./dev.sh test [args]   the test suite (pytest); no args: twice, the 2nd as robot miro02
 #   ./dev.sh bench         simulator, detection and scenario benchmarks
 #   ./dev.sh soak [args]   long free run: memory, open files, speed per minute (--minutes N)
 #   ./dev.sh setup         only the set-up
@@ -53,7 +53,12 @@ cmd=${1:-help}
 case "$cmd" in
   setup) setup ;;
   demo) setup; exec "$PY" -m miro_ball.lab.demo "$@" ;;
-  test) setup; exec "$PY" -m pytest "$@" ;;
+  test) setup
+    if [ $# -gt 0 ]; then exec "$PY" -m pytest "$@"; fi
+    # The whole suite twice: as is, and under another robot name (the MDK's multi-robot
+    # convention), so that no test or node leans on the default name.
+    "$PY" -m pytest
+    MIRO_ROBOT_NAME=miro02 exec "$PY" -m pytest -q ;;
   bench) setup; exec "$PY" -m miro_ball.lab.sim_bench "$@" ;;
   soak) setup; exec "$PY" -m miro_ball.lab.soak "$@" ;;
   *) sed -n '2,8p' "$0"; exit 2 ;;
