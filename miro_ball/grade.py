@@ -88,7 +88,7 @@ def options_from(args, command, p):
 
     try:
         world = load_world(args.world)
-        robots = [check_name(name) for name in robot_names(args.world)]
+        robots = [check_name(name) for name in robot_names(args.world, p)]
     except ValueError as err:  # WorldError, a bad $MIRO_ROBOT_NAME
         p.error(str(err))
     if len(robots) != 1 or world.ball is None:

@@ -8,13 +8,9 @@ from rclpy.parameter import Parameter
 from miro_ball.controller.params import GROUPS
 from miro_sim_bullet.ros.node import FIXED_PARAMS
 from miro_sim_bullet.ros.params import SimParams
+from test_param_bounds import beyond
 
 CONTROLLER_FIXED = ('robot_name', 'tick')
-
-
-def beyond(low, high):
-    step = 1 if isinstance(low, int) else abs(low) * 0.5 + 1e-3
-    return [low - step, high * 2 + 1]
 
 
 def exercise(node, groups, fixed, current):

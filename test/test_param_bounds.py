@@ -18,6 +18,11 @@ def bounded(cls):
     return [(cls, f.name, f.metadata['range']) for f in fields(cls) if 'range' in f.metadata]
 
 
+def beyond(low, high):
+    """A value just under the range and one far over it."""
+    return [low - (1 if isinstance(low, int) else abs(low) * 0.5 + 1e-3), high * 2 + 1]
+
+
 def at(cls, name, value):
     """cls's defaults with one field set (made valid where fields depend on each other)."""
     base = cls()
@@ -60,9 +65,7 @@ def test_behaviours_work_at_their_bounds(cls, name, bounds):
 @pytest.mark.parametrize('cls, name, bounds', bounded(ControllerParams) + bounded(SimParams)
                          + bounded(DetectionParams) + bounded(BehaviourParams))
 def test_beyond_the_bounds_is_refused_by_name(cls, name, bounds):
-    low, high = bounds
-    for value in (low - (1 if isinstance(low, int) else abs(low) * 0.5 + 1e-3),
-                  high * 2 + 1):
+    for value in beyond(*bounds):
         default = getattr(cls(), name)
         value = tuple([value] * len(default)) if isinstance(default, tuple) else value
         with pytest.raises(ValueError, match=name):

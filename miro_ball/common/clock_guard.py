@@ -12,6 +12,8 @@ def guard_clock(node, warn):
     """Check /clock before node's time source sees it; warn(key, text) says what was dropped."""
     source = node._time_source
     unchecked = source.clock_callback
+    if getattr(unchecked, 'guarded', False):  # a second observer on the same node
+        return
 
     def checked(msg):
         if msg.clock.sec < 0:
@@ -19,6 +21,7 @@ def guard_clock(node, warn):
             return
         unchecked(msg)
 
+    checked.guarded = True
     # Future subscriptions (use_sim_time switched on later) and the current one.
     source.clock_callback = checked
     for subscription in node.subscriptions:

@@ -62,11 +62,15 @@ class Processes:
         return killed
 
 
-def robot_names(world):
-    """The world's robot names, as the simulator will call them."""
+def robot_names(world, parser):
+    """The world's robot names, as the simulator will call them; a world that does not load
+    is the parser's one-line error."""
     from miro_sim_bullet.scene.world_file import load_world
 
-    return [spec.name or default_robot_name() for spec in load_world(world).robots]
+    try:
+        return [spec.name or default_robot_name() for spec in load_world(world).robots]
+    except ValueError as err:  # WorldError; a bad $MIRO_ROBOT_NAME fails in the node later
+        parser.error(str(err))
 
 
 def node_commands(args, robots):
@@ -273,10 +277,7 @@ def parse_args(argv):
 
 def main(argv=None):
     args, parser = parse_args(sys.argv[1:] if argv is None else argv)
-    try:
-        robots = robot_names(args.world)
-    except ValueError as err:  # WorldError, or a bad $MIRO_ROBOT_NAME via the node later
-        parser.error(str(err))
+    robots = robot_names(args.world, parser)
     domain_id = private_domain(salt=50)
     out = Path(args.out)
     print(f'miro_ball demo: mode {args.mode}, world {args.world}, robots {", ".join(robots)}, '

@@ -1,7 +1,7 @@
 """What the recorder records and at what time: the pure parts, without rclpy.
 
 Topic selection: an argument with a slash (or a wildcard) is a topic name or an
-fnmatch pattern ('/miro/sensors/*'); a bare name is a robot, which selects every
+fnmatch pattern ('/<robot>/sensors/*'); a bare name is a robot, which selects every
 topic under /<name>/ and the simulator's ground truth of that robot. Nothing
 named selects everything.
 

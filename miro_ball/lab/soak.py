@@ -375,10 +375,7 @@ def parse_args(argv):
 
 def main(argv=None):
     args, parser = parse_args(sys.argv[1:] if argv is None else argv)
-    try:
-        robots = robot_names(args.world)
-    except ValueError as err:
-        parser.error(str(err))
+    robots = robot_names(args.world, parser)
     limit_discovery()  # the observer in this process, like the nodes: this host only
     domain_id = idle_domain(private_domain(salt=70))
     if domain_id is None:
