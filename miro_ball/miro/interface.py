@@ -1,8 +1,17 @@
-"""MiRo on ROS: robot names and every topic and service name, in one place.
+"""MiRo on ROS: how a robot is named, and its interface as one table.
 
-The simulator, the controller, the lab tools and the example clients all take
-their names from here, so a robot called ``miro02`` (the MDK's convention for
-several robots) is one argument away and no other module spells a topic.
+Every topic of MiRo's interface is a row of ``ROBOT_INTERFACE``: its name relative
+to the robot's namespace, its type, its QoS and its direction. A node that serves
+one robot (the controller, a client, the GUI's robot part) lives in the robot's
+namespace and uses the relative names, so ``--ros-args -r __ns:=/miro02`` picks
+the robot as for any ROS 2 node; ``robot_namespace`` is the one rule that decides
+the namespace when none is remapped. Code outside a robot's namespace (the
+simulator, observers, tests) uses ``RobotTopics(name)``, the same rows made
+absolute. Frame ids carry the robot (``frame_id``), as multi-robot ROS 2 stacks do
+with a frame prefix.
+
+Plain Python: QoS is described here and made into rclpy profiles by
+``miro_ball.common.qos``.
 """
 import os
 import re
@@ -15,11 +24,96 @@ EYES = ('caml', 'camr')  # index 0 is the left eye, as the MDK's CAM_L
 EYE_SIDE = {'caml': +1, 'camr': -1}  # +1 left, -1 right: the sign of the eye's y offset
 SIM_NODE_NAME = 'miro_sim'
 BALL_NAME = 'ball'  # the simulator's name of the ball, for set_pose and its ground truth
-CONTROLLER_NODE_NAME = 'kick_blue_ball'
-GUI_NODE_NAME = 'miro_gui'
 MAX_NAME_LENGTH = 64
 # A ROS name token: what may stand between two slashes of a topic name.
 _TOKEN = re.compile(r'[A-Za-z][A-Za-z0-9_]*\Z')
+
+
+@dataclass(frozen=True)
+class Qos:
+    """A QoS profile in plain words: keep the newest ``depth``, reliable or best effort
+    (volatile: a late subscriber gets nothing from before)."""
+
+    depth: int
+    reliable: bool = True
+
+
+# The eyes: the newest frame only (a late frame is worth less than none), reliable so
+# that RViz's and `ros2 bag`'s reliable subscribers match too. One profile for the
+# simulator, the controller, the GUI and the clients.
+EYE_QOS = Qos(depth=1)
+SENSOR_QOS = Qos(depth=10)  # the 50 Hz platform topics, ROS's default
+CONTROL_QOS = Qos(depth=10)
+CLOCK_QOS = Qos(depth=10)  # matches rclpy's own best-effort /clock subscription
+
+SENSOR, CONTROL = 'sensor', 'control'  # out of the robot, into the robot
+
+
+@dataclass(frozen=True)
+class Topic:
+    """One row of MiRo's interface; ``name`` is relative to the robot's namespace and may
+    hold ``{eye}`` or ``{part}``."""
+
+    key: str
+    name: str
+    type: str
+    direction: str
+    qos: Qos
+    about: str
+
+
+ROBOT_INTERFACE = tuple(Topic(*row) for row in (
+    # key, relative name, type, direction, QoS, what it carries
+    ('eye_compressed', 'sensors/{eye}/compressed', 'sensor_msgs/msg/CompressedImage', SENSOR,
+     EYE_QOS, 'eye image, JPEG'),
+    ('eye_raw', 'sensors/{eye}', 'sensor_msgs/msg/Image', SENSOR, EYE_QOS,
+     'eye image, rgb8 (rendered only while subscribed)'),
+    ('camera_info', 'sensors/{eye}/camera_info', 'sensor_msgs/msg/CameraInfo', SENSOR, EYE_QOS,
+     "the eye's camera model, with each frame"),
+    ('kinematic_joints', 'sensors/kinematic_joints', 'sensor_msgs/msg/JointState', SENSOR,
+     SENSOR_QOS, 'tilt, lift, yaw, pitch, rad'),
+    ('odom', 'sensors/odom', 'nav_msgs/msg/Odometry', SENSOR, SENSOR_QOS,
+     'pose in <robot>/odom, twist in <robot>/base_link'),
+    ('body_pose', 'sensors/body_pose', 'geometry_msgs/msg/Pose2D', SENSOR, SENSOR_QOS,
+     'x, y, theta in <robot>/odom'),
+    ('body_vel', 'sensors/body_vel', 'geometry_msgs/msg/Twist', SENSOR, SENSOR_QOS,
+     'body velocity'),
+    ('wheel_speed_cmd', 'sensors/wheel_speed_cmd', 'std_msgs/msg/Float32MultiArray', SENSOR,
+     SENSOR_QOS, 'commanded wheel speeds [L, R], m/s'),
+    ('wheel_speed_opto', 'sensors/wheel_speed_opto', 'std_msgs/msg/Float32MultiArray', SENSOR,
+     SENSOR_QOS, 'measured wheel speeds [L, R], m/s'),
+    ('cliff', 'sensors/cliff', 'std_msgs/msg/Float32MultiArray', SENSOR, SENSOR_QOS,
+     '[L, R]: 1 floor, below 0.7 a drop'),
+    ('sonar', 'sensors/sonar', 'sensor_msgs/msg/Range', SENSOR, SENSOR_QOS, 'range ahead, m'),
+    ('imu', 'sensors/imu_{part}', 'sensor_msgs/msg/Imu', SENSOR, SENSOR_QOS,
+     'part body or head'),
+    ('battery', 'sensors/battery', 'sensor_msgs/msg/BatteryState', SENSOR, SENSOR_QOS,
+     'battery voltage'),
+    ('light', 'sensors/light', 'std_msgs/msg/Float32MultiArray', SENSOR, SENSOR_QOS,
+     'four light sensors, 0..1'),
+    ('touch', 'sensors/touch_{part}', 'std_msgs/msg/UInt16', SENSOR, SENSOR_QOS,
+     'part head or body: a bit per touch sensor'),
+    ('sensor_flags', 'sensors/flags', 'std_msgs/msg/UInt32', SENSOR, SENSOR_QOS,
+     'platform flags (bit 15: simulator)'),
+    ('cmd_vel', 'control/cmd_vel', 'geometry_msgs/msg/TwistStamped', CONTROL, CONTROL_QOS,
+     'body velocity, 0.4 m/s a wheel at most'),
+    ('kinematic_targets', 'control/kinematic_joints', 'sensor_msgs/msg/JointState', CONTROL,
+     CONTROL_QOS, 'tilt, lift, yaw, pitch targets, rad'),
+    ('cosmetic_joints', 'control/cosmetic_joints', 'std_msgs/msg/Float32MultiArray', CONTROL,
+     CONTROL_QOS, 'droop, wag, eyelids, ears, 0..1'),
+    ('illum', 'control/illum', 'std_msgs/msg/UInt32MultiArray', CONTROL, CONTROL_QOS,
+     'six LEDs, ARGB'),
+    ('tone', 'control/tone', 'std_msgs/msg/UInt16MultiArray', CONTROL, CONTROL_QOS,
+     'frequency, volume, ticks'),
+    ('control_flags', 'control/flags', 'std_msgs/msg/UInt32', CONTROL, CONTROL_QOS,
+     'platform flags'),
+))
+TOPIC = {row.key: row for row in ROBOT_INTERFACE}
+
+# The frames of one robot, each prefixed with the robot's name (frame_id):
+#   <robot>/odom -> <robot>/base_link -> <robot>/imu_body, <robot>/imu_head, <robot>/sonar,
+#                                        <robot>/caml_optical, <robot>/camr_optical
+# beside the simulator's 'world' frame, which carries no robot (docs/frames.md).
 
 
 def check_name(name, what='robot name'):
@@ -28,6 +122,36 @@ def check_name(name, what='robot name'):
         raise ValueError(f'{what} {name!r} must be a letter followed by letters, digits or '
                          f'underscores (at most {MAX_NAME_LENGTH} characters)')
     return name
+
+
+def default_robot_name(environ=None):
+    """$MIRO_ROBOT_NAME, as the MDK reads it, else 'miro' (not checked here)."""
+    environ = os.environ if environ is None else environ
+    return environ.get(ROBOT_NAME_ENV) or DEFAULT_ROBOT_NAME
+
+
+def robot_name(given=None, environ=None):
+    """The one rule for a robot's name: a name given (``--robot``), else
+    $MIRO_ROBOT_NAME, else 'miro'; checked, ValueError in one line."""
+    if given is not None:
+        return check_name(given, '--robot')
+    return check_name(default_robot_name(environ), '$' + ROBOT_NAME_ENV)
+
+
+def robot_namespace(given=None, environ=None):
+    """The namespace a node serving one robot is created in (``--ros-args -r __ns:=``
+    overrides it, as for any ROS 2 node)."""
+    return '/' + robot_name(given, environ)
+
+
+def robot_of_namespace(namespace):
+    """The robot a node serves, from its fully qualified namespace: its last part."""
+    return check_name(namespace.rstrip('/').rsplit('/', 1)[-1], f'namespace {namespace!r}:')
+
+
+def frame_id(robot, frame):
+    """A robot's frame: '<robot>/<frame>' (the frame prefix convention)."""
+    return f'{robot}/{frame}'
 
 
 def robots_in(topic_names):
@@ -42,114 +166,47 @@ def robots_in(topic_names):
     return sorted(names)
 
 
-def default_robot_name(environ=None):
-    """$MIRO_ROBOT_NAME, as the MDK reads it, else 'miro' (not checked here)."""
-    environ = os.environ if environ is None else environ
-    return environ.get(ROBOT_NAME_ENV) or DEFAULT_ROBOT_NAME
-
-
 @dataclass(frozen=True)
 class RobotTopics:
-    """Absolute names of one MiRo's interface, under /<name>/."""
+    """One MiRo's topic names: absolute under /<name>/, or, with no name, relative (for a
+    node in the robot's namespace)."""
 
-    name: str
+    name: str = None
 
     def __post_init__(self):
-        check_name(self.name)
+        if self.name is not None:
+            check_name(self.name)
 
     def topic(self, relative):
-        return f'/{self.name}/{relative}'
+        return relative if self.name is None else f'/{self.name}/{relative}'
+
+    def _row(self, key, **fields):
+        return self.topic(TOPIC[key].name.format(**fields))
 
     # Sensors: what the robot (or the simulator standing in for it) publishes.
     def eye_compressed(self, eye):
-        return self.topic(f'sensors/{eye}/compressed')
+        return self._row('eye_compressed', eye=eye)
 
     def eye_raw(self, eye):
-        return self.topic(f'sensors/{eye}')
+        return self._row('eye_raw', eye=eye)
 
     def camera_info(self, eye):
-        return self.topic(f'sensors/{eye}/camera_info')
-
-    @property
-    def kinematic_joints(self):
-        return self.topic('sensors/kinematic_joints')
-
-    @property
-    def odom(self):
-        return self.topic('sensors/odom')
-
-    @property
-    def body_pose(self):
-        return self.topic('sensors/body_pose')
-
-    @property
-    def body_vel(self):
-        return self.topic('sensors/body_vel')
-
-    @property
-    def wheel_speed_cmd(self):
-        return self.topic('sensors/wheel_speed_cmd')
-
-    @property
-    def wheel_speed_opto(self):
-        return self.topic('sensors/wheel_speed_opto')
-
-    @property
-    def cliff(self):
-        return self.topic('sensors/cliff')
-
-    @property
-    def sonar(self):
-        return self.topic('sensors/sonar')
+        return self._row('camera_info', eye=eye)
 
     def imu(self, part):
         """part: 'body' or 'head'."""
-        return self.topic(f'sensors/imu_{part}')
-
-    @property
-    def battery(self):
-        return self.topic('sensors/battery')
-
-    @property
-    def light(self):
-        return self.topic('sensors/light')
+        return self._row('imu', part=part)
 
     def touch(self, part):
         """part: 'head' or 'body'."""
-        return self.topic(f'sensors/touch_{part}')
+        return self._row('touch', part=part)
 
-    @property
-    def sensor_flags(self):
-        return self.topic('sensors/flags')
-
-    # Control: what the robot takes.
-    @property
-    def cmd_vel(self):
-        return self.topic('control/cmd_vel')
-
-    @property
-    def kinematic_targets(self):
-        return self.topic('control/kinematic_joints')
-
-    @property
-    def cosmetic_joints(self):
-        return self.topic('control/cosmetic_joints')
-
-    @property
-    def illum(self):
-        return self.topic('control/illum')
-
-    @property
-    def tone(self):
-        return self.topic('control/tone')
-
-    @property
-    def control_flags(self):
-        return self.topic('control/flags')
-
-    # The kick_blue_ball controller's annotated frames (read by the demo and viewers).
-    def controller_debug(self, eye):
-        return self.topic(f'{CONTROLLER_NODE_NAME}/debug/{eye}/compressed')
+    def __getattr__(self, key):
+        # The rows without a placeholder: t.odom, t.cliff, t.cmd_vel, ...
+        row = TOPIC.get(key)
+        if row is None or '{' in row.name:
+            raise AttributeError(key)
+        return self.topic(row.name)
 
 
 @dataclass(frozen=True)
