@@ -18,9 +18,9 @@ from rosbags.typesys import Stores, get_typestore
 from ruamel.yaml import YAML
 
 from miro_ball.common.isolation import isolated_env
-from miro_ball.lab.bag import SplitBag, offered_qos
-from miro_ball.lab.record_node import Recorder, RecordingFailed
-from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, log_time_ns
+from miro_ball.recording.bag import SplitBag, offered_qos
+from miro_ball.recording.node import Recorder, RecordingFailed
+from miro_ball.recording.selection import Progress, Selection, cdr_stamp_ns, has_stamp, log_time_ns
 from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
 from rostools import Probe, advance_ticks, advance_until, kill_if_running, run_command, spin_until
 

@@ -7,7 +7,7 @@ is subscribed raw: the CDR bytes that arrive are the bytes a rosbag2 stores, so
 nothing is decoded. Topics are looked up every second, so nodes that start late
 are recorded too. The recorder follows the simulator's /clock: it subscribes to
 the other topics once the first /clock has arrived, and logs each message at its
-simulated time (see miro_ball/lab/recorder.py). Ctrl+C finishes the bag.
+simulated time (see miro_ball/recording/selection.py). Ctrl+C finishes the bag.
 """
 import argparse
 import importlib
@@ -25,8 +25,8 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from miro_ball.common.cli import user_args
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
-from miro_ball.lab.bag import BagError, SplitBag, TYPESTORE, offered_qos
-from miro_ball.lab.recorder import Progress, Selection, cdr_stamp_ns, has_stamp, \
+from miro_ball.recording.bag import BagError, SplitBag, TYPESTORE, offered_qos
+from miro_ball.recording.selection import Progress, Selection, cdr_stamp_ns, has_stamp, \
     import_name, log_time_ns
 from miro_ball.miro.interface import CLOCK, DEFAULT_ROBOT_NAME, RobotTopics
 
