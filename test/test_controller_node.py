@@ -18,11 +18,12 @@ from std_msgs.msg import Float32MultiArray
 
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
 from miro_ball.controller.node import build_parser, KickBlueBall, main
-from miro_ball.controller.params import ControllerParams
 from miro_ball.lab.synthetic import decompression_bomb, Disc, jpeg, render
 from miro_ball.miro.camera import Intrinsics
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
+from miro_ball.controller.names import debug_topic
 from miro_ball.miro.interface import CLOCK, default_robot_name, EYES, RobotTopics
+from rostools import drain, kill_if_running, Probe, spin_until
 from test_behaviour import AHEAD, camera_info_k, column
 
 TICK = 0.02
@@ -43,9 +44,9 @@ class Rig:
 
     def __init__(self, context, executor, overrides=(), robot=None, **kwargs):
         robot = robot or default_robot_name()
-        params = [Parameter('use_sim_time', value=True), Parameter('robot_name', value=robot)]
+        params = [Parameter('use_sim_time', value=True)]
         self.node = KickBlueBall(context=context, parameter_overrides=params + list(overrides),
-                                 **kwargs)
+                                 robot=robot, **kwargs)
         self.probe = rclpy.create_node('fake_sim', context=context)
         self.executor = executor
         self.twists, self.joints = [], []
@@ -173,7 +174,7 @@ def test_tutorial_holds_the_head_then_searches(make_rig):
     linear, angular = rig.last_twist()
     assert linear == pytest.approx(0.0) and angular == pytest.approx(TUTORIAL_SPIN)
     twist = rig.twists[-1]
-    assert twist.header.frame_id == 'base_link'
+    assert twist.header.frame_id == rig.names.name + '/base_link'
     stamp = twist.header.stamp.sec + twist.header.stamp.nanosec * 1e-9
     assert 11.0 < stamp <= rig.now + 1e-6  # stamped with simulated time
 
@@ -294,10 +295,57 @@ def test_carries_on_when_the_clock_jumps_back(make_rig):
     assert rig.last_twist()[1] == pytest.approx(SEARCH_SPIN)
 
 
+def test_two_clock_publishers_are_named_once_and_do_not_restart_it(make_rig, capfd):
+    rig = make_rig(*short_hold())
+    rig.set_clock(10.0)
+    rig.advance(0.3)
+    rig.both_eyes(*AHEAD)
+    rig.advance(0.1)
+    assert rig.node.state == 'approach'
+    other = rclpy.create_node('other_sim', context=rig.probe.context)
+    other.create_publisher(Clock, CLOCK, 10)
+    rig.wait_until(lambda: rig.node.count_publishers(CLOCK) == 2, 'a second /clock publisher')
+    for _ in range(3):  # the two timelines take turns
+        rig.set_clock(1.0)
+        rig.advance(0.1)
+        rig.set_clock(10.5)
+        rig.advance(0.1)
+    other.destroy_node()
+    assert rig.node.state == 'approach'  # not started over
+    err = capfd.readouterr().err
+    assert err.count('publishers on /clock') == 1 and '/other_sim' in err, err
+    assert 'starting over' not in err
+
+
+def test_a_remapped_namespace_picks_the_robot(ros_context, executor):
+    """As for any ROS 2 node: -r __ns:=/<robot> drives that robot only."""
+    robot, other = default_robot_name() + '_b', default_robot_name()
+    probe = Probe(ros_context, executor)
+    mine, theirs = (probe.watch(TwistStamped, RobotTopics(name).cmd_vel) for name in (robot, other))
+    clock = probe.publisher(Clock, CLOCK)
+    proc = subprocess.Popen([sys.executable, '-m', 'miro_ball', '--ros-args', '-r',
+                             f'__ns:=/{robot}', '-p', 'use_sim_time:=true', '-p', 'head_hold_s:=0.0'],
+                            env=dict(os.environ, PYTHONWARNINGS='ignore'),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        assert spin_until(executor, lambda: ('kick_blue_ball', f'/{robot}') in
+                          probe.node.get_node_names_and_namespaces(), timeout_s=30)
+        t = 1.0
+        while not mine and t < 60.0:  # sim time moves only as the test says
+            clock.publish(Clock(clock=Time(sec=int(t), nanosec=int(t % 1 * 1e9))))
+            drain(executor)
+            spin_until(executor, lambda: mine, timeout_s=0.05)
+            t += 0.02
+        assert mine and mine[-1].header.frame_id == f'{robot}/base_link'
+        assert not theirs
+    finally:
+        kill_if_running(proc)
+
+
 def test_debug_image_only_while_subscribed(make_rig, tmp_path):
     rig = make_rig(*short_hold(), save_debug=str(tmp_path))
     got = []
-    rig.probe.create_subscription(CompressedImage, rig.names.controller_debug(EYES[0]),
+    rig.probe.create_subscription(CompressedImage, debug_topic(rig.names.name, EYES[0]),
                                   got.append, 2)
     rig.wait_until(lambda: rig.node.pub_debug[0].get_subscription_count() > 0, 'debug sub')
     rig.image(0, ball_frame(0.1))
@@ -310,18 +358,21 @@ def test_debug_image_only_while_subscribed(make_rig, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ['caml_000001.jpg', 'camr_000002.jpg']
 
 
-def test_robot_name_prefixes_the_topics(make_rig):
-    rig = make_rig(*short_hold(), robot=default_robot_name() + '2')  # not the default
+def test_the_robot_is_the_namespace_and_frames_carry_it(make_rig):
+    robot = default_robot_name() + '2'  # not the default
+    rig = make_rig(*short_hold(), robot=robot)
+    assert rig.node.get_fully_qualified_name() == f'/{robot}/kick_blue_ball'
     rig.set_clock(10.0)
     rig.advance(0.3)
     assert rig.twists and rig.twists[-1].twist.angular.z == pytest.approx(SEARCH_SPIN)
+    assert rig.twists[-1].header.frame_id == f'{robot}/base_link'
 
 
-def test_robot_name_defaults_to_the_environment(monkeypatch):
+def test_the_namespace_defaults_to_the_environment(ros_context, monkeypatch):
     monkeypatch.setenv('MIRO_ROBOT_NAME', 'miro07')
-    assert ControllerParams().robot_name == 'miro07'
-    monkeypatch.delenv('MIRO_ROBOT_NAME')
-    assert ControllerParams().robot_name == 'miro'
+    node = KickBlueBall(context=ros_context)
+    assert (node.robot, node.get_namespace()) == ('miro07', '/miro07')
+    node.destroy_node()
 
 
 def test_camera_model_follows_camera_info(make_rig):
@@ -377,8 +428,8 @@ def test_help_lists_parameters_and_topics(capsys):
         main(['kick_blue_ball', '--help'])
     assert done.value.code == 0
     text = capsys.readouterr().out
-    names = RobotTopics(default_robot_name())
-    for word in ('--save-debug', 'hue_window', 'kick_duration', '0.4', names.cmd_vel,
+    names = RobotTopics()
+    for word in ('--save-debug', '--robot', '__ns:=', 'hue_window', 'kick_duration', '0.4', names.cmd_vel,
                  names.cliff, names.camera_info(EYES[0]), 'tutorial or improved'):
         assert word in text
 
@@ -388,7 +439,7 @@ def test_help_survives_a_bad_robot_name_in_the_environment(capsys, monkeypatch):
     with pytest.raises(SystemExit) as done:
         main(['kick_blue_ball', '--help'])
     assert done.value.code == 0
-    assert "topics: robot name 'bad name' must be" in capsys.readouterr().out
+    assert RobotTopics().cmd_vel in capsys.readouterr().out
 
 
 def test_bad_command_line_is_one_line(capsys):
@@ -400,28 +451,29 @@ def test_bad_command_line_is_one_line(capsys):
     assert build_parser().parse_args(['--save-debug', 'x']).save_debug == 'x'
 
 
-def run_controller(*ros_args, **env):
-    """The controller from the shell (python -m miro_ball --ros-args ...): (exit code, stderr)."""
-    done = subprocess.run([sys.executable, '-m', 'miro_ball', '--ros-args', *ros_args],
+def run_controller(*args, **env):
+    """The controller from the shell (python -m miro_ball ARGS): (exit code, stderr)."""
+    done = subprocess.run([sys.executable, '-m', 'miro_ball', *args],
                           capture_output=True, text=True, timeout=60,
                           env=dict(os.environ, PYTHONWARNINGS='ignore', **env))
     return done.returncode, done.stderr.strip().splitlines()
 
 
 def test_bad_ros_parameter_from_the_shell_is_one_line():
-    assert run_controller('-p', 'mode:=fancy') == (2, [
+    assert run_controller('--ros-args', '-p', 'mode:=fancy') == (2, [
         "kick_blue_ball: error: mode must be one of tutorial, improved, not 'fancy'"])
 
 
-@pytest.mark.parametrize('ros_args,env', [
-    (('-p', 'robot_name:=bad name'), {}),
-    (('-p', "robot_name:=''"), {}),
-    ((), {'MIRO_ROBOT_NAME': 'bad name'}),
+@pytest.mark.parametrize('args,env,said', [
+    (('--robot', 'bad name'), {}, "--robot 'bad name'"),
+    (('--robot', ''), {}, "--robot ''"),
+    ((), {'MIRO_ROBOT_NAME': 'bad name'}, "$MIRO_ROBOT_NAME 'bad name'"),
+    (('--ros-args', '-r', '__ns:=/'), {}, "the namespace '/': robot name ''"),
 ])
-def test_bad_robot_name_from_the_shell_is_one_line(ros_args, env):
-    code, lines = run_controller(*ros_args, **env)
+def test_bad_robot_name_from_the_shell_is_one_line(args, env, said):
+    code, lines = run_controller(*args, **env)
     assert code == 2 and len(lines) == 1, lines
-    assert lines[0].startswith('kick_blue_ball: error: robot_name ')
+    assert lines[0].startswith('kick_blue_ball: error: ' + said)
     assert 'must be a letter followed by letters, digits or underscores' in lines[0]
 
 
@@ -432,7 +484,7 @@ def test_run_time_parameters_apply_or_are_refused_with_a_reason(make_rig):
     assert results[0].successful and node.detector.params.blur == 7
     # The same checks as at start: refused, and nothing changed.
     for name, value, reason in [('hough_param2', 0.0, 'hough_param2'), ('blur', 8, 'odd'),
-                                ('tick', 0.05, 'restart'), ('robot_name', 'other', 'restart'),
+                                ('tick', 0.05, 'restart'),
                                 ('slow', 'fast', 'number')]:
         result = node.set_parameters([Parameter(name, value=value)])[0]
         assert not result.successful and reason in result.reason, (name, result.reason)

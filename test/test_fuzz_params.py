@@ -10,7 +10,7 @@ from miro_sim_bullet.ros.node import FIXED_PARAMS
 from miro_sim_bullet.ros.params import SimParams
 from test_param_bounds import beyond
 
-CONTROLLER_FIXED = ('robot_name', 'tick')
+CONTROLLER_FIXED = ('tick',)
 
 
 def exercise(node, groups, fixed, current):

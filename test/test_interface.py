@@ -1,8 +1,10 @@
 """MiRo's names: one module says them, for any robot name."""
 import pytest
 
+from miro_ball.controller.names import debug_topic
 from miro_ball.miro.interface import (EYES, RobotTopics, SimTopics, check_name,
-                                      default_robot_name)
+                                      default_robot_name, frame_id, robot_name, robot_namespace,
+                                      robot_of_namespace, ROBOT_INTERFACE, TOPIC)
 
 
 def test_topics_live_under_the_robot_name():
@@ -11,7 +13,9 @@ def test_topics_live_under_the_robot_name():
     assert t.eye_compressed('caml') == '/miro02/sensors/caml/compressed'
     assert t.camera_info('camr') == '/miro02/sensors/camr/camera_info'
     assert t.imu('head') == '/miro02/sensors/imu_head'
-    assert t.controller_debug('caml') == '/miro02/kick_blue_ball/debug/caml/compressed'
+    assert RobotTopics().cmd_vel == 'control/cmd_vel'  # relative, for a node in the namespace
+    assert debug_topic('miro02', 'caml') == '/miro02/kick_blue_ball/debug/caml/compressed'
+    assert frame_id('miro02', 'base_link') == 'miro02/base_link'
     assert EYES == ('caml', 'camr')
 
 
@@ -21,7 +25,7 @@ def test_the_simulator_has_names_of_its_own():
     assert sim.object_pose('cube') == '/miro_sim/objects/cube'
 
 
-@pytest.mark.parametrize('name', ['', 'bad name', '2miro', 'miro/02', 'm' * 65, None, 7])
+@pytest.mark.parametrize('name', ['', 'bad name', '2miro', 'miro/02', 'm' * 65, 7])
 def test_names_that_cannot_be_ros_namespaces_are_refused_in_one_line(name):
     with pytest.raises(ValueError) as err:
         RobotTopics(name)
@@ -32,3 +36,25 @@ def test_default_name_follows_the_mdk_environment_variable():
     assert default_robot_name({}) == 'miro'
     assert default_robot_name({'MIRO_ROBOT_NAME': 'miro03'}) == 'miro03'
     assert check_name('miro_03') == 'miro_03'
+
+
+def test_one_rule_names_the_robot():
+    assert robot_name(environ={}) == 'miro'
+    assert robot_name(environ={'MIRO_ROBOT_NAME': 'miro03'}) == 'miro03'
+    assert robot_name('miro04', environ={'MIRO_ROBOT_NAME': 'miro03'}) == 'miro04'
+    assert robot_namespace('miro04') == '/miro04'
+    assert robot_of_namespace('/class_a/miro05') == 'miro05'
+    with pytest.raises(ValueError, match="--robot '1x' must be"):
+        robot_name('1x')
+    with pytest.raises(ValueError, match=r"\$MIRO_ROBOT_NAME 'a b' must be"):
+        robot_name(environ={'MIRO_ROBOT_NAME': 'a b'})
+
+
+def test_the_interface_is_one_table_with_one_eye_qos():
+    assert len({row.key for row in ROBOT_INTERFACE}) == len(ROBOT_INTERFACE)
+    assert len({row.name for row in ROBOT_INTERFACE}) == len(ROBOT_INTERFACE)
+    eyes = {TOPIC[key].qos for key in ('eye_compressed', 'eye_raw', 'camera_info')}
+    assert len(eyes) == 1
+    assert {row.direction for row in ROBOT_INTERFACE} == {'sensor', 'control'}
+    prefix = {'sensor': 'sensors/', 'control': 'control/'}  # as on the real MiRo
+    assert all(row.name.startswith(prefix[row.direction]) for row in ROBOT_INTERFACE)

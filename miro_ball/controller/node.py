@@ -6,6 +6,10 @@ freshest detections and cliff reading to the chosen behaviour, publishing the
 resulting wheel speeds as a TwistStamped. Each eye's pinhole model comes from its
 camera_info (MiRo's simulated 120 deg eye until one arrives), so bearings stay
 right whatever field of view the camera has.
+
+The node lives in its robot's namespace and uses relative names, so
+``--ros-args -r __ns:=/miro02`` (or ``--robot miro02``, or $MIRO_ROBOT_NAME)
+makes it ``/miro02/kick_blue_ball`` driving miro02 only.
 """
 import argparse
 import math
@@ -21,7 +25,6 @@ from rclpy.clock import Clock, ClockType, JumpThreshold
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
 from std_msgs.msg import Float32MultiArray
@@ -29,46 +32,48 @@ from std_msgs.msg import Float32MultiArray
 from miro_ball.common.cli import user_args
 from miro_ball.common import params
 from miro_ball.common.clock_guard import guard_clock
+from miro_ball.common.clock_watch import ClockWatch
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
+from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERAS, make_behaviour
 from miro_ball.controller.detection import annotate, BallDetector, DetectionParams
+from miro_ball.controller.names import DEBUG_TOPIC, NODE_NAME
 from miro_ball.controller.params import ControllerParams, GROUPS
 from miro_ball.miro.camera import Intrinsics
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES
-from miro_ball.miro.interface import (CLOCK, CONTROLLER_NODE_NAME, default_robot_name, EYES,
-                                      RobotTopics)
+from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYE_QOS, EYES, frame_id,
+                                      robot_namespace, robot_of_namespace, RobotTopics,
+                                      SENSOR, TOPIC)
 from miro_ball.miro.kinematics import clamp_wheel_speeds, finite, wheel_speed2cmd_vel
 
-NODE_NAME = CONTROLLER_NODE_NAME
 SIDES = ('left', 'right')  # of EYES, in order
 STARTUP = 'startup'
 WARN_EVERY_S = 5.0
 NO_CLOCK_NOTICE_S = 5.0  # wall seconds
 MAX_FRAME_SIDE = max(max(size) for size in FRAME_SIZES)
 
-# Newest frame only: a late frame is worth less than none (like queue_size=1).
-# Best effort matches both reliable and best-effort publishers.
-SENSOR_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
-DEBUG_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+
+def _uses(key, purpose, **fields):
+    """One row of the interface table as the controller uses it."""
+    row = TOPIC[key]
+    way = 'in' if row.direction == SENSOR else 'out'
+    return RobotTopics().topic(row.name.format(**fields)), row.type, way, purpose
 
 
-def topics(robot_name):
-    """(topic, type, direction, purpose) of everything the node uses."""
-    names = RobotTopics(robot_name)
+def topics():
+    """(topic, type, direction, purpose) of everything the node uses, relative to its
+    robot's namespace."""
     used = []
     for eye, side in zip(EYES, SIDES):
-        used += [(names.eye_compressed(eye), 'sensor_msgs/CompressedImage', 'in',
-                  side + ' eye, JPEG'),
-                 (names.camera_info(eye), 'sensor_msgs/CameraInfo', 'in',
-                  '%s eye pinhole (until one arrives: %g deg)' % (side, CAM_HFOV_DEG_SIM))]
-    used += [
-        (names.cliff, 'std_msgs/Float32MultiArray', 'in', '[L, R], 1 floor, <0.7 drop'),
-        (names.cmd_vel, 'geometry_msgs/TwistStamped', 'out', 'every tick'),
-        (names.kinematic_targets, 'sensor_msgs/JointState', 'out', 'head pose at start'),
-    ]
-    used += [(names.controller_debug(eye), 'sensor_msgs/CompressedImage', 'out',
+        used += [_uses('eye_compressed', side + ' eye, JPEG', eye=eye),
+                 _uses('camera_info', '%s eye pinhole (until one arrives: %g deg)'
+                       % (side, CAM_HFOV_DEG_SIM), eye=eye)]
+    used += [_uses('cliff', '[L, R], 1 floor, <0.7 drop'),
+             _uses('cmd_vel', 'every tick'),
+             _uses('kinematic_targets', 'head pose at start')]
+    used += [(DEBUG_TOPIC.format(eye=eye), TOPIC['eye_compressed'].type, 'out',
               'annotated, only while subscribed') for eye in EYES]
     return used
 
@@ -103,19 +108,23 @@ class KickBlueBall(Node):
                       camera_info, at that camera_info's resolution
     last_command      (left, right) wheel speeds of the latest twist, m/s
     last_tick         node time (s) of the latest control tick, None before the first
-    detector, behaviour, config (ControllerParams), names (RobotTopics), pub_twist
+    robot             the robot it drives: the last part of its namespace
+    detector, behaviour, config (ControllerParams), pub_twist
+
+    robot (a name) picks the namespace, as --robot does; a remapped __ns wins.
     """
 
-    def __init__(self, *, context=None, parameter_overrides=None, save_debug=None):
-        super().__init__(NODE_NAME, context=context,
+    def __init__(self, *, context=None, parameter_overrides=None, save_debug=None, robot=None):
+        super().__init__(NODE_NAME, context=context, namespace=robot_namespace(robot),
                          parameter_overrides=list(parameter_overrides or []))
+        self.robot = robot_of_namespace(self.get_namespace())
         self.config = params.declare(self, ControllerParams)
         self.detector = BallDetector(params.declare(self, DetectionParams))
         self._behaviour_params = params.declare(self, BehaviourParams)
         # The topics and the timer are made once; every tunable applies at run time.
         self._live = params.LiveParams(
             self, (self.config, self.detector.params, self._behaviour_params), self._apply,
-            fixed=('robot_name', 'tick'))
+            fixed=('tick',))
         self.save_debug = save_debug
         self.frames_processed = 0
         self.rejected = Counter()
@@ -123,6 +132,7 @@ class KickBlueBall(Node):
         self.state = STARTUP
         self._warn = Throttled(self.get_logger().warning, WARN_EVERY_S)
         guard_clock(self, self._warn)
+        self._clock_watch = ClockWatch(self)
         self.balls = [Latest() for _ in EYES]
         self.cliff = Latest()
         self.cameras = list(DEFAULT_CAMERAS)
@@ -130,17 +140,20 @@ class KickBlueBall(Node):
         self._frame_cameras = list(DEFAULT_CAMERAS)
         self._restart()
 
-        self.names = names = RobotTopics(self.config.robot_name)
+        names, eyes = RobotTopics(), profile(EYE_QOS)
         for eye, cam in enumerate(EYES):
             self.create_subscription(CompressedImage, names.eye_compressed(cam),
-                                     partial(self._on_image, eye), SENSOR_QOS)
+                                     partial(self._on_image, eye), eyes)
             self.create_subscription(CameraInfo, names.camera_info(cam),
-                                     partial(self._on_camera_info, eye), SENSOR_QOS)
-        self.create_subscription(Float32MultiArray, names.cliff, self._on_cliff, SENSOR_QOS)
-        self.pub_twist = self.create_publisher(TwistStamped, names.cmd_vel, 10)
-        self.pub_joints = self.create_publisher(JointState, names.kinematic_targets, 10)
-        self.pub_debug = [self.create_publisher(CompressedImage, names.controller_debug(cam),
-                                                DEBUG_QOS)
+                                     partial(self._on_camera_info, eye), eyes)
+        self.create_subscription(Float32MultiArray, names.cliff, self._on_cliff,
+                                 profile(TOPIC['cliff'].qos))
+        self.pub_twist = self.create_publisher(TwistStamped, names.cmd_vel,
+                                               profile(TOPIC['cmd_vel'].qos))
+        self.pub_joints = self.create_publisher(JointState, names.kinematic_targets,
+                                                profile(TOPIC['kinematic_targets'].qos))
+        self.pub_debug = [self.create_publisher(CompressedImage, DEBUG_TOPIC.format(eye=cam),
+                                                eyes)
                           for cam in EYES]
         self.timer = self.create_timer(self.config.tick, self._on_tick)
         # A restarted simulator sends /clock backwards; rcl versions differ in
@@ -149,8 +162,9 @@ class KickBlueBall(Node):
             JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-1),
                           on_clock_change=False),
             post_callback=lambda jump: self.timer.reset())
-        self.get_logger().info("mode '%s', robot '%s', tick %g s"
-                               % (self.config.mode, names.name, self.config.tick))
+        self.get_logger().info("mode '%s', robot '%s' (topics under %s), tick %g s"
+                               % (self.config.mode, self.robot, self.get_namespace(),
+                                  self.config.tick))
         # On sim time nothing ticks until /clock arrives: say once what we wait for.
         self._no_clock_timer = self.create_timer(
             NO_CLOCK_NOTICE_S, self._on_no_clock, clock=Clock(clock_type=ClockType.STEADY_TIME))
@@ -272,9 +286,12 @@ class KickBlueBall(Node):
     def _on_tick(self):
         now = self._seconds()
         if self._last_tick is not None and now < self._last_tick:
-            self.get_logger().warning('clock went back %.3f s (simulator restart?): starting over'
-                                      % (self._last_tick - now))
-            self._restart()
+            # Two simulators on one domain send /clock back and forth: the watch says so
+            # once; starting over on every jump would only flood the log.
+            if not self._clock_watch.check():
+                self.get_logger().warning('clock went back %.3f s (simulator restart?): '
+                                          'starting over' % (self._last_tick - now))
+                self._restart()
         self._last_tick = now
         if self._started is None:
             self._started = now
@@ -299,8 +316,9 @@ class KickBlueBall(Node):
     def _check_silence(self, now):
         """Warn about inputs that stopped (or never started) arriving."""
         stale = self.config.stale_s
-        watched = [(self.names.eye_compressed(eye), latest)
-                   for eye, latest in zip(EYES, self.balls)] + [(self.names.cliff, self.cliff)]
+        names = RobotTopics(self.robot)
+        watched = [(names.eye_compressed(eye), latest)
+                   for eye, latest in zip(EYES, self.balls)] + [(names.cliff, self.cliff)]
         for name, latest in watched:
             since = latest.stamp if latest.stamp is not None else self._started
             if now - since > stale:
@@ -318,7 +336,7 @@ class KickBlueBall(Node):
         linear, angular = wheel_speed2cmd_vel((left, right))
         msg = TwistStamped()
         msg.header.stamp = self.get_clock().now().to_msg()
-        msg.header.frame_id = 'base_link'
+        msg.header.frame_id = frame_id(self.robot, 'base_link')
         msg.twist.linear.x = float(linear)
         msg.twist.angular.z = float(angular)
         self.pub_twist.publish(msg)
@@ -337,25 +355,28 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, '%s: error: %s (try --help)\n' % (self.prog, message))
 
 
-def _topic_lines(robot_name):
-    """The --help topic table; a bad robot name in its place (starting then fails on it)."""
-    try:
-        used = topics(robot_name)
-    except ValueError as err:
-        return ['topics: %s' % err]
+def _topic_lines():
+    """The --help topic table, relative to the robot's namespace."""
+    used = topics()
     width = max(len(name) for name, _, _, _ in used)
-    return ['topics (robot_name %s):' % robot_name] + [
+    return ["topics, relative to the robot's namespace (/%s/... by default):"
+            % DEFAULT_ROBOT_NAME] + [
         '  %-3s %-*s  %s, %s' % (way, width, name, kind, what) for name, kind, way, what in used]
 
 
 def build_parser():
-    lines = params.help_lines(*GROUPS) + [''] + _topic_lines(default_robot_name())
-    lines += ['', 'With --ros-args -p use_sim_time:=true the control tick follows %s.' % CLOCK]
+    lines = params.help_lines(*GROUPS) + [''] + _topic_lines()
+    lines += ['', 'With --ros-args -p use_sim_time:=true the control tick follows %s.' % CLOCK,
+              'The robot: --ros-args -r __ns:=/NAME, as for any ROS 2 node; --robot NAME and '
+              '$MIRO_ROBOT_NAME are shorthands (the node is then /NAME/%s).' % NODE_NAME]
     parser = _Parser(
         prog='kick_blue_ball',
         description='MiRo-E kick_blue_ball controller for ROS 2: finds the blue ball with '
                     'both eyes and kicks it. Ctrl+C stops it with a zero twist.',
         epilog='\n'.join(lines), formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('--robot', metavar='NAME',
+                        help='the robot to drive (its namespace); default $MIRO_ROBOT_NAME, '
+                             'else miro; a remapped __ns wins')
     parser.add_argument('--save-debug', metavar='DIR',
                         help='write every annotated camera frame to DIR as JPEG')
     return parser
@@ -383,7 +404,7 @@ def main(argv=None):
     stop = StopRequest()
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-        node = KickBlueBall(save_debug=options.save_debug)
+        node = KickBlueBall(save_debug=options.save_debug, robot=options.robot)
     except Exception as err:  # a bad parameter or topic name: say so in one line
         rclpy.try_shutdown()
         _fail(parser, err)

@@ -6,14 +6,10 @@ from miro_ball.common.params import check_ranges
 from miro_ball.controller.behaviour import BehaviourParams, MODES
 from miro_ball.controller.detection import DetectionParams
 from miro_ball.miro.constants import LIFT_RAD_CALIB, PLATFORM_TICK_S
-from miro_ball.miro.interface import check_name, default_robot_name
 
 
 @dataclass(frozen=True)
 class ControllerParams:
-    robot_name: str = field(
-        default_factory=default_robot_name,
-        metadata={'help': 'topic prefix; default $MIRO_ROBOT_NAME, else miro'})
     mode: str = field(default='improved', metadata={'help': ' or '.join(MODES)})
     tick: float = field(default=PLATFORM_TICK_S,
                         metadata={'help': 'control period, s (node clock)', 'range': (0.001, 1.0)})
@@ -32,7 +28,6 @@ class ControllerParams:
     def __post_init__(self):
         if self.mode not in MODES:
             raise ValueError("mode must be one of %s, not '%s'" % (', '.join(MODES), self.mode))
-        check_name(self.robot_name, 'robot_name')
         check_ranges(self)
 
 

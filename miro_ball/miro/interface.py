@@ -146,7 +146,8 @@ def robot_namespace(given=None, environ=None):
 
 def robot_of_namespace(namespace):
     """The robot a node serves, from its fully qualified namespace: its last part."""
-    return check_name(namespace.rstrip('/').rsplit('/', 1)[-1], f'namespace {namespace!r}:')
+    return check_name(namespace.rstrip('/').rsplit('/', 1)[-1],
+                      f'the namespace {namespace!r}: robot name')
 
 
 def frame_id(robot, frame):
