@@ -6,7 +6,6 @@ import re
 import signal
 import subprocess
 import sys
-import time
 
 import cv2
 import pytest
@@ -169,32 +168,47 @@ def test_every_client_has_help_and_refuses_bad_input(name):
     assert bad.returncode == 2 and 'error:' in bad.stderr and 'Traceback' not in bad.stderr
 
 
-def test_minimal_as_a_command_with_the_robot_from_the_environment(paused_sim, executor):
-    env = dict(isolated_env(int(os.environ['ROS_DOMAIN_ID'])), MIRO_ROBOT_NAME=T.name)
-    proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.examples.client_minimal'],
-                            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True)
+@pytest.mark.parametrize('module,args,env,said', [
+    ('client_minimal', [], {'MIRO_ROBOT_NAME': T.name}, 'battery: 4.80 V'),
+    ('client_follower', ['--path', 'line', '--size', '0.1', '--ros-args', '-r',
+                         f'__ns:=/{T.name}'], {'MIRO_ROBOT_NAME': T.name + 'x'}, '0 to go'),
+])
+def test_a_client_as_a_command_drives_its_robot_and_exits_cleanly(module, args, env, said,
+                                                                  paused_sim, executor):
+    """The robot from the environment, or from a remapped namespace (which wins); a normal
+    exit prints no traceback (client_follower printed Executor.__del__'s every time)."""
+    proc = subprocess.Popen([sys.executable, '-m', f'miro_ball.examples.{module}', *args],
+                            env=dict(isolated_env(int(os.environ['ROS_DOMAIN_ID'])), **env),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         interface = paused_sim.robots[T.name]
-        assert spin_until(executor, lambda: interface.pub_battery.get_subscription_count(),
-                          timeout_s=60.0)
+        assert spin_until(executor, lambda: interface.pub_odom.get_subscription_count()
+                          + interface.pub_battery.get_subscription_count(), timeout_s=60.0)
         advance_until(paused_sim, executor, lambda: proc.poll() is not None)
         output, _ = proc.communicate(timeout=10)
     finally:
         kill_if_running(proc)
     assert proc.returncode == 0, output
-    assert 'battery: 4.80 V' in output and 'Traceback' not in output
-    assert math.hypot(*robot(paused_sim).pose()[:2]) > 0.1
+    assert said in output and 'Traceback' not in output and 'InvalidHandle' not in output
+    assert math.hypot(*robot(paused_sim).pose()[:2]) > 0.05
 
 
-def test_a_client_waiting_for_the_simulator_ends_on_ctrl_c():
+def test_a_client_waiting_for_the_simulator_says_what_for_and_ends_on_ctrl_c():
+    domain = int(os.environ['ROS_DOMAIN_ID'])
     proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.examples.client_show', 'odom'],
-                            env=isolated_env(int(os.environ['ROS_DOMAIN_ID'])),
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                            env=isolated_env(domain), stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    lines = []
     try:
-        time.sleep(2.0)  # past rclpy.init: the client's own handling is what is tested
+        for line in proc.stdout:  # the notice comes after 2 s of wall time with nothing
+            lines.append(line)
+            if 'waiting for robot' in line:
+                break
         proc.send_signal(signal.SIGINT)
         output, _ = proc.communicate(timeout=10)
     finally:
         kill_if_running(proc)
+    notice = lines[-1]
+    assert f'/{T.name}/sensors/odom' in notice and f'ROS domain {domain}' in notice, lines
+    assert f"robot '{T.name}'" in notice
     assert proc.returncode == 0 and 'Traceback' not in output, output

@@ -1,15 +1,20 @@
 """What the example clients share: the command line, the node, and running it.
 
 A client is a Node on simulated time (the simulator's /clock) that talks to one
-robot, named like the MDK does: $MIRO_ROBOT_NAME, else 'miro' (or --robot).
-When it has done its job it raises SystemExit; Ctrl+C or SIGTERM end it too,
-without a traceback, and its stop() (e.g. a zero twist) runs on the way out.
+robot. It lives in the robot's namespace and uses relative names, so
+``--ros-args -r __ns:=/miro02`` picks the robot as for any ROS 2 node; --robot and
+$MIRO_ROBOT_NAME (as in the MDK) are shorthands. When it has done its job it
+raises SystemExit; Ctrl+C or SIGTERM end it too, without a traceback, and its
+stop() (e.g. a zero twist) runs on the way out. If nothing arrives for 2 s of
+wall time it says once what it waits for.
 """
 import argparse
 import math
 import sys
 
 import rclpy
+from geometry_msgs.msg import TwistStamped
+from rclpy.clock import Clock, ClockType
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -17,21 +22,27 @@ from rclpy.signals import SignalHandlerOptions
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_guard import guard_clock
+from miro_ball.common.clock_watch import ClockWatch
+from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
-from miro_ball.miro.interface import DEFAULT_ROBOT_NAME, RobotTopics, check_name, \
-    default_robot_name
+from miro_ball.miro.interface import (CONTROL_QOS, DEFAULT_ROBOT_NAME, frame_id, robot_name,
+                                      robot_namespace, robot_of_namespace, RobotTopics,
+                                      SENSOR_QOS)
+
+SILENCE_NOTICE_S = 2.0  # wall seconds
 
 
 def make_parser(prog, doc):
     """An argument parser with --robot, described by the client's docstring."""
     parser = argparse.ArgumentParser(
         prog=prog, description=doc, formatter_class=argparse.RawDescriptionHelpFormatter,
-        epilog='MIRO_ROBOT_NAME sets the robot, as in the MDK. Start the simulator first '
+        epilog='The robot is the node\'s namespace: --ros-args -r __ns:=/NAME, or --robot NAME, '
+               'or MIRO_ROBOT_NAME as in the MDK. Start the simulator first '
                '(python -m miro_sim_bullet).')
-    parser.add_argument('--robot', default=default_robot_name(),
-                        help='robot name, i.e. topic prefix (default: $MIRO_ROBOT_NAME or '
-                             f'{DEFAULT_ROBOT_NAME}: %(default)s)')
+    parser.add_argument('--robot', metavar='NAME',
+                        help='the robot (its namespace); default $MIRO_ROBOT_NAME, else '
+                             f'{DEFAULT_ROBOT_NAME}; a remapped __ns wins')
     return parser
 
 
@@ -55,21 +66,55 @@ def parse(parser, argv):
     try:
         options = parser.parse_args(user_args(argv, parser.prog))
         if hasattr(options, 'robot'):  # not every client drives a robot (ball_mover)
-            check_name(options.robot)
+            robot_name(options.robot)
     except ValueError as err:  # a bad robot name, or rclpy's malformed --ros-args
         parser.error(str(err))
     return options
 
 
 class Client(Node):
-    """A node on simulated time with the topics of robot ``options.robot`` in ``self.topics``."""
+    """A node on simulated time in its robot's namespace: ``self.robot`` is the robot's name,
+    ``self.topics`` its topic names relative to the namespace."""
 
     def __init__(self, name, options, context=None):
-        super().__init__(name, context=context,
+        super().__init__(name, context=context, namespace=robot_namespace(options.robot),
                          parameter_overrides=[Parameter('use_sim_time', value=True)])
         self.options = options
-        self.topics = RobotTopics(options.robot)
+        self.robot = robot_of_namespace(self.get_namespace())
+        self.topics = RobotTopics()
         guard_clock(self, Throttled(self.get_logger().warning))
+        self._clock_watch = ClockWatch(self)
+        self._heard = False
+        self._silence_timer = self.create_timer(SILENCE_NOTICE_S, self._on_silence,
+                                                clock=Clock(clock_type=ClockType.STEADY_TIME))
+
+    def subscribe(self, msg_type, topic, callback, qos=SENSOR_QOS):
+        """Subscribe to one of the robot's topics (relative name, the interface's QoS)."""
+        def heard(msg):
+            self._heard = True
+            callback(msg)
+        return self.create_subscription(msg_type, topic, heard, profile(qos))
+
+    def advertise(self, msg_type, topic, qos=CONTROL_QOS):
+        return self.create_publisher(msg_type, topic, profile(qos))
+
+    def _on_silence(self):
+        self._silence_timer.cancel()
+        if not self._heard:
+            topics = ', '.join(sub.topic_name for sub in self.subscriptions
+                               if sub.topic_name != '/clock')
+            self.get_logger().warning(
+                f'nothing on {topics} after {SILENCE_NOTICE_S:g} s: waiting for robot '
+                f'{self.robot!r} on ROS domain {self.context.get_domain_id()} (is the '
+                'simulator running, with the same ROS_DOMAIN_ID and robot name?)')
+
+    def twist(self, linear, angular):
+        """A TwistStamped for control/cmd_vel, stamped now in the robot's body frame."""
+        msg = TwistStamped()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = frame_id(self.robot, 'base_link')
+        msg.twist.linear.x, msg.twist.angular.z = float(linear), float(angular)
+        return msg
 
     def now(self):
         """Simulated seconds (0 until the first /clock)."""
@@ -104,6 +149,10 @@ def run(client_class, parser, argv=None):
     finally:
         if rclpy.ok():
             node.stop()
+        # Shut the executor down while its handles are valid: left to the garbage
+        # collector after rclpy's shutdown, Executor.__del__ printed an InvalidHandle
+        # traceback on every normal exit.
+        executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown()
     return code

@@ -57,9 +57,9 @@ def in_frame(origin, x, y):
 class Follower(Client):
     def __init__(self, options, context=None):
         super().__init__('client_follower', options, context)
-        self.cmd_vel = self.create_publisher(TwistStamped, self.topics.cmd_vel, 10)
-        self.flags = self.create_publisher(UInt32, self.topics.control_flags, 10)
-        self.create_subscription(Odometry, self.topics.odom, self.on_odom, 10)
+        self.cmd_vel = self.advertise(TwistStamped, self.topics.cmd_vel)
+        self.flags = self.advertise(UInt32, self.topics.control_flags)
+        self.subscribe(Odometry, self.topics.odom, self.on_odom)
         self.pose = None  # (x, y, heading) from odometry
         self.goals = None  # corners still to visit, in odometry coordinates
         self.create_timer(TICK, self.tick)
@@ -69,10 +69,7 @@ class Follower(Client):
         self.pose = (p.x, p.y, heading(msg.pose.pose.orientation))
 
     def drive(self, linear, angular):
-        msg = TwistStamped()
-        msg.header.stamp = self.get_clock().now().to_msg()
-        msg.twist.linear.x, msg.twist.angular.z = linear, angular
-        self.cmd_vel.publish(msg)
+        self.cmd_vel.publish(self.twist(linear, angular))
 
     def tick(self):
         if self.pose is None:

@@ -19,8 +19,8 @@ TICK = 0.02  # s: MiRo's 50 Hz platform tick
 class Minimal(Client):
     def __init__(self, options, context=None):
         super().__init__('client_minimal', options, context)
-        self.cmd_vel = self.create_publisher(TwistStamped, self.topics.cmd_vel, 10)
-        self.create_subscription(BatteryState, self.topics.battery, self.on_battery, 10)
+        self.cmd_vel = self.advertise(TwistStamped, self.topics.cmd_vel)
+        self.subscribe(BatteryState, self.topics.battery, self.on_battery)
         self.voltage = None
         self.start = None
         self.create_timer(TICK, self.tick)
@@ -31,11 +31,7 @@ class Minimal(Client):
         self.voltage = msg.voltage
 
     def drive(self, linear, angular):
-        msg = TwistStamped()
-        msg.header.stamp = self.get_clock().now().to_msg()
-        msg.twist.linear.x = linear
-        msg.twist.angular.z = angular
-        self.cmd_vel.publish(msg)
+        self.cmd_vel.publish(self.twist(linear, angular))
 
     def tick(self):
         if self.now() == 0.0:

@@ -65,7 +65,7 @@ class Show(Client):
     def __init__(self, options, context=None):
         super().__init__('client_show', options, context)
         msg_type, topic, self.line = SIGNALS[options.signal]
-        self.create_subscription(msg_type, topic(self.topics), self.on_message, 10)
+        self.subscribe(msg_type, topic(self.topics), self.on_message)
         self.shown = 0
 
     def on_message(self, msg):

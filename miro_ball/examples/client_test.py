@@ -70,12 +70,12 @@ class Bench(Client):
     def __init__(self, options, context=None):
         super().__init__('client_test', options, context)
         t = self.topics
-        self.pubs = {'cmd_vel': self.create_publisher(TwistStamped, t.cmd_vel, 10),
-                     'kin': self.create_publisher(JointState, t.kinematic_targets, 10),
-                     'cos': self.create_publisher(Float32MultiArray, t.cosmetic_joints, 10),
-                     'illum': self.create_publisher(UInt32MultiArray, t.illum, 10)}
-        self.create_subscription(Odometry, t.odom, self.on_odom, 10)
-        self.create_subscription(JointState, t.kinematic_joints, self.on_joints, 10)
+        self.pubs = {'cmd_vel': self.advertise(TwistStamped, t.cmd_vel),
+                     'kin': self.advertise(JointState, t.kinematic_targets),
+                     'cos': self.advertise(Float32MultiArray, t.cosmetic_joints),
+                     'illum': self.advertise(UInt32MultiArray, t.illum)}
+        self.subscribe(Odometry, t.odom, self.on_odom)
+        self.subscribe(JointState, t.kinematic_joints, self.on_joints)
         self.queue = list(TESTS) if options.test == 'workout' else [options.test]
         self.pose = None  # (x, y, heading)
         self.joints = None
@@ -94,9 +94,7 @@ class Bench(Client):
     def send(self, commands):
         for kind, value in commands.items():
             if kind == 'cmd_vel':
-                msg = TwistStamped()
-                msg.header.stamp = self.get_clock().now().to_msg()
-                msg.twist.linear.x, msg.twist.angular.z = value
+                msg = self.twist(*value)
             elif kind == 'kin':
                 msg = JointState(name=list(JOINT_NAMES), position=value)
                 msg.header.stamp = self.get_clock().now().to_msg()

@@ -19,7 +19,7 @@ from sensor_msgs.msg import CompressedImage
 from miro_ball.common.jpeg import ImageRejected, decode_jpeg
 from miro_ball.common.throttle import Throttled
 from miro_ball.examples._client import Client, make_parser, run
-from miro_ball.miro.interface import EYES
+from miro_ball.miro.interface import EYE_QOS, EYES
 
 VIDEO_FPS = 15.0
 
@@ -34,8 +34,8 @@ class Video(Client):
         self.pairs = 0
         self.warn = Throttled(self.get_logger().warning)
         for eye in EYES:
-            self.create_subscription(CompressedImage, self.topics.eye_compressed(eye),
-                                     lambda msg, eye=eye: self.on_image(eye, msg), 2)
+            self.subscribe(CompressedImage, self.topics.eye_compressed(eye),
+                           lambda msg, eye=eye: self.on_image(eye, msg), EYE_QOS)
 
     def on_image(self, eye, msg):
         try:
