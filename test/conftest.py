@@ -45,17 +45,18 @@ def executor(ros_context):
 
 @pytest.fixture
 def make_sim(ros_context, executor):
-    """make_sim(name=value, ...): a simulator node in-process, paused (the test steps it,
-    rostools.advance_ticks), with those parameters; destroyed after the test."""
+    """make_sim(name=value, ..., robot=None): a simulator node in-process, paused (the test
+    steps it, rostools.advance_ticks), with those parameters and the world's unnamed robot
+    named robot (as --robot does); destroyed after the test."""
     from rclpy.parameter import Parameter
 
     from miro_sim_bullet.ros.node import SimNode
 
     made = []
 
-    def make(**params):
+    def make(robot=None, **params):
         params = {'paused': True, 'world': 'miro', **params}
-        made.append(SimNode(context=ros_context, parameter_overrides=[
+        made.append(SimNode(context=ros_context, robot=robot, parameter_overrides=[
             Parameter(name, value=value) for name, value in params.items()]))
         executor.add_node(made[-1])
         return made[-1]

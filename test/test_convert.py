@@ -26,9 +26,9 @@ def test_stamps_round_trip_to_the_nanosecond(seconds):
 
 
 def test_odometry_is_the_foot_pose_with_a_yaw_quaternion():
-    msg = convert.odometry(SENSORS, convert.stamp(1.5))
+    msg = convert.odometry(SENSORS, convert.stamp(1.5), 'miro02')
     q = msg.pose.pose.orientation
-    assert (msg.header.frame_id, msg.child_frame_id) == ('odom', 'base_link')
+    assert (msg.header.frame_id, msg.child_frame_id) == ('miro02/odom', 'miro02/base_link')
     assert (msg.pose.pose.position.x, msg.pose.pose.position.y) == (0.3, -0.2)
     assert 2 * math.atan2(q.z, q.w) == pytest.approx(2.5)
     assert (msg.twist.twist.linear.x, msg.twist.twist.angular.z) == (0.2, -0.5)
@@ -36,19 +36,19 @@ def test_odometry_is_the_foot_pose_with_a_yaw_quaternion():
 
 def test_sensor_messages_carry_the_readings():
     when = convert.stamp(1.5)
-    joints = convert.kinematic_joints(SENSORS, when)
+    joints = convert.kinematic_joints(SENSORS, when, 'miro')
     assert list(joints.name) == ['tilt', 'lift', 'yaw', 'pitch']
     assert list(joints.position) == pytest.approx(SENSORS.kinematic_positions)
     assert list(convert.floats(SENSORS.cliff).data) == pytest.approx([1.0, 0.4])
-    sonar = convert.sonar(SENSORS, when)
+    sonar = convert.sonar(SENSORS, when, 'miro')
     assert sonar.range == math.inf and (sonar.min_range, sonar.max_range) == (0.03, 1.0)
-    imu = convert.imu(SENSORS.imu_body, when, 'imu_body')
+    imu = convert.imu(SENSORS.imu_body, when, 'miro/imu_body')
     assert imu.linear_acceleration.z == pytest.approx(9.8) and imu.angular_velocity.z == 0.1
 
 
 def test_camera_info_matches_the_intrinsics():
     k = Intrinsics.from_hfov(640, 360, 90.0)
-    info = convert.camera_info(k, convert.stamp(0.0), 'caml_optical_frame')
+    info = convert.camera_info(k, convert.stamp(0.0), 'miro/caml_optical')
     again = Intrinsics.from_k(info.width, info.height, info.k)
     assert (again.fx, again.cx, again.cy) == pytest.approx((320.0, 319.5, 179.5))
     assert list(info.p) == [k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0]
@@ -57,7 +57,7 @@ def test_camera_info_matches_the_intrinsics():
 def test_jpeg_keeps_the_ball_blue():
     rgb = np.zeros((36, 64, 3), np.uint8)
     rgb[:, :, 2] = 255  # pure blue in RGB
-    msg = convert.jpeg(rgb, convert.stamp(0.0), 'caml_optical_frame', 90)
+    msg = convert.jpeg(rgb, convert.stamp(0.0), 'miro/caml_optical', 90)
     b, g, r = cv2.imdecode(np.frombuffer(bytes(msg.data), np.uint8), cv2.IMREAD_COLOR)[10, 10]
     assert b > 240 and g < 15 and r < 15
 

@@ -9,16 +9,17 @@ import sys
 import cv2
 import numpy as np
 import pytest
-from geometry_msgs.msg import TwistStamped
+from geometry_msgs.msg import PointStamped, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import CameraInfo, CompressedImage, Image, JointState
+from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState, \
+    Range
 from std_msgs.msg import Float32MultiArray, UInt16MultiArray, UInt32, UInt32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR
-from miro_ball.miro.interface import RobotTopics, SimTopics, default_robot_name
+from miro_ball.miro.interface import EYES, RobotTopics, SimTopics, default_robot_name, robot_name
 from miro_sim_bullet.physics.world import PHYSICS_DT_S
 from rostools import Probe, drain, spin_until
 
@@ -62,11 +63,41 @@ def test_sensors_and_clock_follow_simulated_time(sim_node, probe, executor):
     times = [seconds(m.clock) for m in clock]
     assert times == sorted(times) and times[-1] == pytest.approx(1.0)
     assert seconds(odom[-1].header.stamp) == pytest.approx(1.0)
-    assert odom[-1].header.frame_id == 'odom' and odom[-1].child_frame_id == 'base_link'
     assert flags[-1].data & UPSTREAM_FLAG_SIMULATOR
     assert list(cliff[-1].data) == [1.0, 1.0]
     assert list(kin[-1].name) == ['tilt', 'lift', 'yaw', 'pitch']
     assert kin[-1].position[1] == pytest.approx(math.radians(34), abs=0.01)
+
+
+@pytest.mark.parametrize('given', [None, 'miro02'])
+def test_every_stamped_message_names_its_robots_frame(make_sim, probe, executor, given):
+    """Frame ids carry the robot (<robot>/odom, ...), for the default robot and a named one;
+    ground truth is in the simulator's 'world' frame."""
+    name = robot_name(given)
+    node = make_sim(robot=given)
+    t = RobotTopics(name)
+    expected = {  # topic: (type, header frame id)
+        t.odom: (Odometry, f'{name}/odom'),
+        t.kinematic_joints: (JointState, f'{name}/base_link'),
+        t.battery: (BatteryState, f'{name}/base_link'),
+        t.sonar: (Range, f'{name}/sonar'),
+        **{t.imu(part): (Imu, f'{name}/imu_{part}') for part in ('body', 'head')},
+        **{topic: (kind, f'{name}/{eye}_optical') for eye in EYES for kind, topic in (
+            (CompressedImage, t.eye_compressed(eye)), (Image, t.eye_raw(eye)),
+            (CameraInfo, t.camera_info(eye)))},
+        SIM.object_pose(name): (PoseStamped, 'world'),
+        SIM.ball: (PointStamped, 'world'),
+    }
+    heard = {topic: probe.watch(kind, topic) for topic, (kind, _) in expected.items()}
+    eyes = node.robots[name].pub_eyes
+    spin_until(executor, lambda: all(p.get_subscription_count() for p in
+                                     (*eyes['caml'], *eyes['camr'], node.robots[name].pub_odom)))
+    run(node, executor, 0.1)
+    assert spin_until(executor, lambda: all(heard.values()))
+    assert {topic: {m.header.frame_id for m in messages} for topic, messages in heard.items()} \
+        == {topic: {frame} for topic, (_, frame) in expected.items()}
+    odom = heard[t.odom]
+    assert {m.child_frame_id for m in odom} == {f'{name}/base_link'}
 
 
 def test_cmd_vel_drives_the_robot(sim_node, probe, executor):
@@ -174,6 +205,7 @@ def test_cameras_render_only_while_subscribed(sim_node, executor):
     (['--world', 'nowhere'], "unknown world 'nowhere'"),
     (['--ros-args', '-p', 'frame_width:=1000'], 'frame size 1000x360 is not one of'),
     (['--ros-args', '-p', 'camera_rate:=abc'], "parameter 'camera_rate' must be a number"),
+    (['--robot', '1x'], "--robot '1x' must be a letter"),
 ])
 def test_bad_start_options_fail_in_one_line(args, message):
     out = subprocess.run([sys.executable, '-m', 'miro_sim_bullet', *args], capture_output=True,

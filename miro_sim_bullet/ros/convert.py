@@ -6,15 +6,15 @@ import numpy as np
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import PointStamped, Pose2D, PoseStamped
 from nav_msgs.msg import Odometry
-from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState, \
     Range
 from std_msgs.msg import Float32MultiArray
 
 from miro_ball.miro.constants import JOINT_NAMES
+from miro_ball.miro.interface import frame_id
 from miro_sim_bullet.physics import model as rb
 
-WORLD_FRAME = 'world'
+WORLD_FRAME = 'world'  # the simulator's own frame: ground truth, no robot's
 MAX_COORDINATE_M = 1000.0  # where set_pose may put things: far beyond any bundled world
 
 
@@ -23,28 +23,25 @@ def stamp(seconds):
     return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
 
 
-def clock(seconds):
-    return Clock(clock=stamp(seconds))
-
-
 def _yaw_quaternion(q, yaw):
     q.z, q.w = math.sin(yaw / 2), math.cos(yaw / 2)
     return q
 
 
-def kinematic_joints(s, when):
+def kinematic_joints(s, when, robot):
     msg = JointState(name=list(JOINT_NAMES), position=list(s.kinematic_positions),
                      velocity=list(s.kinematic_velocities))
-    msg.header.stamp = when
+    msg.header.stamp, msg.header.frame_id = when, frame_id(robot, 'base_link')
     return msg
 
 
-def odometry(s, when):
-    """Ground truth as odometry: odom -> base_link, the pose of the FOOT frame."""
+def odometry(s, when, robot):
+    """Ground truth as odometry: <robot>/odom -> <robot>/base_link, the pose of the FOOT
+    frame."""
     x, y, yaw = s.pose
     forward, turn = s.velocity
-    msg = Odometry(child_frame_id='base_link')
-    msg.header.stamp, msg.header.frame_id = when, 'odom'
+    msg = Odometry(child_frame_id=frame_id(robot, 'base_link'))
+    msg.header.stamp, msg.header.frame_id = when, frame_id(robot, 'odom')
     msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
     _yaw_quaternion(msg.pose.pose.orientation, yaw)
     msg.twist.twist.linear.x, msg.twist.twist.angular.z = forward, turn
@@ -60,11 +57,11 @@ def floats(values):
     return Float32MultiArray(data=[float(v) for v in values])
 
 
-def sonar(s, when):
+def sonar(s, when, robot):
     lo, hi = rb.SONAR_RANGE
     msg = Range(radiation_type=Range.ULTRASOUND, field_of_view=2 * rb.SONAR_HALF_CONE,
                 min_range=lo, max_range=hi, range=s.sonar)
-    msg.header.stamp, msg.header.frame_id = when, 'sonar'
+    msg.header.stamp, msg.header.frame_id = when, frame_id(robot, 'sonar')
     return msg
 
 
@@ -79,9 +76,9 @@ def imu(reading, when, frame_id):
     return msg
 
 
-def battery(s, when):
+def battery(s, when, robot):
     msg = BatteryState(voltage=s.battery_voltage, present=True, percentage=1.0)
-    msg.header.stamp = when
+    msg.header.stamp, msg.header.frame_id = when, frame_id(robot, 'base_link')
     return msg
 
 

@@ -25,10 +25,11 @@ from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.params import declare, help_lines, LiveParams
+from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera import Intrinsics
-from miro_ball.miro.interface import CLOCK, SIM_NODE_NAME, SimTopics
+from miro_ball.miro.interface import CLOCK, CLOCK_QOS, robot_name, SIM_NODE_NAME, SimTopics
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.overhead import overhead_camera
 from miro_sim_bullet.render.renderer import RendererUnavailable
@@ -41,22 +42,27 @@ from miro_sim_bullet.scene.world_file import WorldError, bundled_worlds
 # ROS's default keeps 10 requests: a burst of 200 clients lost 190 answers.
 SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
-FIXED_PARAMS = ('robot_name', 'world', 'physics_dt', 'frame_width', 'frame_height',
+FIXED_PARAMS = ('world', 'physics_dt', 'frame_width', 'frame_height',
                 'camera_rate', 'hfov_deg', 'renderer', 'eye_workers')
 
 
 class SimNode(Node):
-    """MiRo-E robots in PyBullet behind MiRo's topics; see README for the topic table."""
+    """MiRo-E robots in PyBullet behind MiRo's topics; see README for the topic table.
 
-    def __init__(self, *, context=None, parameter_overrides=None):
+    robot names the world's robot when its file names none, as --robot does (default
+    $MIRO_ROBOT_NAME, else 'miro'); ValueError in one line if it can not be a ROS name.
+    """
+
+    def __init__(self, *, context=None, parameter_overrides=None, robot=None):
         super().__init__(SIM_NODE_NAME, context=context,
                          parameter_overrides=parameter_overrides)
+        unnamed_robot = robot_name(robot)
         self.params = p = declare(self, SimParams)
         self._live = LiveParams(self, (p,), self._apply, fixed=FIXED_PARAMS)
         self.warn = Throttled(self.get_logger().warning)
         self.sim = SimWorld(p.world, physics_dt=p.physics_dt, renderer=p.renderer,
                             log=self.get_logger().info, eye_workers=p.eye_workers,
-                            robot_name=p.robot_name)
+                            robot_name=unnamed_robot)
         self.intrinsics = Intrinsics.from_hfov(p.frame_width, p.frame_height, p.hfov_deg)
         self.overhead = overhead_camera(self.sim.description)
         self.paused = p.paused
@@ -88,7 +94,7 @@ class SimNode(Node):
 
     def _make_sim_interface(self):
         t = SimTopics()
-        self.pub_clock = self.create_publisher(ClockMsg, CLOCK, 10)
+        self.pub_clock = self.create_publisher(ClockMsg, CLOCK, profile(CLOCK_QOS))
         self.pub_ball = self.create_publisher(PointStamped, t.ball, 10)
         names = [*self.sim.objects, *self.sim.robots]
         self.pub_objects = {name: self.create_publisher(PoseStamped, t.object_pose(name), 10)
@@ -238,6 +244,9 @@ def parse_args(argv):
         + f'\n\nbundled worlds: {", ".join(bundled_worlds())}')
     parser.add_argument('--world', help='bundled world name or path to a .toml file '
                         '(same as -p world:=...)')
+    parser.add_argument('--robot', metavar='NAME',
+                        help="name of the world's robot when its file names none (its topics "
+                             'are /NAME/...); default $MIRO_ROBOT_NAME, else miro')
     return parser.parse_args(argv)
 
 
@@ -258,7 +267,7 @@ def main(argv=None):
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     try:
-        node = SimNode(parameter_overrides=overrides)
+        node = SimNode(parameter_overrides=overrides, robot=args.robot)
         executor = make_executor()
         executor.add_node(node)
         spin_until_stopped(executor, stop)

@@ -3,7 +3,6 @@ from dataclasses import dataclass, field
 
 from miro_ball.common.params import check_ranges
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES
-from miro_ball.miro.interface import check_name, default_robot_name
 from miro_sim_bullet.physics.world import PHYSICS_DT_S
 
 RENDERERS = ('auto', 'tiny', 'egl')
@@ -11,10 +10,6 @@ RENDERERS = ('auto', 'tiny', 'egl')
 
 @dataclass(frozen=True)
 class SimParams:
-    robot_name: str = field(
-        default_factory=default_robot_name,
-        metadata={'help': "name of the world's robot when its file names none (topic prefix "
-                          "/<robot_name>/); default $MIRO_ROBOT_NAME, else miro"})
     world: str = field(default='miro',
                        metadata={'help': 'bundled world name or path to a .toml world file'})
     real_time_factor: float = field(
@@ -53,7 +48,6 @@ class SimParams:
         if size not in FRAME_SIZES:
             raise ValueError(f"frame size {size[0]}x{size[1]} is not one of MiRo's: "
                              + ', '.join(f'{w}x{h}' for w, h in FRAME_SIZES))
-        check_name(self.robot_name, 'robot_name')
         checks = (('world', self.world != '', 'a world name or a path'),
                   ('renderer', self.renderer in RENDERERS, ' or '.join(RENDERERS)))
         for name, ok, rule in checks:

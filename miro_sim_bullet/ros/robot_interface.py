@@ -10,17 +10,15 @@ import math
 
 from geometry_msgs.msg import Pose2D, Twist, TwistStamped
 from nav_msgs.msg import Odometry
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState, \
     Range
 from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, UInt32MultiArray
 
+from miro_ball.common.qos import profile
 from miro_ball.miro.constants import JOINT_NAMES, UPSTREAM_FLAG_SIMULATOR
-from miro_ball.miro.interface import EYE_SIDE, EYES, RobotTopics
+from miro_ball.miro.interface import EYE_SIDE, EYES, frame_id, RobotTopics, TOPIC
 from miro_ball.miro.kinematics import finite
 from miro_sim_bullet.ros import convert
-
-CAMERA_QOS = QoSProfile(depth=2, reliability=ReliabilityPolicy.RELIABLE)
 
 
 class RobotInterface:
@@ -31,34 +29,38 @@ class RobotInterface:
         self.name = name
         self.topics = t = RobotTopics(name)
 
-        def pub(msg_type, topic, qos=10):
-            return node.create_publisher(msg_type, topic, qos)
+        def pub(msg_type, key, **fields):
+            """A publisher of the interface's row ``key``, with the row's QoS."""
+            row = TOPIC[key]
+            return node.create_publisher(msg_type, t.topic(row.name.format(**fields)),
+                                         profile(row.qos))
 
-        self.pub_eyes = {eye: (pub(CompressedImage, t.eye_compressed(eye), CAMERA_QOS),
-                               pub(Image, t.eye_raw(eye), CAMERA_QOS),
-                               pub(CameraInfo, t.camera_info(eye), CAMERA_QOS))
+        self.pub_eyes = {eye: (pub(CompressedImage, 'eye_compressed', eye=eye),
+                               pub(Image, 'eye_raw', eye=eye),
+                               pub(CameraInfo, 'camera_info', eye=eye))
                          for eye in EYES}
-        self.pub_kin = pub(JointState, t.kinematic_joints)
-        self.pub_odom = pub(Odometry, t.odom)
-        self.pub_pose = pub(Pose2D, t.body_pose)
-        self.pub_vel = pub(Twist, t.body_vel)
-        self.pub_wheel_cmd = pub(Float32MultiArray, t.wheel_speed_cmd)
-        self.pub_wheel_opto = pub(Float32MultiArray, t.wheel_speed_opto)
-        self.pub_cliff = pub(Float32MultiArray, t.cliff)
-        self.pub_sonar = pub(Range, t.sonar)
-        self.pub_imu = {part: pub(Imu, t.imu(part)) for part in ('body', 'head')}
-        self.pub_battery = pub(BatteryState, t.battery)
-        self.pub_light = pub(Float32MultiArray, t.light)
-        self.pub_touch = [pub(UInt16, t.touch(part)) for part in ('head', 'body')]
-        self.pub_flags = pub(UInt32, t.sensor_flags)
-        self.subs = [node.create_subscription(msg_type, topic, callback, 10)
-                     for msg_type, topic, callback in (
-                         (TwistStamped, t.cmd_vel, self._on_cmd_vel),
-                         (JointState, t.kinematic_targets, self._on_kinematic),
-                         (Float32MultiArray, t.cosmetic_joints, self._on_cosmetic),
-                         (UInt32MultiArray, t.illum, self._on_illum),
-                         (UInt16MultiArray, t.tone, self._on_tone),
-                         (UInt32, t.control_flags, self._on_flags))]
+        self.pub_kin = pub(JointState, 'kinematic_joints')
+        self.pub_odom = pub(Odometry, 'odom')
+        self.pub_pose = pub(Pose2D, 'body_pose')
+        self.pub_vel = pub(Twist, 'body_vel')
+        self.pub_wheel_cmd = pub(Float32MultiArray, 'wheel_speed_cmd')
+        self.pub_wheel_opto = pub(Float32MultiArray, 'wheel_speed_opto')
+        self.pub_cliff = pub(Float32MultiArray, 'cliff')
+        self.pub_sonar = pub(Range, 'sonar')
+        self.pub_imu = {part: pub(Imu, 'imu', part=part) for part in ('body', 'head')}
+        self.pub_battery = pub(BatteryState, 'battery')
+        self.pub_light = pub(Float32MultiArray, 'light')
+        self.pub_touch = [pub(UInt16, 'touch', part=part) for part in ('head', 'body')]
+        self.pub_flags = pub(UInt32, 'sensor_flags')
+        self.subs = [node.create_subscription(msg_type, getattr(t, key), callback,
+                                              profile(TOPIC[key].qos))
+                     for msg_type, key, callback in (
+                         (TwistStamped, 'cmd_vel', self._on_cmd_vel),
+                         (JointState, 'kinematic_targets', self._on_kinematic),
+                         (Float32MultiArray, 'cosmetic_joints', self._on_cosmetic),
+                         (UInt32MultiArray, 'illum', self._on_illum),
+                         (UInt16MultiArray, 'tone', self._on_tone),
+                         (UInt32, 'control_flags', self._on_flags))]
 
     @property
     def robot(self):
@@ -123,18 +125,19 @@ class RobotInterface:
     def publish_tick(self, when):
         """This platform tick's sensor readings, stamped ``when``."""
         s = self.robot.sensors
-        odom = convert.odometry(s, when)
-        self.pub_kin.publish(convert.kinematic_joints(s, when))
+        odom = convert.odometry(s, when, self.name)
+        self.pub_kin.publish(convert.kinematic_joints(s, when, self.name))
         self.pub_odom.publish(odom)
         self.pub_pose.publish(convert.body_pose(s))
         self.pub_vel.publish(odom.twist.twist)
         self.pub_wheel_cmd.publish(convert.floats(s.wheel_speed_cmd))
         self.pub_wheel_opto.publish(convert.floats(s.wheel_speed_opto))
         self.pub_cliff.publish(convert.floats(s.cliff))
-        self.pub_sonar.publish(convert.sonar(s, when))
+        self.pub_sonar.publish(convert.sonar(s, when, self.name))
         for part, reading in (('body', s.imu_body), ('head', s.imu_head)):
-            self.pub_imu[part].publish(convert.imu(reading, when, f'imu_{part}'))
-        self.pub_battery.publish(convert.battery(s, when))
+            self.pub_imu[part].publish(convert.imu(reading, when,
+                                                   frame_id(self.name, f'imu_{part}')))
+        self.pub_battery.publish(convert.battery(s, when, self.name))
         self.pub_light.publish(convert.floats(s.light))
         for pub in self.pub_touch:
             pub.publish(UInt16(data=0))
@@ -147,9 +150,9 @@ class RobotInterface:
 
     def publish_eye(self, eye, rgb, when, intrinsics, jpeg_quality):
         compressed, raw, info = self.pub_eyes[eye]
-        frame_id = f'{eye}_optical_frame'
+        frame = frame_id(self.name, f'{eye}_optical')
         if compressed.get_subscription_count():
-            compressed.publish(convert.jpeg(rgb, when, frame_id, jpeg_quality))
+            compressed.publish(convert.jpeg(rgb, when, frame, jpeg_quality))
         if raw.get_subscription_count():
-            raw.publish(convert.raw_image(rgb, when, frame_id))
-        info.publish(convert.camera_info(intrinsics, when, frame_id))
+            raw.publish(convert.raw_image(rgb, when, frame))
+        info.publish(convert.camera_info(intrinsics, when, frame))
