@@ -81,7 +81,9 @@ def test_the_gui_survives_every_topic(ros_context, executor):
     bridge = GuiBridge(default_robot_name(), context=ros_context)
     executor.add_node(bridge)
     try:
-        delivered = fuzz(bridge, Probe(ros_context, executor, 'fuzzer'), executor)
+        probe = Probe(ros_context, executor, 'fuzzer')
+        # The bridge's own topics, then those of its robot part (in the robot's namespace).
+        delivered = {**fuzz(bridge, probe, executor), **fuzz(bridge.watch, probe, executor)}
         assert RobotTopics(default_robot_name()).odom in delivered
         assert min(delivered.values()) > 2
         json.loads(bridge.state())  # the page's readouts still make valid JSON

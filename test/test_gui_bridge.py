@@ -8,9 +8,9 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float32MultiArray, UInt16MultiArray, UInt32, UInt32MultiArray
 
 from miro_ball.gui import protocol as p
-from miro_ball.gui.bridge import DEADMAN_S, GuiBridge
+from miro_ball.gui.bridge import DEADMAN_S, GuiBridge, NODE_NAME
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
-from miro_ball.miro.interface import GUI_NODE_NAME, RobotTopics, default_robot_name
+from miro_ball.miro.interface import RobotTopics, default_robot_name
 from rostools import Probe, spin_until
 
 T = RobotTopics(default_robot_name())
@@ -47,9 +47,12 @@ def test_every_control_reaches_miros_topics_and_nothing_else_is_published(
     assert got[T.control_flags][-1].data == DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
     assert list(got[T.tone][-1].data) == [440, 100, 50]
     assert got[T.cmd_vel][-1].twist.linear.x == pytest.approx(0.1)
+    # Only the robot part, in the robot's namespace, publishes on MiRo's topics.
     published = {name for name, _ in bridge.get_publisher_names_and_types_by_node(
-        GUI_NODE_NAME, '/')}
+        NODE_NAME, '/' + T.name)}
     assert published - ROS_OWN == set(got)
+    assert {name for name, _ in bridge.get_publisher_names_and_types_by_node(
+        NODE_NAME, '/')} <= ROS_OWN
 
 
 def test_a_drive_that_is_not_renewed_stops_and_another_page_cannot_stop_it(
@@ -87,13 +90,13 @@ def test_robots_are_found_and_picked_by_what_publishes(ros_context, executor):
     executor.add_node(node)
     try:
         assert spin_until(executor, lambda: node.robots == ['robot_a', 'robot_b'])
-        assert spin_until(executor, lambda: node.watch.topics.name == 'robot_a')
+        assert spin_until(executor, lambda: node.watch.robot == 'robot_a')
         node.submit(p.SelectRobot('robot_b'), owner=1)
-        assert spin_until(executor, lambda: node.watch.topics.name == 'robot_b')
+        assert spin_until(executor, lambda: node.watch.robot == 'robot_b')
         node.submit(p.SelectRobot('ghost'), owner=1)  # not running: refused
         node.submit(p.Stop(), owner=1)
         assert spin_until(executor, lambda: not node._commands)
-        assert node.watch.topics.name == 'robot_b'
+        assert node.watch.robot == 'robot_b'
     finally:
         executor.remove_node(node)
         node.destroy_node()

@@ -10,7 +10,7 @@ import threading
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.stopping import StopRequest, spin_until_stopped
-from miro_ball.miro.interface import check_name, default_robot_name
+from miro_ball.miro.interface import robot_name
 
 DEFAULT_HOST = '127.0.0.1'
 DEFAULT_PORT = 8080
@@ -37,7 +37,7 @@ def parse_args(argv):
         parser.error(f'--port must be in 0..65535, got {args.port}')
     if args.robot is not None:
         try:
-            check_name(args.robot, '--robot')
+            robot_name(args.robot)
         except ValueError as err:
             parser.error(str(err))
     return args, parser
@@ -51,7 +51,7 @@ def main(argv=None):
 
     args, parser = parse_args(user_args(argv, PROG))
     try:
-        default = check_name(default_robot_name(), '$MIRO_ROBOT_NAME')
+        default = robot_name()
     except ValueError as err:
         parser.error(str(err))
 

@@ -1,4 +1,8 @@
-"""The GUI's ROS side: one rclpy node that watches a MiRo and drives it for the pages.
+"""The GUI's ROS side: rclpy nodes that watch a MiRo and drive it for the pages.
+
+The bridge (``/miro_gui``) follows /clock, finds the robots that run and calls the
+simulator's services; its robot part (``/<robot>/miro_gui``, made anew when the page
+picks another robot) lives in that robot's namespace and uses MiRo's relative names.
 
 It runs in the ROS thread (its own executor); the web server calls the thread-safe
 methods marked so. Images are kept newest-only, one slot per channel, and handed
@@ -18,25 +22,27 @@ from dataclasses import dataclass
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import BatteryState, CompressedImage, Imu, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, \
     UInt32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
+from miro_ball.common.clock_watch import clock_publishers, ClockWatch, shared_domain_line
 from miro_ball.common.jpeg import MAX_SIDE, ImageRejected, jpeg_size
+from miro_ball.common.qos import profile
 from miro_ball.common.throttle import Throttled
 from miro_ball.gui import protocol as p
 from miro_ball.gui import readouts as r
 from miro_ball.miro.constants import JOINT_NAMES, PLATFORM_TICK_S
-from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYES, GUI_NODE_NAME,
-                                      RobotTopics, SimTopics, robots_in)
+from miro_ball.controller.names import debug_topic
+from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
+                                      frame_id, RobotTopics, SENSOR_QOS, SimTopics, robots_in)
 
+NODE_NAME = 'miro_gui'
 DEADMAN_S = 0.3  # a drive command not refreshed for this long becomes a stop
 DISCOVERY_PERIOD_S = 1.0
 READOUT_PERIOD_S = 0.05  # readouts to the pages at 20 Hz
-IMAGE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
 
 
 @dataclass(frozen=True)
@@ -46,17 +52,22 @@ class Frame:
     jpeg: bytes
 
 
-class _Watch:
-    """The subscriptions to one robot's sensors and eyes, and what they last said."""
+class _Watch(Node):
+    """The GUI's robot part: a node in the robot's namespace that subscribes to its sensors
+    and eyes, keeps what they last said and publishes the page's commands."""
 
     def __init__(self, bridge, name):
+        super().__init__(NODE_NAME, namespace='/' + name, context=bridge.context)
         self.bridge = bridge
-        self.topics = t = RobotTopics(name)
+        self.robot = name
+        self.topics = t = RobotTopics()
         self.values = {}
         self.last_heard = None
+        self._control_pubs = {}
 
-        def sub(msg_type, topic, handler, qos=10):
-            return bridge.create_subscription(msg_type, topic, self._wrap(handler), qos)
+        def sub(msg_type, topic, handler):
+            return self.create_subscription(msg_type, topic, self._wrap(handler),
+                                            profile(SENSOR_QOS))
 
         self.subs = [
             sub(BatteryState, t.battery, lambda m: {'battery': m.voltage}),
@@ -79,9 +90,16 @@ class _Watch:
             sub(UInt32, t.sensor_flags, lambda m: {'flags': m.data}),
         ]
         for index, eye in enumerate(EYES):
-            self.subs.append(bridge.image_subscription(t.eye_compressed(eye), index))
+            self.subs.append(bridge.image_subscription(self, t.eye_compressed(eye), index))
             self.subs.append(bridge.image_subscription(
-                t.controller_debug(eye), p.CHANNELS.index(f'debug_{eye}')))
+                self, debug_topic(name, eye), p.CHANNELS.index(f'debug_{eye}')))
+
+    def publisher(self, msg_type, topic):
+        """The robot's control topic, made on first use."""
+        if topic not in self._control_pubs:
+            self._control_pubs[topic] = self.create_publisher(msg_type, topic,
+                                                              profile(CONTROL_QOS))
+        return self._control_pubs[topic]
 
     def _wrap(self, handler):
         def on_message(msg):
@@ -94,10 +112,6 @@ class _Watch:
                 self.values.update(values)
                 self.last_heard = time.monotonic()
         return on_message
-
-    def destroy(self):
-        for sub in self.subs:
-            self.bridge.destroy_subscription(sub)
 
 
 def _xyz(imu):
@@ -117,7 +131,7 @@ class GuiBridge(Node):
 
     def __init__(self, robot=None, *, context=None, on_frame=None,
                  default_robot=DEFAULT_ROBOT_NAME):
-        super().__init__(GUI_NODE_NAME, context=context)
+        super().__init__(NODE_NAME, context=context)
         self.warn = Throttled(self.get_logger().warning)
         self.fixed_robot = robot
         self.on_frame = on_frame or (lambda channel: None)
@@ -132,10 +146,10 @@ class GuiBridge(Node):
         self._clock_samples = []  # (wall, sim) of the last 2 s of /clock: the real-time factor
         self.sim_time = None
         self.sim_paused = None
-        self._control_pubs = {}
+        self._clock_watch = ClockWatch(self)
         self._wake = self.create_guard_condition(self._run_commands)
         self.create_subscription(Clock, CLOCK, self._on_clock, 10)
-        self.image_subscription(self.sim.overhead, p.CHANNELS.index('overhead'))
+        self.image_subscription(self, self.sim.overhead, p.CHANNELS.index('overhead'))
         self.sim_clients = {'reset': self.create_client(Trigger, self.sim.reset),
                             'step': self.create_client(Trigger, self.sim.step),
                             'pause': self.create_client(SetBool, self.sim.pause)}
@@ -145,6 +159,18 @@ class GuiBridge(Node):
         self.create_timer(PLATFORM_TICK_S, self._on_tick)
         self.create_timer(READOUT_PERIOD_S, self._make_state)
         self.create_timer(DISCOVERY_PERIOD_S, self._discover)
+
+    # The robot part spins wherever the bridge spins, and goes when the bridge goes.
+    def _set_executor(self, executor):
+        Node.executor.fset(self, executor)
+        if executor is not None:
+            executor.add_node(self.watch)
+
+    executor = property(Node.executor.fget, _set_executor)
+
+    def destroy_node(self):
+        self._drop_watch()
+        super().destroy_node()
 
     # -- thread-safe, for the web server ------------------------------------------------------
     def submit(self, command, owner):
@@ -174,10 +200,11 @@ class GuiBridge(Node):
     def _make_state(self):
         watch = self.watch
         heard = watch.last_heard
-        rtf = self._rtf()
+        # Two simulators' clocks side by side make a speed of nonsense: none is shown.
+        rtf = None if self._clock_watch.contested else self._rtf()
         self._state = json.dumps(r.jsonable({
             't': 'state',
-            'robot': watch.topics.name,
+            'robot': watch.robot,
             'robots': self.robots,
             'fixed': self.fixed_robot is not None,
             'readouts': watch.values,
@@ -186,11 +213,13 @@ class GuiBridge(Node):
                     'time': self.sim_time, 'rtf': rtf,
                     # Known when paused from here; else guessed from time standing still.
                     'paused': rtf == 0.0 if self.sim_paused is None else self.sim_paused},
-            'status': self.status,
+            'status': (shared_domain_line(clock_publishers(self), self.context.get_domain_id())
+                       if self._clock_watch.contested else self.status),
         }))
 
     # -- images ---------------------------------------------------------------------------------
-    def image_subscription(self, topic, channel):
+    def image_subscription(self, node, topic, channel):
+        """Subscribe on ``node`` to a JPEG topic shown on ``channel``."""
         def on_image(msg):
             data = bytes(msg.data)
             problem = None
@@ -211,44 +240,39 @@ class GuiBridge(Node):
                 self._seq += 1
                 self._frames[channel] = Frame(self._seq, stamp, data)
             self.on_frame(channel)
-        return self.create_subscription(CompressedImage, topic, on_image, IMAGE_QOS)
+        return node.create_subscription(CompressedImage, topic, on_image, profile(EYE_QOS))
 
     # -- commands (ROS thread) -------------------------------------------------------------------
-    def _publisher(self, msg_type, topic):
-        if topic not in self._control_pubs:
-            self._control_pubs[topic] = self.create_publisher(msg_type, topic, 10)
-        return self._control_pubs[topic]
-
     def _run_commands(self):
         while self._commands:
             command, owner = self._commands.popleft()
             self._run(command, owner)
 
     def _run(self, command, owner):
-        t = self.watch.topics
+        t, publisher = self.watch.topics, self.watch.publisher
         if isinstance(command, p.Drive):
             fresh = self._drive is None
             self._drive = (command.linear, command.angular, owner, time.monotonic())
             self._publish_twist(command.linear, command.angular)
             if fresh:
-                self.get_logger().info(f'driving {t.name}')
+                self.get_logger().info(f'driving {self.watch.robot}')
         elif isinstance(command, p.Stop):
             if self._drive is not None and self._drive[2] == owner:
                 self._stop('stopped by the page')
         elif isinstance(command, p.Head):
-            self._publisher(JointState, t.kinematic_targets).publish(
+            publisher(JointState, t.kinematic_targets).publish(
                 JointState(name=list(JOINT_NAMES), position=list(command.positions)))
         elif isinstance(command, p.Cosmetic):
-            self._publisher(Float32MultiArray, t.cosmetic_joints).publish(
+            publisher(Float32MultiArray, t.cosmetic_joints).publish(
                 Float32MultiArray(data=list(command.values)))
         elif isinstance(command, p.Illum):
-            self._publisher(UInt32MultiArray, t.illum).publish(
+            publisher(UInt32MultiArray, t.illum).publish(
                 UInt32MultiArray(data=list(command.leds)))
         elif isinstance(command, p.Tone):
-            self._publisher(UInt16MultiArray, t.tone).publish(
+            publisher(UInt16MultiArray, t.tone).publish(
                 UInt16MultiArray(data=list(command.values)))
         elif isinstance(command, p.Flags):
-            self._publisher(UInt32, t.control_flags).publish(UInt32(data=command.data))
+            publisher(UInt32, t.control_flags).publish(UInt32(data=command.data))
         elif isinstance(command, p.SimAction):
             self._call_sim(command.action)
         elif isinstance(command, p.SelectRobot):
@@ -257,14 +281,14 @@ class GuiBridge(Node):
     def _publish_twist(self, linear, angular):
         msg = TwistStamped()
         msg.header.stamp = self.get_clock().now().to_msg()
-        msg.header.frame_id = 'base_link'
+        msg.header.frame_id = frame_id(self.watch.robot, 'base_link')
         msg.twist.linear.x, msg.twist.angular.z = float(linear), float(angular)
-        self._publisher(TwistStamped, self.watch.topics.cmd_vel).publish(msg)
+        self.watch.publisher(TwistStamped, self.watch.topics.cmd_vel).publish(msg)
 
     def _stop(self, why):
         self._drive = None
         self._publish_twist(0.0, 0.0)
-        self.get_logger().info(f'{self.watch.topics.name} stopped: {why}')
+        self.get_logger().info(f'{self.watch.robot} stopped: {why}')
 
     def _on_tick(self):
         """Keep a held drive command going at MiRo's 50 Hz, until its deadman runs out."""
@@ -299,12 +323,20 @@ class GuiBridge(Node):
         future.add_done_callback(done)
 
     # -- which robot -----------------------------------------------------------------------------
-    def _select(self, name):
+    def _drop_watch(self):
         if self.watch is not None:
-            if self._drive is not None:
-                self._stop('another robot was chosen')
-            self.watch.destroy()
+            if self.executor is not None:
+                self.executor.remove_node(self.watch)
+            self.watch.destroy_node()
+            self.watch = None
+
+    def _select(self, name):
+        if self.watch is not None and self._drive is not None:
+            self._stop('another robot was chosen')
+        self._drop_watch()
         self.watch = _Watch(self, name)
+        if self.executor is not None:
+            self.executor.add_node(self.watch)
         with self._lock:
             self._frames = {ch: f for ch, f in self._frames.items()
                             if p.CHANNELS[ch] == 'overhead'}
@@ -315,14 +347,14 @@ class GuiBridge(Node):
             self.status = f'fixed to {self.fixed_robot} by --robot'
         elif name not in self.robots:
             self.warn('robot', f'no robot {name!r} running; there are {self.robots}')
-        elif name != self.watch.topics.name:
+        elif name != self.watch.robot:
             self._select(name)
 
     def _discover(self):
         # The graph lists topics that only have subscribers too, like our own watch's.
         self.robots = [name for name in robots_in(n for n, _ in self.get_topic_names_and_types())
                        if self.count_publishers(RobotTopics(name).odom)]
-        if self.fixed_robot is None and self.robots and self.watch.topics.name not in self.robots:
+        if self.fixed_robot is None and self.robots and self.watch.robot not in self.robots:
             self._select(self.robots[0])
 
     # -- simulated time --------------------------------------------------------------------------
