@@ -52,14 +52,14 @@ cmd=${1:-help}
 [ $# -gt 0 ] && shift
 case "$cmd" in
   setup) setup ;;
-  demo) setup; exec "$PY" -m miro_ball.lab.demo "$@" ;;
+  demo) setup; exec "$PY" -m miro_ball.demo "$@" ;;
   test) setup
     if [ $# -gt 0 ]; then exec "$PY" -m pytest "$@"; fi
     # The whole suite twice: as is, and under another robot name (the MDK's multi-robot
     # convention), so that no test or node leans on the default name.
     "$PY" -m pytest
     MIRO_ROBOT_NAME=miro02 exec "$PY" -m pytest -q ;;
-  bench) setup; exec "$PY" -m miro_ball.lab.sim_bench "$@" ;;
-  soak) setup; exec "$PY" -m miro_ball.lab.soak "$@" ;;
+  bench) setup; exec "$PY" -m miro_ball.bench.sim_bench "$@" ;;
+  soak) setup; exec "$PY" -m miro_ball.bench.soak "$@" ;;
   *) sed -n '2,8p' "$0"; exit 2 ;;
 esac

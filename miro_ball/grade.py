@@ -3,7 +3,7 @@
 COMMAND (a student's script, our controller, any ROS 2 program) is run as a
 process of its own against seeded placements of robot and ball, each episode
 with a fresh simulator on a ROS domain of its own and MIRO_ROBOT_NAME set. See
-miro_ball/lab/grader.py for what an episode is.
+miro_ball/grading/grader.py for what an episode is.
 """
 import argparse
 import shutil
@@ -11,8 +11,8 @@ import sys
 import time
 from pathlib import Path
 
-from miro_ball.lab.judge import KICK_DISTANCE_M
-from miro_ball.lab.scenarios import ARENA_FREE_RADIUS
+from miro_ball.run.judge import KICK_DISTANCE_M
+from miro_ball.run.scenarios import ARENA_FREE_RADIUS
 
 EXAMPLE = 'python -m miro_ball.grade --count 5 -- python -m miro_ball --ros-args -p ' \
           'use_sim_time:=true'
@@ -81,8 +81,8 @@ def parse_args(argv):
 
 
 def options_from(args, command, p):
-    from miro_ball.lab.demo import robot_names
-    from miro_ball.lab.grader import Options
+    from miro_ball.demo import robot_names
+    from miro_ball.grading.grader import Options
     from miro_ball.miro.interface import check_name
     from miro_sim_bullet.scene.world_file import load_world
 
@@ -105,9 +105,9 @@ def main(argv=None):
     args, command, p = parse_args(sys.argv[1:] if argv is None else argv)
     options = options_from(args, command, p)
     from miro_ball.common.stopping import StopRequest
-    from miro_ball.lab.grader import grade
-    from miro_ball.lab.grading import report, to_json
-    from miro_ball.lab.scenarios import placements
+    from miro_ball.grading.grader import grade
+    from miro_ball.grading.scores import report, to_json
+    from miro_ball.run.scenarios import placements
 
     stop = StopRequest()
     print(f'grading: {" ".join(command)}\n  {args.count} placement(s) (seed {args.seed}) in '

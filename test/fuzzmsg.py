@@ -12,7 +12,7 @@ import math
 
 from rosidl_parser.definition import AbstractNestedType, Array, BasicType, NamespacedType
 
-from miro_ball.lab.synthetic import decompression_bomb
+from hostile import decompression_bomb
 
 FLOATS = [math.nan, math.inf, -math.inf, 1e308, -1e308, 3.4e38, -0.0, 5e-324]
 INTS = {'int8': (-2**7, 2**7 - 1), 'int16': (-2**15, 2**15 - 1), 'int32': (-2**31, 2**31 - 1),

@@ -11,7 +11,7 @@ import sys
 
 import pytest
 
-from miro_ball.lab.scenarios import Placement, placements, run_episode
+from miro_ball.run.scenarios import Placement, placements, run_episode
 from miro_ball.miro.interface import default_robot_name
 
 
@@ -49,7 +49,7 @@ def test_placements_are_reproducible_and_inside_the_arena():
 
 def test_two_processes_find_each_other_and_kick(tmp_path):
     """The README's main job: two nodes over DDS, headless, until the ball moves."""
-    cmd = [sys.executable, '-m', 'miro_ball.lab.demo', '--no-video', '--limit', '40',
+    cmd = [sys.executable, '-m', 'miro_ball.demo', '--no-video', '--limit', '40',
            '--real-time-factor', '0', '--out', str(tmp_path)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             start_new_session=True)

@@ -5,7 +5,7 @@ import pytest
 
 from miro_ball.controller.detection import (annotate, Ball, BallDetector, DetectionParams,
                                             hue_ranges, normalise, target_hue, to_pixels)
-from miro_ball.lab.synthetic import BLUE, Disc, GREEN, jpeg, RED, render
+from miro_ball.bench.synthetic import BLUE, Disc, GREEN, jpeg, RED, render
 from miro_ball.miro.constants import FRAME_SIZES
 
 POS_TOL = 0.01  # of the frame width: 6 px at 640

@@ -7,8 +7,8 @@ import sys
 import pytest
 
 from miro_ball.grade import parse_args
-from miro_ball.lab.grader import last_bytes
-from miro_ball.lab.grading import EpisodeResult, printable_tail, report, to_json, total_line
+from miro_ball.grading.grader import last_bytes
+from miro_ball.grading.scores import EpisodeResult, printable_tail, report, to_json, total_line
 
 PY = sys.executable
 PLACE = ((0.1, 0.2, 0.5), (0.6, -0.3))

@@ -2,7 +2,8 @@
 import pytest
 
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected, jpeg_size
-from miro_ball.lab.synthetic import decompression_bomb, Disc, jpeg, render
+from miro_ball.bench.synthetic import Disc, jpeg, render
+from hostile import decompression_bomb
 
 
 @pytest.mark.parametrize('width, height', [(640, 360), (1280, 720), (320, 240), (17, 3)])

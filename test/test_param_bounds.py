@@ -8,7 +8,7 @@ import pytest
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERAS, make_behaviour, MODES
 from miro_ball.controller.detection import Ball, BallDetector, DetectionParams
 from miro_ball.controller.params import ControllerParams, GROUPS
-from miro_ball.lab.synthetic import Disc, render
+from miro_ball.bench.synthetic import Disc, render
 from miro_sim_bullet.ros.params import SimParams
 
 FRAME = render(640, 360, [Disc(320, 200, 30)])

@@ -16,8 +16,8 @@ from std_msgs.msg import Float32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.common.isolation import isolated_env
-from miro_ball.lab.demo import node_commands, parse_args, Processes
-from miro_ball.lab.monitor import Monitor
+from miro_ball.demo import node_commands, parse_args, Processes
+from miro_ball.run.monitor import Monitor
 from miro_ball.miro.interface import default_robot_name, RobotTopics, SimTopics
 from miro_sim_bullet.physics.robot import CMD_TIMEOUT_S
 from rostools import drain, Probe, spin_until

@@ -1,6 +1,6 @@
 """The scenario benchmark plays the same episodes whatever the number of worker processes."""
-from miro_ball.lab.scenario_bench import run, table
-from miro_ball.lab.scenarios import placements
+from miro_ball.bench.scenario_bench import run, table
+from miro_ball.run.scenarios import placements
 
 
 def test_outcomes_do_not_depend_on_the_number_of_jobs():

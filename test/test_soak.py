@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from miro_ball.lab.soak import (descendants, growth, process_tree, RSS_TARGET_PCT, rss_mb,
+from miro_ball.bench.soak import (descendants, growth, process_tree, RSS_TARGET_PCT, rss_mb,
                                 Sample, SimulatedTime, trend_pct, verdict)
 from miro_ball.miro.interface import default_robot_name
 from rostools import run_command
@@ -107,18 +107,18 @@ def test_the_process_tree_includes_children_with_their_memory():
 
 
 def test_help_and_bad_minutes():
-    ok = subprocess.run([sys.executable, '-m', 'miro_ball.lab.soak', '--help'],
+    ok = subprocess.run([sys.executable, '-m', 'miro_ball.bench.soak', '--help'],
                         capture_output=True, text=True)
     assert ok.returncode == 0 and '--minutes' in ok.stdout and '--gui' in ok.stdout
-    bad = subprocess.run([sys.executable, '-m', 'miro_ball.lab.soak', '--minutes', '-1'],
+    bad = subprocess.run([sys.executable, '-m', 'miro_ball.bench.soak', '--minutes', '-1'],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.strip().splitlines()[-1].startswith(
-        'python -m miro_ball.lab.soak: error: --minutes')
+        'python -m miro_ball.bench.soak: error: --minutes')
     assert 'Traceback' not in bad.stderr
 
 
 def test_a_short_soak_reports_every_process_and_the_growth(tmp_path):
-    code, output = run_command([sys.executable, '-m', 'miro_ball.lab.soak', '--minutes',
+    code, output = run_command([sys.executable, '-m', 'miro_ball.bench.soak', '--minutes',
                                 '0.15', '--report-every', '3', '--out', str(tmp_path)])
     reports = re.findall(r'^after [0-9.]+ min: simulated [0-9.]+ min, RTF ([0-9.]+), '
                          r'(\d+) frames', output, re.M)

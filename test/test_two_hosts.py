@@ -23,7 +23,7 @@ import time
 import pytest
 
 from miro_ball.common.isolation import isolated_env
-from miro_ball.lab.demo import node_commands, parse_args, Processes
+from miro_ball.demo import node_commands, parse_args, Processes
 from miro_ball.miro.interface import default_robot_name
 
 SUBNET = '10.231.0.{}/24'  # only ever inside the two namespaces made here
@@ -148,7 +148,7 @@ def observe(limit_s):
     from rclpy.executors import SingleThreadedExecutor
     from std_srvs.srv import SetBool
 
-    from miro_ball.lab.monitor import Monitor
+    from miro_ball.run.monitor import Monitor
     from miro_ball.miro.interface import EYES, RobotTopics, SimTopics
 
     context = Context()

@@ -14,7 +14,7 @@ import sys
 import time
 
 from miro_ball.common.isolation import limit_discovery, private_domains
-from miro_ball.lab.report import machine, write_section
+from miro_ball.bench.report import machine, write_section
 
 MODES = ('improved', 'tutorial')
 
@@ -45,7 +45,7 @@ def _episode(job):
     import rclpy
     from rclpy.context import Context
 
-    from miro_ball.lab.scenarios import run_episode
+    from miro_ball.run.scenarios import run_episode
 
     mode, index, placement, seed, renderer = job
     context = Context()
@@ -94,7 +94,7 @@ def table(results, count):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog='python -m miro_ball.lab.scenario_bench',
+    parser = argparse.ArgumentParser(prog='python -m miro_ball.bench.scenario_bench',
                                      description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--count', type=int, default=50, help='placements (50)')
@@ -108,7 +108,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     if not 1 <= args.count <= 10000 or not 0 < args.limit <= 3600 or not 1 <= args.jobs <= 64:
         parser.error('--count must be in 1..10000, --limit in (0, 3600] and --jobs in 1..64')
-    from miro_ball.lab.scenarios import placements
+    from miro_ball.run.scenarios import placements
 
     print(f'scenario benchmark: {args.count} placements (seed {args.seed}), modes '
           f'{", ".join(args.modes)}, limit {args.limit:g} s simulated, {args.jobs} jobs',
@@ -121,7 +121,7 @@ def main(argv=None):
     print('\n' + report + f'\n\nwall time {wall:.1f} min')
     write_section(args.output, 'scenario_bench', (
         '# Scenario benchmark\n\n'
-        f'`python -m miro_ball.lab.scenario_bench --count {args.count} --seed {args.seed} '
+        f'`python -m miro_ball.bench.scenario_bench --count {args.count} --seed {args.seed} '
         f'--jobs {args.jobs}` ({args.count} seeded placements of robot and ball in the default '
         f'arena; success = ball moved >= 0.3 m within {args.limit:g} s of simulated time and '
         f'the robot never fell; times are simulated seconds from the start of the episode).'

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from miro_ball.common.isolation import isolated_env, private_domains
-from miro_ball.lab.demo import Processes, Video, VIDEO_FPS
-from miro_ball.lab.grading import EpisodeResult, placement_text, printable_tail
+from miro_ball.demo import Processes, Video, VIDEO_FPS
+from miro_ball.grading.scores import EpisodeResult, placement_text, printable_tail
 from miro_ball.miro.interface import RobotTopics, ROBOT_NAME_ENV, SimTopics
 
 PLACED_WITHIN_M = 0.02  # ground truth this close to the placement: it took
@@ -62,7 +62,7 @@ class Session:
         from rclpy.parameter import Parameter
         from std_srvs.srv import SetBool, Trigger
 
-        from miro_ball.lab.monitor import Monitor
+        from miro_ball.run.monitor import Monitor
 
         self.context = Context()
         rclpy.init(context=self.context, domain_id=domain)

@@ -152,7 +152,7 @@ def watch(args, robots, procs, domain_id, stop):
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.parameter import Parameter
 
-    from miro_ball.lab.monitor import Monitor
+    from miro_ball.run.monitor import Monitor
 
     context = Context()
     rclpy.init(context=context, domain_id=domain_id)
@@ -244,7 +244,7 @@ def summary(outcome, monitor, rtf, video, killed, record=None):
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(
-        prog='python -m miro_ball.lab.demo',
+        prog='python -m miro_ball.demo',
         description='Run the simulator and one controller per robot headless until the ball '
                     'is kicked; print a summary and write a video.')
     parser.add_argument('--mode', choices=('improved', 'tutorial'), default='improved')

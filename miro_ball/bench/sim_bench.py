@@ -25,8 +25,8 @@ import time
 from pathlib import Path
 
 from miro_ball.common.isolation import isolated_env, private_domain
-from miro_ball.lab import render_bench
-from miro_ball.lab.report import machine, write_section
+from miro_ball.bench import render_bench
+from miro_ball.bench.report import machine, write_section
 from miro_ball.miro.interface import EYES, RobotTopics
 from miro_sim_bullet.render.renderer import probe_egl
 from miro_sim_bullet.ros.params import SimParams
@@ -111,7 +111,7 @@ def measure(renderer, world, watched, sim_seconds, width, height, rate):
 def run_once(args, env, renderer, world, watched):
     """Figures of one child process, or None (and a line) if it failed."""
     out = subprocess.run(
-        [sys.executable, '-m', 'miro_ball.lab.sim_bench', '--one', renderer,
+        [sys.executable, '-m', 'miro_ball.bench.sim_bench', '--one', renderer,
          '--world', world, '--watched', str(watched), '--seconds', str(args.seconds),
          '--size', args.size, '--rate', str(args.rate)],
         env=env, capture_output=True, text=True, check=False)
@@ -157,7 +157,7 @@ def comparison(args, kinds, width, height):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog='python -m miro_ball.lab.sim_bench',
+    parser = argparse.ArgumentParser(prog='python -m miro_ball.bench.sim_bench',
                                      description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--seconds', type=float, default=10.0, help='simulated seconds per run')
@@ -202,7 +202,7 @@ def main(argv=None):
     if args.output:
         write_section(args.output, 'sim_bench', '\n'.join([
             '# Simulator benchmark', '',
-            f'`python -m miro_ball.lab.sim_bench` (`./dev.sh bench`): eyes {width}x{height} @ '
+            f'`python -m miro_ball.bench.sim_bench` (`./dev.sh bench`): eyes {width}x{height} @ '
             f'{args.rate:g} Hz, physics step {1000 * SimParams().physics_dt:g} ms, the node '
             f'free-running on its own executor, {args.seconds:g} simulated s x '
             f'{args.runs} runs per case (medians). {reason if ok else "No EGL here"}.', '',

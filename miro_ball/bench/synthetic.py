@@ -1,4 +1,5 @@
-"""Synthetic camera frames for tests and benchmarks: shaded balls on a grey floor.
+"""Synthetic camera frames: shaded balls on a grey floor, to try the detector without the
+simulator (the controller benchmark, the tutorial, the tests).
 
 The balls are lit from the upper left (Lambert shading plus ambient) and cast a
 soft shadow, and the floor has a gradient and sensor noise, so the detector sees
@@ -78,10 +79,3 @@ def jpeg(image, quality=90):
         raise ValueError('JPEG encoding failed')
     return buf.tobytes()
 
-
-def decompression_bomb(width=20000, height=20000):
-    """A tiny JPEG whose frame header claims width x height pixels (hostile input)."""
-    data = bytearray(jpeg(np.zeros((8, 8, 3), np.uint8)))
-    at = data.index(b'\xff\xc0')  # OpenCV writes baseline frames
-    data[at + 5:at + 9] = height.to_bytes(2, 'big') + width.to_bytes(2, 'big')
-    return bytes(data)

@@ -11,7 +11,7 @@ import random
 import time
 from dataclasses import dataclass
 
-from miro_ball.lab.judge import FELL_BELOW_M, KICK_DISTANCE_M
+from miro_ball.run.judge import FELL_BELOW_M, KICK_DISTANCE_M
 
 ARENA_FREE_RADIUS = 1.21 - 0.25  # keep starting poses clear of the wall panels
 

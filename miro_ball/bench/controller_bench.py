@@ -1,6 +1,6 @@
 """Controller benchmark: detection cost per frame and the node's image-to-command latency.
 
-    python -m miro_ball.lab.controller_bench [--frames N] [--latency N] [--cv-threads N]
+    python -m miro_ball.bench.controller_bench [--frames N] [--latency N] [--cv-threads N]
 
 Detection runs on synthetic frames (shaded balls on a grey floor, see synthetic.py).
 The latency part runs the node in-process on wall time, publishes a JPEG to one eye
@@ -18,7 +18,7 @@ from miro_ball.miro.constants import FRAME_SIZES
 from miro_ball.controller.detection import BallDetector
 from miro_ball.common.isolation import limit_discovery, private_domain
 from miro_ball.miro.interface import RobotTopics
-from miro_ball.lab.synthetic import Disc, jpeg, render
+from miro_ball.bench.synthetic import Disc, jpeg, render
 
 BENCH_ROBOT = 'miro_bench'  # a name no real simulator or robot answers to
 POOL = 16  # distinct frames per case; rendering is slower than detecting
@@ -129,7 +129,7 @@ def bench_latency(count):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog='python -m miro_ball.lab.controller_bench', description=__doc__,
+    parser = argparse.ArgumentParser(prog='python -m miro_ball.bench.controller_bench', description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--frames', type=int, default=300, help='detections per case')
     parser.add_argument('--latency', type=int, default=100, help='frames for the node latency')

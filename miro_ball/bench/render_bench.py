@@ -1,4 +1,4 @@
-"""Renderer comparison: ``python -m miro_ball.lab.render_bench``.
+"""Renderer comparison: ``python -m miro_ball.bench.render_bench``.
 
 Milliseconds to render the eyes of one camera instant in the same scene (a bundled world
 after 0.5 s, the robots' eyes from their own poses, the head panning between instants)
@@ -149,7 +149,7 @@ def print_table(results, sizes, kinds, label, report=print):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog='python -m miro_ball.lab.render_bench',
+    parser = argparse.ArgumentParser(prog='python -m miro_ball.bench.render_bench',
                                      description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--batches', type=int, default=6,

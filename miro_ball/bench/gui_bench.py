@@ -6,7 +6,7 @@ and one page in headless Chromium, which logs when it drew each frame. Latency
 is publish -> drawn on the page (both read from this machine's clock); frames
 per second count what the page drew; CPU is the GUI process's user + system
 time over the measured wall time. Run it alone:
-``flock /tmp/miro_heavy.lock .venv/bin/python -m miro_ball.lab.gui_bench``.
+``flock /tmp/miro_heavy.lock .venv/bin/python -m miro_ball.bench.gui_bench``.
 """
 import argparse
 import os
@@ -132,7 +132,7 @@ def measure(args):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(
-        prog='python -m miro_ball.lab.gui_bench',
+        prog='python -m miro_ball.bench.gui_bench',
         description='Eye frame latency (publish -> drawn in the page), frames per second per '
                     'eye and the GUI process CPU, with one page open in headless Chromium.')
     parser.add_argument('--seconds', type=float, default=20.0, help='measured time (20)')

@@ -7,7 +7,7 @@ Image callbacks are optional; they get each frame decoded to BGR.
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.throttle import Throttled
-from miro_ball.lab.judge import FELL_BELOW_M, KICK_DISTANCE_M, ball_moved
+from miro_ball.run.judge import FELL_BELOW_M, KICK_DISTANCE_M, ball_moved
 from miro_ball.miro.constants import WHEEL_RADIUS_M
 from miro_ball.miro.interface import CLOCK, EYES, RobotTopics, SimTopics
 

@@ -20,7 +20,7 @@ from pathlib import Path
 from miro_ball.common.isolation import isolated_env, limit_discovery, private_domain
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
-from miro_ball.lab.demo import node_commands, Processes, robot_names
+from miro_ball.demo import node_commands, Processes, robot_names
 from miro_ball.miro.interface import CLOCK
 
 RSS_TARGET_PCT = 2.0  # per 60 simulated minutes
@@ -264,7 +264,7 @@ def run(args, robots, procs, domain_id, stop):
 
     from rosgraph_msgs.msg import Clock
 
-    from miro_ball.lab.monitor import Monitor
+    from miro_ball.run.monitor import Monitor
 
     context = Context()
     rclpy.init(context=context, domain_id=domain_id)
@@ -346,7 +346,7 @@ def commands(args, robots):
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(
-        prog='python -m miro_ball.lab.soak',
+        prog='python -m miro_ball.bench.soak',
         description='Run the simulator and its controllers (and the GUI) free-running with '
                     'cameras on; every minute print RSS and open files of every process, the '
                     'real-time factor and the frames processed; at the end the growth over '

@@ -19,19 +19,21 @@ def machine():
 
 
 def markers(name):
-    return (f'<!-- {name}: written by python -m miro_ball.lab.{name} -->',
+    return (f'<!-- {name}: written by python -m miro_ball.bench.{name} -->',
             f'<!-- end of {name} -->')
 
 
 def write_section(path, name, text):
     """Put text between the markers of section ``name`` of path, replacing what was there
-    (or adding the section at the end); the rest of the file stays as it is."""
+    (or adding the section at the end); the rest of the file stays as it is. A start marker
+    is known by its name alone, so one naming an older module still counts."""
     path = Path(path)
     start, end = markers(name)
+    opening = start.split(':', 1)[0] + ':'
     old = path.read_text() if path.exists() else ''
     section = f'{start}\n{text}\n{end}\n'
-    if start in old and end in old:
-        head, _, rest = old.partition(start)
+    if opening in old and end in old:
+        head, _, rest = old.partition(opening)
         _, _, tail = rest.partition(end + '\n')
         path.write_text(head + section + tail)
     else:

@@ -1,0 +1,1 @@
+"""The benchmarks (simulator, renderers, controller, GUI, scenarios) and the soak."""

@@ -1,0 +1,1 @@
+"""Grading a controller: episodes from seeded placements, scored (python -m miro_ball.grade)."""
