@@ -10,6 +10,39 @@ from miro_ball.common.isolation import limit_discovery, private_domain
 limit_discovery()
 os.environ['ROS_DOMAIN_ID'] = str(private_domain())
 
+# Every test module is in one tier, so a contributor can run one: pytest -m unit.
+TIERS = {
+    'unit': ('pure logic, PyBullet and the renderers in-process; no ROS graph (under a minute)',
+             ('test_behaviour', 'test_convert', 'test_detection', 'test_eye_geometry',
+              'test_gui_protocol', 'test_interface', 'test_isolation', 'test_jpeg',
+              'test_layering', 'test_param_bounds', 'test_rendering', 'test_report',
+              'test_shm', 'test_sim_physics', 'test_world_file', 'test_world_fuzz')),
+    'ros': ('nodes in-process on executors of their own, a process or two beside them',
+            ('test_clients', 'test_controller_node', 'test_fuzz_params', 'test_fuzz_topics',
+             'test_gui_bridge', 'test_multi_robot', 'test_sim_executor', 'test_sim_node')),
+    'e2e': ('whole runs as processes: demo, grader, recorder, tutorial, soak, packaging',
+            ('test_closed_loop', 'test_grade', 'test_gui_packaging', 'test_packaging',
+             'test_record', 'test_restart', 'test_scenario_bench', 'test_signals',
+             'test_sim_domain', 'test_soak', 'test_tutorial')),
+    'browser': ('the GUI in Debian\'s chromium through Playwright', ('test_gui_browser',)),
+    'netns': ('hosts in network namespaces (root)', ('test_two_hosts',)),
+}
+TIER_OF = {module: tier for tier, (_, modules) in TIERS.items() for module in modules}
+
+
+def pytest_configure(config):
+    for tier, (about, _) in TIERS.items():
+        config.addinivalue_line('markers', f'{tier}: {about}')
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        tier = TIER_OF.get(item.path.stem)
+        if tier is None:
+            raise pytest.UsageError(f'{item.path.name} is in no test tier: add it to TIERS in '
+                                    'test/conftest.py')
+        item.add_marker(tier)
+
 
 @pytest.fixture(scope='session', autouse=True)
 def shared_memory_janitor():

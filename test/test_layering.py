@@ -1,0 +1,97 @@
+"""The layering rules, in one place: who may import whom.
+
+- The simulator loads no controller, GUI, example or lab code (nodes talk only over ROS).
+- MiRo's own library (miro_ball.miro) imports neither rclpy nor PyBullet.
+- No import cycles between our modules, counting imports inside functions too (a cycle
+  hidden in a function is still a cycle).
+"""
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGES = ('miro_ball', 'miro_sim_bullet')
+# What the simulator may use of miro_ball: MiRo's facts and the shared plumbing.
+SIMULATOR_MAY_USE = ('miro_ball.miro', 'miro_ball.common')
+
+
+def our_modules():
+    """{dotted name: path} of every module of our packages."""
+    found = {}
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob('*.py'):
+            parts = path.relative_to(ROOT).with_suffix('').parts
+            if parts[-1] == '__init__':
+                parts = parts[:-1]
+            found['.'.join(parts)] = path
+    return found
+
+
+def imports_of(name, path, modules):
+    """Our modules that module `name` imports anywhere in its text."""
+    package = name if path.name == '__init__.py' else name.rpartition('.')[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ''
+            if node.level:
+                base = '.'.join(package.split('.')[:len(package.split('.')) - node.level + 1]
+                                + ([base] if base else []))
+            # `from a.b import c` uses a.b, or the module a.b.c if there is one.
+            targets = [f'{base}.{alias.name}' if f'{base}.{alias.name}' in modules else base
+                       for alias in node.names]
+        else:
+            continue
+        found.update(t for t in targets if t in modules and t != name)
+    return found
+
+
+def loaded_by(module):
+    """The modules of ours that importing `module` loads, from a clean interpreter."""
+    code = (f'import sys, {module}\n'
+            'print("\\n".join(sorted(sys.modules)))')
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          timeout=120, cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    return set(done.stdout.split())
+
+
+def test_our_modules_import_in_no_cycle():
+    modules = our_modules()
+    graph = {name: imports_of(name, path, modules) for name, path in modules.items()}
+    # A package imports its __init__ on the way to a submodule: that is not a cycle.
+    for name in graph:
+        graph[name] = {t for t in graph[name] if not name.startswith(t + '.')}
+    done, cycles = set(), []
+
+    def visit(name, trail):
+        if name in trail:
+            cycles.append(trail[trail.index(name):] + [name])
+            return
+        if name in done:
+            return
+        for target in sorted(graph[name]):
+            visit(target, trail + [name])
+        done.add(name)
+
+    for name in sorted(graph):
+        visit(name, [])
+    assert not cycles, '\n'.join(' -> '.join(cycle) for cycle in cycles)
+
+
+def test_the_simulator_loads_no_controller_gui_or_lab_code():
+    simulator = sorted(m for m in our_modules()
+                       if m.startswith('miro_sim_bullet') and not m.endswith('__main__'))
+    ours = {m for m in loaded_by(', '.join(simulator)) if m.split('.')[0] == 'miro_ball'}
+    foreign = {m for m in ours - {'miro_ball'} if m not in SIMULATOR_MAY_USE
+               and not m.startswith(tuple(p + '.' for p in SIMULATOR_MAY_USE))}
+    assert not foreign, sorted(foreign)
+
+
+def test_miros_own_library_needs_neither_ros_nor_pybullet():
+    library = sorted(m for m in our_modules() if m.startswith('miro_ball.miro'))
+    loaded = loaded_by(', '.join(library))
+    assert not {m.split('.')[0] for m in loaded} & {'rclpy', 'pybullet'}
