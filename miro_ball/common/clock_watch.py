@@ -26,8 +26,9 @@ def shared_domain_line(publishers, domain):
 
 
 class ClockWatch:
-    """Keeps ``contested`` (more than ``own`` + 1 publishers on /clock, ``own`` being this
-    node's own) up to date and says so once, in one line, each time it starts."""
+    """Keeps ``contested`` (more publishers on /clock than the node's ``own``, or than the
+    one simulator a node with none of its own follows) up to date and says so once, in one
+    line, each time it starts."""
 
     def __init__(self, node, own=0):
         self.node = node
@@ -39,7 +40,7 @@ class ClockWatch:
     def check(self):
         """Look again now; True while another simulator shares the domain."""
         publishers = clock_publishers(self.node)
-        contested = len(publishers) > self.own + 1
+        contested = len(publishers) > max(self.own, 1)
         if contested and not self.contested:
             self.node.get_logger().warning(
                 shared_domain_line(publishers, self.node.context.get_domain_id()))

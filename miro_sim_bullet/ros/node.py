@@ -24,6 +24,7 @@ from sensor_msgs.msg import CompressedImage
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.common.cli import user_args
+from miro_ball.common.clock_watch import ClockWatch
 from miro_ball.common.params import declare, help_lines, LiveParams
 from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
@@ -34,6 +35,7 @@ from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.overhead import overhead_camera
 from miro_sim_bullet.render.renderer import RendererUnavailable
 from miro_sim_bullet.ros import convert
+from miro_sim_bullet.ros.domain_guard import refuse_shared_domain, SharedDomain
 from miro_sim_bullet.ros.params import SimParams
 from miro_sim_bullet.ros.robot_interface import RobotInterface
 from miro_sim_bullet.scene.world_file import WorldError, bundled_worlds
@@ -43,7 +45,7 @@ from miro_sim_bullet.scene.world_file import WorldError, bundled_worlds
 SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 FIXED_PARAMS = ('world', 'physics_dt', 'frame_width', 'frame_height',
-                'camera_rate', 'hfov_deg', 'renderer', 'eye_workers')
+                'camera_rate', 'hfov_deg', 'renderer', 'eye_workers', 'peer_check_s')
 
 
 class SimNode(Node):
@@ -51,15 +53,24 @@ class SimNode(Node):
 
     robot names the world's robot when its file names none, as --robot does (default
     $MIRO_ROBOT_NAME, else 'miro'); ValueError in one line if it can not be a ROS name.
+    guard_domain, as the command line simulator does: refuse to start (SharedDomain) when
+    another node publishes /clock on the ROS domain, and say so once, in one line, when
+    one appears later.
     """
 
-    def __init__(self, *, context=None, parameter_overrides=None, robot=None):
+    def __init__(self, *, context=None, parameter_overrides=None, robot=None,
+                 guard_domain=False):
         super().__init__(SIM_NODE_NAME, context=context,
                          parameter_overrides=parameter_overrides)
         unnamed_robot = robot_name(robot)
         self.params = p = declare(self, SimParams)
         self._live = LiveParams(self, (p,), self._apply, fixed=FIXED_PARAMS)
         self.warn = Throttled(self.get_logger().warning)
+        # Before the look for another simulator: two started together see each other.
+        self.pub_clock = self.create_publisher(ClockMsg, CLOCK, profile(CLOCK_QOS))
+        if guard_domain:  # before the world is built: a refusal costs no time
+            refuse_shared_domain(self, p.peer_check_s)
+            self._clock_watch = ClockWatch(self, own=1)
         self.sim = SimWorld(p.world, physics_dt=p.physics_dt, renderer=p.renderer,
                             log=self.get_logger().info, eye_workers=p.eye_workers,
                             robot_name=unnamed_robot)
@@ -94,7 +105,6 @@ class SimNode(Node):
 
     def _make_sim_interface(self):
         t = SimTopics()
-        self.pub_clock = self.create_publisher(ClockMsg, CLOCK, profile(CLOCK_QOS))
         self.pub_ball = self.create_publisher(PointStamped, t.ball, 10)
         names = [*self.sim.objects, *self.sim.robots]
         self.pub_objects = {name: self.create_publisher(PoseStamped, t.object_pose(name), 10)
@@ -267,11 +277,11 @@ def main(argv=None):
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     try:
-        node = SimNode(parameter_overrides=overrides, robot=args.robot)
+        node = SimNode(parameter_overrides=overrides, robot=args.robot, guard_domain=True)
         executor = make_executor()
         executor.add_node(node)
         spin_until_stopped(executor, stop)
-    except (WorldError, RendererUnavailable, ValueError) as err:
+    except (WorldError, RendererUnavailable, ValueError, SharedDomain) as err:
         print(f'{SIM_NODE_NAME}: error: {err}', file=sys.stderr)
         sys.exit(2)
     finally:

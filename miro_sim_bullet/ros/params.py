@@ -38,6 +38,11 @@ class SimParams:
     jpeg_quality: int = field(default=80,
                               metadata={'help': 'JPEG quality of sensors/cam?/compressed',
                                         'range': (1, 100)})
+    peer_check_s: float = field(
+        default=1.0, metadata={'help': 'wall seconds to look for another simulator (/clock '
+                                       'publisher) on the ROS domain before starting, and '
+                                       'refuse if there is one; 0 = do not look',
+                               'range': (0.0, 10.0)})
     overhead_rate: float = field(
         default=0.0, metadata={'help': 'frames per simulated second of ~/overhead/compressed; '
                                        '0 = off', 'range': (0.0, 100.0)})
