@@ -170,8 +170,10 @@ def test_every_client_has_help_and_refuses_bad_input(name):
 
 @pytest.mark.parametrize('module,args,env,said', [
     ('client_minimal', [], {'MIRO_ROBOT_NAME': T.name}, 'battery: 4.80 V'),
+    # There and back: it reaches both ends only if it drives the robot it reads.
     ('client_follower', ['--path', 'line', '--size', '0.1', '--ros-args', '-r',
-                         f'__ns:=/{T.name}'], {'MIRO_ROBOT_NAME': T.name + 'x'}, '0 to go'),
+                         f'__ns:=/{T.name}'], {'MIRO_ROBOT_NAME': T.name + 'x'},
+     '0 to go'),
 ])
 def test_a_client_as_a_command_drives_its_robot_and_exits_cleanly(module, args, env, said,
                                                                   paused_sim, executor):
@@ -190,7 +192,6 @@ def test_a_client_as_a_command_drives_its_robot_and_exits_cleanly(module, args, 
         kill_if_running(proc)
     assert proc.returncode == 0, output
     assert said in output and 'Traceback' not in output and 'InvalidHandle' not in output
-    assert math.hypot(*robot(paused_sim).pose()[:2]) > 0.05
 
 
 def test_a_client_waiting_for_the_simulator_says_what_for_and_ends_on_ctrl_c():

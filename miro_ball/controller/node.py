@@ -32,7 +32,6 @@ from std_msgs.msg import Float32MultiArray
 from miro_ball.common.cli import user_args
 from miro_ball.common import params
 from miro_ball.common.clock_guard import guard_clock
-from miro_ball.common.clock_watch import ClockWatch
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
@@ -131,8 +130,7 @@ class KickBlueBall(Node):
         self.last_command = None
         self.state = STARTUP
         self._warn = Throttled(self.get_logger().warning, WARN_EVERY_S)
-        guard_clock(self, self._warn)
-        self._clock_watch = ClockWatch(self)
+        self._clock_watch = guard_clock(self, self._warn)
         self.balls = [Latest() for _ in EYES]
         self.cliff = Latest()
         self.cameras = list(DEFAULT_CAMERAS)

@@ -22,7 +22,6 @@ from rclpy.signals import SignalHandlerOptions
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_guard import guard_clock
-from miro_ball.common.clock_watch import ClockWatch
 from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
@@ -83,7 +82,6 @@ class Client(Node):
         self.robot = robot_of_namespace(self.get_namespace())
         self.topics = RobotTopics()
         guard_clock(self, Throttled(self.get_logger().warning))
-        self._clock_watch = ClockWatch(self)
         self._heard = False
         self._silence_timer = self.create_timer(SILENCE_NOTICE_S, self._on_silence,
                                                 clock=Clock(clock_type=ClockType.STEADY_TIME))
