@@ -7,10 +7,10 @@ import sys
 import threading
 
 import numpy as np
-import pybullet as p
 import pytest
 
 from miro_ball.miro.camera import Intrinsics, project
+from miro_sim_bullet.bullet import pybullet as p
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render import gl_renderer
 from miro_sim_bullet.render import renderer as rendering

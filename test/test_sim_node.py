@@ -210,10 +210,10 @@ def test_cameras_render_only_while_subscribed(sim_node, executor):
 def test_bad_start_options_fail_in_one_line(args, message):
     out = subprocess.run([sys.executable, '-m', 'miro_sim_bullet', *args], capture_output=True,
                          text=True, timeout=60)
-    assert out.returncode == 2
-    errors = [line for line in out.stderr.splitlines() if line.startswith('miro_sim: error:')]
-    assert len(errors) == 1 and message in errors[0]
-    assert 'Traceback' not in out.stderr
+    assert out.returncode == 2 and out.stdout == ''
+    errors = out.stderr.splitlines()  # one line: no pybullet banner, no traceback
+    assert len(errors) == 1 and errors[0].startswith('miro_sim: error:') \
+        and message in errors[0], out.stderr
 
 
 def test_help_lists_the_parameters_and_worlds():
@@ -221,6 +221,13 @@ def test_help_lists_the_parameters_and_worlds():
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0
     assert 'real_time_factor' in out.stdout and 'bundled worlds: cube, empty, football, football_pitch, miro, petshop, tables' in out.stdout
+
+
+def test_importing_the_simulator_prints_nothing():
+    """pybullet's build-time banner stays out of users' output."""
+    out = subprocess.run([sys.executable, '-c', 'import miro_sim_bullet.ros.node'],
+                         capture_output=True, text=True, timeout=60)
+    assert (out.returncode, out.stdout, out.stderr) == (0, '', '')
 
 
 def test_run_time_parameters_apply_or_are_refused_with_a_reason(sim_node, probe, executor):

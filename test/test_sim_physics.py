@@ -23,7 +23,7 @@ def drive(sim, linear, angular, seconds):
 
 
 def test_mass_and_resting_tilt(empty):
-    import pybullet as pb
+    from miro_sim_bullet.bullet import pybullet as pb
     body = empty.robot.body_id
     total = sum(pb.getDynamicsInfo(body, link, physicsClientId=empty.client)[0]
                 for link in range(-1, pb.getNumJoints(body, physicsClientId=empty.client)))
@@ -150,7 +150,7 @@ def test_reset_restores_the_initial_state():
 
 
 def test_illum_colours_the_body_patches(empty):
-    import pybullet as pb
+    from miro_sim_bullet.bullet import pybullet as pb
     from miro_sim_bullet.physics.model import ILLUM_LINKS
     empty.robot.set_illum([0xFFFF0000, 0x8000FF00, 0, 0, 0, 0xFF0000FF])
     colours = {row[1]: row[7] for row in pb.getVisualShapeData(empty.robot.body_id,

@@ -11,10 +11,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import pybullet as pb
 
 from miro_ball.miro.constants import (CAM_DIVERGENCE_RAD, CAM_ELEVATION_RAD, JOINT_LIMITS_RAD, LIFT,
                                  PITCH, TILT_RAD, WHEEL_RADIUS_M, WHEEL_TRACK_M, YAW)
+from miro_sim_bullet.bullet import pybullet as pb
 
 AXLE_HEIGHT = WHEEL_RADIUS_M
 LIFT_JOINT_IN_BODY = (0.0022, 0.0, 0.0807 - AXLE_HEIGHT)

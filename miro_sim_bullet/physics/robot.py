@@ -7,12 +7,12 @@ every sensor, so readers get one consistent snapshot per tick (``sensors``).
 import math
 
 import numpy as np
-import pybullet as pb
 
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       KIN_CALIB_RAD, TILT_RAD, WHEEL_RADIUS_M)
 from miro_ball.miro.kinematics import clamp_wheel_speeds, cmd_vel2wheel_speed
+from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics import model as rb
 from miro_sim_bullet.physics.sensors import (SONAR_DIRECTIONS, Accelerometer, Sensors,
                                              cliff_value)

@@ -6,10 +6,9 @@ robot's eyes. Nothing here sleeps or looks at the wall clock.
 """
 import math
 
-import pybullet as pb
-
 from miro_ball.miro.constants import PLATFORM_TICK_S
 from miro_ball.miro.interface import default_robot_name
+from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.robot import MiroRobot
 from miro_sim_bullet.physics.sensors import GRAVITY
 from miro_sim_bullet.render.eye_workers import EyeWorkers

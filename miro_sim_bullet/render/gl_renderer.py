@@ -15,7 +15,8 @@ import math
 import os
 
 import numpy as np
-import pybullet as p
+
+from miro_sim_bullet.bullet import pybullet as p
 
 SUN_DIRECTION = (-0.5, 0.5, -1.0)  # where the sun's light travels (MDK worlds)
 AMBIENT = 0.4

@@ -14,8 +14,8 @@ import functools
 
 import cv2
 import numpy as np
-import pybullet as p
 
+from miro_sim_bullet.bullet import pybullet as p
 from miro_sim_bullet.render.gl_renderer import GlBackend, GlUnavailable, probe_egl, \
     view_projection
 
