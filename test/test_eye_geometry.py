@@ -9,6 +9,7 @@ from miro_ball.miro.constants import LIFT_RAD_CALIB
 from miro_ball.controller.detection import BallDetector
 from miro_ball.miro.camera import Intrinsics, project
 from miro_sim_bullet.physics.world import SimWorld
+from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.renderer import probe_egl, view_matrix_from_pose
 from miro_sim_bullet.scene.world_file import load_world
 
@@ -18,12 +19,15 @@ SMALL_BALL = 0.03  # small enough that its image centroid is its projected centr
 
 
 @pytest.fixture(params=RENDERERS)
-def sim(request, tmp_path):
+def small_ball(request, tmp_path):
+    """(a SimWorld with a small ball, its Cameras)"""
     path = tmp_path / 'small_ball.toml'
     path.write_text(f'[ball]\nradius = {SMALL_BALL}\n[ground]\nheight = 0.0\n'
                     'colour = [0.6, 0.6, 0.58]\n')
-    world = SimWorld(load_world(str(path)), renderer=request.param)
-    yield world
+    world = SimWorld(load_world(str(path)))
+    cameras = Cameras(world, request.param)
+    yield world, cameras
+    cameras.close()
     world.close()
 
 
@@ -60,13 +64,14 @@ def blue_centroid(rgb):
     ((0.7, -0.7), {-1}),      # well to the right: right eye only
     ((1.2, 0.3), {+1, -1}),
 ])
-def test_ball_appears_where_the_pinhole_model_predicts(sim, size, ball_xy, seen_by):
+def test_ball_appears_where_the_pinhole_model_predicts(small_ball, size, ball_xy, seen_by):
+    sim, cameras = small_ball
     intrinsics = Intrinsics.from_hfov(*size, 120.0)
     sim.place_ball(*ball_xy)
     sim.run(0.3)
     centre = sim.ball_position()
     for side in (+1, -1):
-        rgb, = sim.render_eyes([(sim.robot, side)], intrinsics)
+        rgb, = cameras.render_eyes([(sim.robot, side)], intrinsics)
         assert rgb.shape == (size[1], size[0], 3)
         found = blue_centroid(rgb)
         pos, rot = sim.robot.eye_pose(side)
@@ -81,15 +86,16 @@ def test_ball_appears_where_the_pinhole_model_predicts(sim, size, ball_xy, seen_
             assert found is None
 
 
-def test_ball_is_blue_after_jpeg_and_nothing_else_is(sim):
+def test_ball_is_blue_after_jpeg_and_nothing_else_is(small_ball):
     """What the controller relies on: after JPEG, its own colour mask covers the ball, lit
     side and shaded side, and nothing else (floor, walls, sky, the robot)."""
+    sim, cameras = small_ball
     intrinsics = Intrinsics.from_hfov(640, 360, 120.0)
     detector = BallDetector()
     for xy in ((1.0, 0.2), (0.5, 0.1), (0.7, 0.4)):
         sim.place_ball(*xy)
         sim.run(0.2)
-        rgb, = sim.render_eyes([(sim.robot, +1)], intrinsics)
+        rgb, = cameras.render_eyes([(sim.robot, +1)], intrinsics)
         ok, jpeg = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
         seen = detector.mask(cv2.imdecode(jpeg, cv2.IMREAD_COLOR)) > 0
         ball = blue_mask(rgb)
@@ -101,18 +107,21 @@ def test_ball_is_blue_after_jpeg_and_nothing_else_is(sim):
 
 
 def test_eye_worker_processes_render_exactly_what_the_simulator_would():
-    world = SimWorld('miro', renderer='tiny', eye_workers=True)
+    world = SimWorld('miro')
+    cameras = Cameras(world, 'tiny', eye_workers=True)
     try:
-        assert world.eye_workers is not None
+        assert cameras.eye_workers is not None
         world.robot.set_kinematic_targets([0.0, math.radians(50), math.radians(20), 0.0])
         world.robot.set_cmd_vel(0.2, 0.5)
         world.run(1.0)  # robot, head and (maybe) ball have moved since the workers' copy
         intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
         requests = [(world.robot, +1), (world.robot, -1)]
-        from_workers = world.render_eyes(requests, intrinsics)
-        in_process = [world.renderer.render(view_matrix_from_pose(*world.robot.eye_pose(side)),
-                                            intrinsics) for side in (+1, -1)]
+        from_workers = cameras.render_eyes(requests, intrinsics)
+        in_process = [cameras.renderer.render(
+            view_matrix_from_pose(*world.robot.eye_pose(side)), intrinsics)
+            for side in (+1, -1)]
         for a, b in zip(from_workers, in_process):
             assert np.array_equal(a, b)
     finally:
+        cameras.close()
         world.close()

@@ -15,6 +15,7 @@ from miro_ball.examples.ball_mover import BallMover, ball_y, parse_args
 from miro_ball.miro.camera import Intrinsics, project
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics
 from miro_sim_bullet.physics.world import SimWorld
+from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.scene.world_file import bundled_worlds
 from rostools import Probe, drain, spin_until
 
@@ -91,7 +92,8 @@ def blue_centroid(rgb):
 def test_each_robot_sees_from_its_own_eyes():
     """A ball in front of miro03 shows in miro03's eyes where the pinhole model puts it,
     and not in the eyes of miro01, turned away from it."""
-    world = SimWorld('football_pitch', renderer='tiny')
+    world = SimWorld('football_pitch')
+    cameras = Cameras(world, 'tiny')
     try:
         miro01, miro03 = world.robots['miro01'], world.robots['miro03']
         miro01.place(0.0, 0.0, math.pi)
@@ -100,7 +102,7 @@ def test_each_robot_sees_from_its_own_eyes():
         world.run(0.3)
         intrinsics = Intrinsics.from_hfov(640, 360)
         requests = [(robot, side) for robot in (miro03, miro01) for side in (+1, -1)]
-        images = world.render_eyes(requests, intrinsics)
+        images = cameras.render_eyes(requests, intrinsics)
         for (robot, side), rgb in zip(requests[:2], images[:2]):
             predicted = project(intrinsics, *robot.eye_pose(side), world.ball_position())
             found = blue_centroid(rgb)
@@ -108,6 +110,7 @@ def test_each_robot_sees_from_its_own_eyes():
         for rgb in images[2:]:
             assert blue_centroid(rgb) is None
     finally:
+        cameras.close()
         world.close()
 
 

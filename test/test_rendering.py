@@ -13,6 +13,7 @@ from miro_ball.miro.camera import Intrinsics, project
 from miro_sim_bullet.bullet import pybullet as p
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render import gl_renderer
+from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render import renderer as rendering
 from miro_sim_bullet.render.overhead import overhead_camera
 from miro_sim_bullet.render.renderer import (opengl_projection, probe_egl, Renderer,
@@ -88,14 +89,17 @@ def worlds():
 
 @pytest.fixture
 def sims():
+    """sims(world, kind) -> (SimWorld, its Cameras with a renderer of kind)."""
     made = []
 
-    def make(world, kind, **kw):
-        made.append(SimWorld(world, renderer=kind, log=lambda _: None, **kw))
+    def make(world, kind):
+        sim = SimWorld(world)
+        made.append((sim, Cameras(sim, kind, log=lambda _: None)))
         return made[-1]
 
     yield make
-    for sim in made:
+    for sim, cameras in made:
+        cameras.close()
         sim.close()
 
 
@@ -206,16 +210,16 @@ def test_colours_sun_and_ambient(worlds):
 @requires_egl
 def test_led_colour_changes_are_drawn(sims):
     """Visual colours can change at run time (control/illum): every frame reads them."""
-    sim = sims('empty', 'egl')
+    sim, cameras = sims('empty', 'egl')
     robot = sim.robot
     # A camera 0.5 m to the robot's left, looking at its flank.
     rotation = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     intrinsics = Intrinsics.from_hfov(320, 240, 60.0)
     x, y, _ = robot.pose()
     view = (np.array([x, y + 0.5, 0.1]), rotation)
-    before = sim.render_view(*view, intrinsics)
+    before = cameras.render_view(*view, intrinsics)
     robot.set_illum([0xFFFF0000] * 6)
-    after = sim.render_view(*view, intrinsics)
+    after = cameras.render_view(*view, intrinsics)
     assert colour_mask(before, 'red').sum() == 0
     assert colour_mask(after, 'red').sum() > 50
 
@@ -224,9 +228,9 @@ def test_led_colour_changes_are_drawn(sims):
 def test_overhead_view_shows_ball_and_robots_where_they_are(sims, kind):
     """The football pitch from above: the ball where the pinhole model puts it, and the
     white and grey robots, not the green pitch, at the three robots' poses."""
-    sim = sims('football_pitch', kind)
+    sim, cameras = sims('football_pitch', kind)
     position, rotation, intrinsics = overhead_camera(sim.description)
-    image = sim.render_view(position, rotation, intrinsics)
+    image = cameras.render_view(position, rotation, intrinsics)
     assert image.shape == (intrinsics.height, intrinsics.width, 3)
     want = project(intrinsics, position, rotation, sim.ball_position())
     got = centroid(image, 'blue')
@@ -244,15 +248,15 @@ def test_overhead_view_shows_ball_and_robots_where_they_are(sims, kind):
 def test_all_eyes_in_one_pass_equal_eyes_one_by_one(sims):
     """The six eyes of the football pitch drawn together, also split over several passes
     when the framebuffer holds fewer, are the images each eye gets on its own."""
-    sim = sims('football_pitch', 'egl')
+    sim, cameras = sims('football_pitch', 'egl')
     sim.run(0.3)
     intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
     requests = [(robot, side) for robot in sim.robots.values() for side in (1, -1)]
-    together = sim.render_eyes(requests, intrinsics)
-    alone = [sim.render_eyes([request], intrinsics)[0] for request in requests]
-    gl = sim.renderer._backend.gl
+    together = cameras.render_eyes(requests, intrinsics)
+    alone = [cameras.render_eyes([request], intrinsics)[0] for request in requests]
+    gl = cameras.renderer._backend.gl
     gl.max_height = 2 * intrinsics.height + 1  # two views per pass
-    in_passes = sim.render_eyes(requests, intrinsics)
+    in_passes = cameras.render_eyes(requests, intrinsics)
     for a, b, c in zip(together, alone, in_passes):
         # Identical but for a few edge pixels: llvmpipe rounds a view's window coordinates
         # a little differently at another offset in the framebuffer.
@@ -263,15 +267,15 @@ def test_all_eyes_in_one_pass_equal_eyes_one_by_one(sims):
 
 @pytest.mark.parametrize('kind', KINDS)
 def test_renderer_survives_a_world_reset(sims, kind):
-    sim = sims('miro', kind)
+    sim, cameras = sims('miro', kind)
     intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
-    first = sim.render_eyes([(sim.robot, -1)], intrinsics)[0]
+    first = cameras.render_eyes([(sim.robot, -1)], intrinsics)[0]
     sim.place_ball(0.3, 0.4)
     sim.robot.set_cmd_vel(0.2, 1.0)
     sim.run(1.0)
-    moved = sim.render_eyes([(sim.robot, -1)], intrinsics)[0]
+    moved = cameras.render_eyes([(sim.robot, -1)], intrinsics)[0]
     sim.reset()
-    again = sim.render_eyes([(sim.robot, -1)], intrinsics)[0]
+    again = cameras.render_eyes([(sim.robot, -1)], intrinsics)[0]
     assert not np.array_equal(first, moved)
     assert np.array_equal(first, again)
     pos, rot = sim.robot.eye_pose(-1)
@@ -302,12 +306,14 @@ def test_egl_renderers_coexist_and_render_from_any_thread(worlds):
 def test_no_egl_falls_back_to_tiny_with_one_log_line(monkeypatch):
     monkeypatch.setattr(rendering, 'probe_egl', lambda: (False, 'no EGL on this box'))
     log = []
-    sim = SimWorld('miro', renderer='auto', log=log.append)
+    sim = SimWorld('miro')
+    cameras = Cameras(sim, 'auto', log=log.append)
     try:
-        assert sim.renderer.name == 'tiny'
+        assert cameras.renderer.name == 'tiny'
         assert log == ['camera renderer: tiny (no EGL on this box; falling back to '
                        'TinyRenderer)']
-        image = sim.render_eyes([(sim.robot, 1)], Intrinsics.from_hfov(320, 240, 120.0))[0]
+        image = cameras.render_eyes([(sim.robot, 1)],
+                                    Intrinsics.from_hfov(320, 240, 120.0))[0]
         assert image.shape == (240, 320, 3)
         client = p.connect(p.DIRECT)
         try:
@@ -316,17 +322,20 @@ def test_no_egl_falls_back_to_tiny_with_one_log_line(monkeypatch):
         finally:
             p.disconnect(client)
     finally:
+        cameras.close()
         sim.close()
 
 
 @requires_egl
 def test_egl_logs_the_device_that_renders():
     log = []
-    sim = SimWorld('empty', renderer='auto', log=log.append)
+    sim = SimWorld('empty')
+    cameras = Cameras(sim, 'auto', log=log.append)
     try:
-        assert sim.renderer.name == 'egl' and sim.renderer.device
-        assert log == [f'camera renderer: egl (rendering on {sim.renderer.device})']
+        assert cameras.renderer.name == 'egl' and cameras.renderer.device
+        assert log == [f'camera renderer: egl (rendering on {cameras.renderer.device})']
     finally:
+        cameras.close()
         sim.close()
 
 

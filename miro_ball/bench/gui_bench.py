@@ -93,8 +93,8 @@ def measure(args):
         sim.close()
         sys.exit(f'gui_bench: error: {err}')
     url = gui.url
-    print(f'gui_bench: simulator in-process ({sim.node.sim.renderer.name}), miro_gui at {url}, '
-          f'{args.seconds:g} s measured after {args.warmup:g} s', flush=True)
+    print(f'gui_bench: simulator in-process ({sim.node.cameras.renderer.name}), miro_gui at '
+          f'{url}, {args.seconds:g} s measured after {args.warmup:g} s', flush=True)
     try:
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=CHROMIUM)

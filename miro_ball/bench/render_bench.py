@@ -28,8 +28,8 @@ def _pybullet_egl(sim):
 
     import cv2
     import numpy as np
-    import pybullet as p
 
+    from miro_sim_bullet.bullet import pybullet as p
     from miro_sim_bullet.render.renderer import opengl_projection
 
     spec = importlib.util.find_spec('eglRenderer')
@@ -53,14 +53,15 @@ def _serve(connection, kind, world):
     """Worker: builds the world with its renderer, then times batches on request."""
     from miro_ball.miro.camera import Intrinsics
     from miro_sim_bullet.physics.world import SimWorld
+    from miro_sim_bullet.render.cameras import Cameras
     from miro_sim_bullet.render.renderer import view_matrix_from_pose
 
-    sim = SimWorld(world, renderer=None if kind == 'pybullet-egl' else kind,
-                   log=lambda _: None)
+    sim = SimWorld(world)
+    cameras = None if kind == 'pybullet-egl' else Cameras(sim, kind, log=lambda _: None)
     try:
-        render = _pybullet_egl(sim) if kind == 'pybullet-egl' else sim.renderer.render_many
+        render = _pybullet_egl(sim) if cameras is None else cameras.renderer.render_many
         sim.run(0.5)
-        connection.send(('ready', kind if sim.renderer is None else sim.renderer.name))
+        connection.send(('ready', kind if cameras is None else cameras.renderer.name))
         turn = 0
         while (job := connection.recv()) is not None:
             (width, height), robots = job
@@ -75,6 +76,8 @@ def _serve(connection, kind, world):
                 times.append(time.perf_counter() - start)
             connection.send(times)
     finally:
+        if cameras is not None:
+            cameras.close()
         sim.close()
 
 

@@ -90,13 +90,13 @@ def measure(renderer, world, watched, sim_seconds, width, height, rate):
     drain()
     frames = len(received) - frames0
     figures = {
-        'renderer': node.sim.renderer.name,
+        'renderer': node.cameras.renderer.name,
         'real_time_factor': sim_time / wall,
         'frames_per_wall_s': frames / wall,
         'frames_lost': node.frames_published - published0 - frames,
         'ms_per_camera_instant': 1000 * statistics.median(node.render_seconds[renders0:]),
     }
-    workers = 0 if node.sim.eye_workers is None else len(node.sim.eye_workers.processes)
+    workers = 0 if node.cameras.eye_workers is None else len(node.cameras.eye_workers.processes)
     figures['renderer'] += f' + {workers} eye processes' if workers else ''
     node.destroy_node()  # also ends the eye processes, so their peak is known below
     # Peak memory of this process plus that of each eye process (the largest one's).

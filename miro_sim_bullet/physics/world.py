@@ -1,8 +1,9 @@
 """The simulated world without ROS: one PyBullet client, its bodies, its robots, time.
 
 SimWorld is what the ROS node wraps and what tests drive directly: build a world
-from its description, step it, move things, read the ground truth, render any
-robot's eyes. Nothing here sleeps or looks at the wall clock.
+from its description, step it, move things, read the ground truth. Nothing here
+sleeps or looks at the wall clock, and nothing draws: the cameras
+(render.cameras.Cameras) take a world and draw its client's bodies.
 """
 import math
 
@@ -11,8 +12,6 @@ from miro_ball.miro.interface import default_robot_name
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.robot import MiroRobot
 from miro_sim_bullet.physics.sensors import GRAVITY
-from miro_sim_bullet.render.eye_workers import EyeWorkers
-from miro_sim_bullet.render.renderer import Renderer, view_matrix_from_pose
 from miro_sim_bullet.scene.world_file import BALL_NAME, MAX_ROBOTS, Shape, World, load_world
 
 # Collision groups. Bit 0 stays in every mask because Bullet's ray tests carry group 1.
@@ -38,24 +37,17 @@ class SimWorld:
 
     world: a World or a bundled name / file path. robot_name names the world's robot
     when the file leaves it unnamed (default $MIRO_ROBOT_NAME or 'miro').
-    renderer: None (no cameras), 'auto', 'tiny' or 'egl'. eye_workers: with
-    TinyRenderer, render eyes in two helper processes.
+    ``generation`` counts the builds: a reset makes every body anew.
     """
 
-    def __init__(self, world='miro', physics_dt=PHYSICS_DT_S, renderer=None, log=print,
-                 eye_workers=False, robot_name=None):
+    def __init__(self, world='miro', physics_dt=PHYSICS_DT_S, robot_name=None):
         self.description = world if isinstance(world, World) else load_world(world)
         self.robot_name = robot_name or default_robot_name()
         self.dt = physics_dt
         self.ticks_per_platform_tick = max(1, round(PLATFORM_TICK_S / physics_dt))
         self.client = pb.connect(pb.DIRECT)
-        self.renderer = None if renderer is None else Renderer(self.client, kind=renderer,
-                                                               log=log)
+        self.generation = 0
         self._build()
-        self.eye_workers = None
-        if eye_workers and self.renderer is not None and self.renderer.kind == 'tiny':
-            self.eye_workers = EyeWorkers(self.description, physics_dt, self.robot_name)
-            log('eyes rendered in 2 worker processes')
 
     # -- building -----------------------------------------------------------------------------
     def _kw(self):
@@ -99,8 +91,7 @@ class SimWorld:
                               ray_mask=ALL_GROUPS & ~robot_group(index))
             robot.model.set_collision_filter(robot_group(index), ALL_GROUPS)
             self.robots[name] = robot
-        if self.renderer is not None:
-            self.renderer.scene_changed()  # new bodies (a reset rebuilds them all)
+        self.generation += 1
 
     def _shape(self, shape):
         kw = self._kw()
@@ -126,12 +117,6 @@ class SimWorld:
         self._build()
 
     def close(self):
-        if self.eye_workers is not None:
-            self.eye_workers.close()
-            self.eye_workers = None
-        if self.renderer is not None:
-            self.renderer.close()
-            self.renderer = None
         if self.client is not None and pb.isConnected(self.client):
             pb.disconnect(self.client)
         self.client = None
@@ -189,19 +174,7 @@ class SimWorld:
     def run(self, seconds):
         self.step(round(seconds / self.dt))
 
-    # -- images ---------------------------------------------------------------------------------
-    def render_eyes(self, requests, intrinsics):
-        """RGB images, one per (robot, side) in requests (side +1 left, -1 right), all of
-        this instant."""
-        views = [view_matrix_from_pose(*robot.eye_pose(side)) for robot, side in requests]
-        if self.eye_workers is None:
-            return self.renderer.render_many(views, intrinsics)
-        return self.eye_workers.render(self.snapshot(), views, intrinsics)
-
-    def render_view(self, position, rotation, intrinsics):
-        """RGB image from any camera pose (x forward, y left, z up)."""
-        return self.renderer.render(view_matrix_from_pose(position, rotation), intrinsics)
-
+    # -- copies ---------------------------------------------------------------------------------
     def snapshot(self):
         """Poses of everything that moves and each robot's joints and LEDs: enough for an
         identically built world to draw the same picture."""

@@ -9,6 +9,9 @@ import multiprocessing
 
 import numpy as np
 
+from miro_sim_bullet.physics.world import SimWorld
+from miro_sim_bullet.render.renderer import Renderer
+
 
 class EyeWorkers:
     """Processes that render in parallel; render() blocks until all are done."""
@@ -58,10 +61,8 @@ class EyeWorkers:
 
 
 def _serve(connection, world, physics_dt, robot_name):
-    from miro_sim_bullet.physics.world import SimWorld
-
-    sim = SimWorld(world, physics_dt=physics_dt, renderer='tiny', log=lambda *_: None,
-                   robot_name=robot_name)
+    sim = SimWorld(world, physics_dt=physics_dt, robot_name=robot_name)
+    renderer = Renderer(sim.client, kind='tiny', log=lambda *_: None)
     connection.send('ready')
     try:
         while True:
@@ -71,8 +72,9 @@ def _serve(connection, world, physics_dt, robot_name):
             snapshot, views, intrinsics = job
             sim.restore(snapshot)
             for view in views:
-                connection.send_bytes(sim.renderer.render(view, intrinsics).tobytes())
+                connection.send_bytes(renderer.render(view, intrinsics).tobytes())
     except (EOFError, OSError, KeyboardInterrupt):
         pass  # the simulator went away (stopped, or interrupted mid-frame)
     finally:
+        renderer.close()
         sim.close()

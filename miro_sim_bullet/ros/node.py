@@ -1,27 +1,24 @@
-"""miro_sim: the rclpy node that owns a SimWorld, paces its time and serves its ROS side.
+"""miro_sim: the rclpy node that owns a SimWorld and paces its time.
 
-Each robot of the world gets MiRo's interface under /<name>/ (RobotInterface).
-This node publishes /clock from physics time, the simulator's own topics
-(ground truth, the overhead view) and services (reset, pause, step), and takes
-set_pose requests. Either a steady wall-clock timer advances the world
-(real_time_factor 1.0 = real time, 0 = as fast as possible), or, when paused,
-the ~/step service or in-process code calls advance().
+The world's ROS side is two kinds of interface the node makes and hands what they
+need: each robot's (RobotInterface, MiRo's topics under /<name>/) and the
+simulator's own (SimInterface: ground truth, the overhead view, set_pose, reset,
+pause, step). The node itself publishes /clock from physics time and decides when
+everything is published. Either a steady wall-clock timer advances the world
+(real_time_factor 1.0 = real time, 0 = as fast as possible), or, when paused, the
+~/step service or in-process code calls advance().
 """
 import argparse
 import sys
 import time
 
 import rclpy
-from geometry_msgs.msg import PointStamped, PoseStamped
 from rclpy.clock import Clock, ClockType
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock as ClockMsg
-from sensor_msgs.msg import CompressedImage
-from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_watch import ClockWatch
@@ -30,26 +27,25 @@ from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera import Intrinsics
-from miro_ball.miro.interface import CLOCK, CLOCK_QOS, robot_name, SIM_NODE_NAME, SimTopics
+from miro_ball.miro.interface import CLOCK, CLOCK_QOS, robot_name, SIM_NODE_NAME
 from miro_sim_bullet.physics.world import SimWorld
-from miro_sim_bullet.render.overhead import overhead_camera
+from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.renderer import RendererUnavailable
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.domain_guard import refuse_shared_domain, SharedDomain
+from miro_sim_bullet.ros.endpoints import Endpoints
 from miro_sim_bullet.ros.params import SimParams
 from miro_sim_bullet.ros.robot_interface import RobotInterface
+from miro_sim_bullet.ros.sim_interface import SimInterface
 from miro_sim_bullet.scene.world_file import WorldError, bundled_worlds
 
-
-# ROS's default keeps 10 requests: a burst of 200 clients lost 190 answers.
-SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 FIXED_PARAMS = ('world', 'physics_dt', 'frame_width', 'frame_height',
                 'camera_rate', 'hfov_deg', 'renderer', 'eye_workers', 'peer_check_s')
 
 
 class SimNode(Node):
-    """MiRo-E robots in PyBullet behind MiRo's topics; see README for the topic table.
+    """MiRo-E robots in PyBullet behind MiRo's topics; see docs for the topic table.
 
     robot names the world's robot when its file names none, as --robot does (default
     $MIRO_ROBOT_NAME, else 'miro'); ValueError in one line if it can not be a ROS name.
@@ -71,23 +67,29 @@ class SimNode(Node):
         if guard_domain:  # before the world is built: a refusal costs no time
             refuse_shared_domain(self, p.peer_check_s)
             self._clock_watch = ClockWatch(self, own=1)
-        self.sim = SimWorld(p.world, physics_dt=p.physics_dt, renderer=p.renderer,
-                            log=self.get_logger().info, eye_workers=p.eye_workers,
-                            robot_name=unnamed_robot)
+        self.sim = SimWorld(p.world, physics_dt=p.physics_dt, robot_name=unnamed_robot)
+        self.cameras = Cameras(self.sim, p.renderer, log=self.get_logger().info,
+                               eye_workers=p.eye_workers)
         self.intrinsics = Intrinsics.from_hfov(p.frame_width, p.frame_height, p.hfov_deg)
-        self.overhead = overhead_camera(self.sim.description)
         self.paused = p.paused
         self.frames_published = 0
         self.render_seconds = []  # wall time of each camera instant (all eyes)
-        self.robots = {name: RobotInterface(self, name) for name in self.sim.robots}
-        self._make_sim_interface()
+        ros = Endpoints.of(self)
+        self.robots = {name: RobotInterface(name, ros, self._robot_lookup(name), self.warn)
+                       for name in self.sim.robots}
+        self.sim_interface = SimInterface(ros, self.sim, self.cameras, reset=self.reset,
+                                          pause=self.pause, step=self.step, warn=self.warn)
         self.get_logger().info(
             f'world {self.sim.description.source}; robots {", ".join(self.robots)}; renderer '
-            f'{self.sim.renderer.name}; cameras {p.frame_width}x{p.frame_height} @ '
+            f'{self.cameras.renderer.name}; cameras {p.frame_width}x{p.frame_height} @ '
             f'{p.camera_rate:g} Hz; real-time factor {p.real_time_factor:g}')
         self._restart_schedule()
         self._progress = (time.monotonic(), 0.0)
         self.timer = self._make_timer()
+
+    def _robot_lookup(self, name):
+        # The world's robots are made anew by a reset: looked up each time.
+        return lambda: self.sim.robots[name]
 
     def _make_timer(self):
         period = 0.005 if self.params.real_time_factor > 0 else 0.0
@@ -103,53 +105,25 @@ class SimNode(Node):
         self.paused = params.paused
         self._restart_schedule(keep_time=True)
 
-    def _make_sim_interface(self):
-        t = SimTopics()
-        self.pub_ball = self.create_publisher(PointStamped, t.ball, 10)
-        names = [*self.sim.objects, *self.sim.robots]
-        self.pub_objects = {name: self.create_publisher(PoseStamped, t.object_pose(name), 10)
-                            for name in names}
-        self.pub_overhead = self.create_publisher(CompressedImage, t.overhead, 2)
-        self.create_subscription(PoseStamped, t.set_pose, self._on_set_pose, 10)
-        self.srvs = [
-            self.create_service(Trigger, t.reset, self._on_reset, qos_profile=SERVICE_QOS),
-            self.create_service(SetBool, t.pause, self._on_pause, qos_profile=SERVICE_QOS),
-            self.create_service(Trigger, t.step, self._on_step, qos_profile=SERVICE_QOS),
-        ]
-
-    # -- the simulator's own interface --------------------------------------------------------
-    def _on_set_pose(self, msg):
-        try:
-            name, position, orientation = convert.pose_request(msg)
-            self.sim.set_object_pose(name, position, orientation)
-        except ValueError as err:
-            self.warn('set_pose', f'set_pose ignored: {err}')
-        except KeyError:
-            self.warn('set_pose_name', f'set_pose ignored: no object or robot named '
-                      f'{msg.header.frame_id!r} (header.frame_id); there are '
-                      f'{", ".join(self.pub_objects)}')
-
-    def _on_reset(self, request, response):
+    # -- what the simulator's services do to time ---------------------------------------------
+    def reset(self):
+        """The world back to its initial state, time and schedule from zero."""
         self.sim.reset()
         self._restart_schedule()
         self.get_logger().info('world reset')
-        response.success, response.message = True, 'world reset to its initial state'
-        return response
 
-    def _on_pause(self, request, response):
-        # Through the parameter, so that it always says whether the simulator is paused.
-        self.set_parameters([Parameter('paused', value=bool(request.data))])
-        response.success, response.message = True, 'paused' if self.paused else 'running'
-        return response
+    def pause(self, paused):
+        """Pause or run; whether paused now. Through the parameter, so that it always says
+        whether the simulator is paused."""
+        self.set_parameters([Parameter('paused', value=paused)])
+        return self.paused
 
-    def _on_step(self, request, response):
+    def step(self):
+        """(done, message): step_count physics steps, only while paused."""
         if not self.paused:
-            response.success, response.message = False, 'step works only while paused'
-            return response
+            return False, 'step works only while paused'
         self.advance(self.params.step_count)
-        response.success = True
-        response.message = f'stepped {self.params.step_count}; time {self.sim.time:.3f} s'
-        return response
+        return True, f'stepped {self.params.step_count}; time {self.sim.time:.3f} s'
 
     # -- time ---------------------------------------------------------------------------------
     def _restart_schedule(self, keep_time=False):
@@ -203,7 +177,8 @@ class SimNode(Node):
                 self._publish_tick()
             rate = self.params.overhead_rate
             if rate > 0 and sim.time >= self._next_overhead:
-                self._publish_overhead()
+                self.sim_interface.publish_overhead(convert.stamp(sim.time),
+                                                    self.params.jpeg_quality)
                 self._next_overhead += 1.0 / rate
 
     # -- publishing ---------------------------------------------------------------------------
@@ -212,35 +187,25 @@ class SimNode(Node):
         self.pub_clock.publish(ClockMsg(clock=when))
         for interface in self.robots.values():
             interface.publish_tick(when)
-        for name, (position, orientation) in self.sim.object_poses().items():
-            self.pub_objects[name].publish(convert.pose(position, orientation, when))
-        for name, robot in self.sim.robots.items():
-            self.pub_objects[name].publish(convert.robot_pose(*robot.ground_truth(), when))
-        ball = self.sim.ball_position()
-        if ball is not None:
-            self.pub_ball.publish(convert.point(ball, when))
-
-    def _publish_overhead(self):
-        if self.pub_overhead.get_subscription_count():
-            rgb = self.sim.render_view(*self.overhead)
-            self.pub_overhead.publish(convert.jpeg(rgb, convert.stamp(self.sim.time),
-                                                   'overhead', self.params.jpeg_quality))
+        self.sim_interface.publish_ground_truth(when)
 
     def _publish_cameras(self):
+        """Every eye someone subscribes to, of every robot, drawn together."""
         wanted = [(interface, eye, side) for interface in self.robots.values()
                   for eye, side in interface.wanted_eyes()]
         if not wanted:
             return
         when = convert.stamp(self.sim.time)
         started = time.perf_counter()
-        images = self.sim.render_eyes([(i.robot, side) for i, _, side in wanted],
-                                      self.intrinsics)
+        images = self.cameras.render_eyes([(i.robot, side) for i, _, side in wanted],
+                                          self.intrinsics)
         for (interface, eye, _), rgb in zip(wanted, images):
             interface.publish_eye(eye, rgb, when, self.intrinsics, self.params.jpeg_quality)
         self.frames_published += len(wanted)
         self.render_seconds.append(time.perf_counter() - started)
 
     def destroy_node(self):
+        self.cameras.close()
         self.sim.close()
         super().destroy_node()
 

@@ -3,8 +3,8 @@
 It publishes the robot's 50 Hz sensors and its eyes, and turns control messages
 into platform commands after checking them: wrong lengths and non-finite values
 are ignored, finite values out of range are clamped, both with a rate-limited
-warning. The robot is looked up by name each time, so a world reset (which
-rebuilds every robot) needs nothing from here.
+warning. The robot is looked up each time, so a world reset (which rebuilds
+every robot) needs nothing from here.
 """
 import math
 
@@ -22,18 +22,20 @@ from miro_sim_bullet.ros import convert
 
 
 class RobotInterface:
-    """The topics of robot ``name`` of ``node.sim``; warnings go to ``node.warn``."""
+    """The topics of robot ``name``: ros (Endpoints) makes them, robot() gives the robot
+    (a MiroRobot) as it is now, warn(kind, message) is a rate-limited warning."""
 
-    def __init__(self, node, name):
-        self.node = node
+    def __init__(self, name, ros, robot, warn):
         self.name = name
+        self._robot = robot
+        self._warn = lambda kind, message: warn(f'{name}:{kind}', message)
         self.topics = t = RobotTopics(name)
 
         def pub(msg_type, key, **fields):
             """A publisher of the interface's row ``key``, with the row's QoS."""
             row = TOPIC[key]
-            return node.create_publisher(msg_type, t.topic(row.name.format(**fields)),
-                                         profile(row.qos))
+            return ros.publisher(msg_type, t.topic(row.name.format(**fields)),
+                                 profile(row.qos))
 
         self.pub_eyes = {eye: (pub(CompressedImage, 'eye_compressed', eye=eye),
                                pub(Image, 'eye_raw', eye=eye),
@@ -52,8 +54,8 @@ class RobotInterface:
         self.pub_light = pub(Float32MultiArray, 'light')
         self.pub_touch = [pub(UInt16, 'touch', part=part) for part in ('head', 'body')]
         self.pub_flags = pub(UInt32, 'sensor_flags')
-        self.subs = [node.create_subscription(msg_type, getattr(t, key), callback,
-                                              profile(TOPIC[key].qos))
+        self.subs = [ros.subscription(msg_type, getattr(t, key), callback,
+                                      profile(TOPIC[key].qos))
                      for msg_type, key, callback in (
                          (TwistStamped, 'cmd_vel', self._on_cmd_vel),
                          (JointState, 'kinematic_targets', self._on_kinematic),
@@ -64,10 +66,7 @@ class RobotInterface:
 
     @property
     def robot(self):
-        return self.node.sim.robots[self.name]
-
-    def _warn(self, kind, message):
-        self.node.warn(f'{self.name}:{kind}', message)
+        return self._robot()
 
     # -- control topics -----------------------------------------------------------------------
     def _on_cmd_vel(self, msg):

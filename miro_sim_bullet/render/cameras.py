@@ -1,0 +1,47 @@
+"""The cameras of a simulated world: any robot's eyes and any camera pose, drawn from
+the world's PyBullet client (physics knows nothing of them)."""
+from miro_sim_bullet.render.eye_workers import EyeWorkers
+from miro_sim_bullet.render.renderer import Renderer, view_matrix_from_pose
+
+
+class Cameras:
+    """Images of ``world`` (a SimWorld) with a Renderer of ``kind`` ('auto', 'tiny' or
+    'egl'; RendererUnavailable if 'egl' can not be had). eye_workers: with TinyRenderer,
+    the eyes are drawn in two helper processes, each with its own copy of the world.
+    ``renderer`` tells what draws (name, device); ``eye_workers`` is None or the workers.
+    """
+
+    def __init__(self, world, kind='auto', log=print, eye_workers=False):
+        self.world = world
+        self.renderer = Renderer(world.client, kind=kind, log=log)
+        self._generation = world.generation  # the bodies the renderer has read
+        self.eye_workers = None
+        if eye_workers and self.renderer.kind == 'tiny':
+            self.eye_workers = EyeWorkers(world.description, world.dt, world.robot_name)
+            log('eyes rendered in 2 worker processes')
+
+    def _current(self):
+        """The renderer, after it has read the bodies of a rebuilt (reset) world."""
+        if self._generation != self.world.generation:
+            self.renderer.scene_changed()
+            self._generation = self.world.generation
+        return self.renderer
+
+    def render_eyes(self, requests, intrinsics):
+        """RGB images, one per (robot, side) in requests (side +1 left, -1 right), all of
+        this instant."""
+        views = [view_matrix_from_pose(*robot.eye_pose(side)) for robot, side in requests]
+        if self.eye_workers is None:
+            return self._current().render_many(views, intrinsics)
+        return self.eye_workers.render(self.world.snapshot(), views, intrinsics)
+
+    def render_view(self, position, rotation, intrinsics):
+        """RGB image from any camera pose (x forward, y left, z up)."""
+        return self._current().render(view_matrix_from_pose(position, rotation), intrinsics)
+
+    def close(self):
+        """Stop the workers and release the renderer. Idempotent."""
+        if self.eye_workers is not None:
+            self.eye_workers.close()
+            self.eye_workers = None
+        self.renderer.close()

@@ -1,0 +1,17 @@
+"""Where the simulator's interfaces make their publishers, subscriptions and services."""
+from dataclasses import dataclass
+from typing import Callable
+
+
+@dataclass(frozen=True)
+class Endpoints:
+    """The create_* functions of the node that owns the endpoints (rclpy's signatures):
+    an interface made with these needs nothing else of the node."""
+
+    publisher: Callable
+    subscription: Callable
+    service: Callable
+
+    @classmethod
+    def of(cls, node):
+        return cls(node.create_publisher, node.create_subscription, node.create_service)

@@ -1,0 +1,88 @@
+"""The simulator's own ROS interface under /miro_sim/ (SimTopics), beside each robot's.
+
+Ground truth of every movable object and robot in the 'world' frame, the overhead
+view, set_pose, and the reset, pause and step services. What these do to time (a
+reset starts the schedule over, a step advances it) belongs to the node that paces
+the world, so the services call the functions it hands in.
+"""
+from geometry_msgs.msg import PointStamped, PoseStamped
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import CompressedImage
+from std_srvs.srv import SetBool, Trigger
+
+from miro_ball.miro.interface import SimTopics
+from miro_sim_bullet.render.overhead import overhead_camera
+from miro_sim_bullet.ros import convert
+
+# ROS's default keeps 10 requests: a burst of 200 clients lost 190 answers.
+SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+OVERHEAD_FRAME = 'overhead'
+
+
+class SimInterface:
+    """The topics and services of the simulator itself.
+
+    ros: Endpoints; world: the SimWorld; cameras: its Cameras (the overhead view);
+    reset(): back to the start; pause(bool) -> whether now paused; step() ->
+    (done, message); warn(kind, message): a rate-limited warning.
+    """
+
+    def __init__(self, ros, world, cameras, *, reset, pause, step, warn):
+        self.world, self.cameras = world, cameras
+        self._reset, self._pause, self._step, self._warn = reset, pause, step, warn
+        self.overhead = overhead_camera(world.description)
+        t = SimTopics()
+        self.pub_ball = ros.publisher(PointStamped, t.ball, 10)
+        self.pub_objects = {name: ros.publisher(PoseStamped, t.object_pose(name), 10)
+                            for name in (*world.objects, *world.robots)}
+        self.pub_overhead = ros.publisher(CompressedImage, t.overhead, 2)
+        self.sub_set_pose = ros.subscription(PoseStamped, t.set_pose, self._on_set_pose, 10)
+        self.srvs = [
+            ros.service(Trigger, t.reset, self._on_reset, qos_profile=SERVICE_QOS),
+            ros.service(SetBool, t.pause, self._on_pause, qos_profile=SERVICE_QOS),
+            ros.service(Trigger, t.step, self._on_step, qos_profile=SERVICE_QOS),
+        ]
+
+    # -- requests -----------------------------------------------------------------------------
+    def _on_set_pose(self, msg):
+        try:
+            name, position, orientation = convert.pose_request(msg)
+            self.world.set_object_pose(name, position, orientation)
+        except ValueError as err:
+            self._warn('set_pose', f'set_pose ignored: {err}')
+        except KeyError:
+            self._warn('set_pose_name', f'set_pose ignored: no object or robot named '
+                       f'{msg.header.frame_id!r} (header.frame_id); there are '
+                       f'{", ".join(self.pub_objects)}')
+
+    def _on_reset(self, request, response):
+        self._reset()
+        response.success, response.message = True, 'world reset to its initial state'
+        return response
+
+    def _on_pause(self, request, response):
+        paused = self._pause(bool(request.data))
+        response.success, response.message = True, 'paused' if paused else 'running'
+        return response
+
+    def _on_step(self, request, response):
+        response.success, response.message = self._step()
+        return response
+
+    # -- publishing ---------------------------------------------------------------------------
+    def publish_ground_truth(self, when):
+        """Every movable object's and robot's pose, and the ball's centre, stamped when."""
+        world = self.world
+        for name, (position, orientation) in world.object_poses().items():
+            self.pub_objects[name].publish(convert.pose(position, orientation, when))
+        for name, robot in world.robots.items():
+            self.pub_objects[name].publish(convert.robot_pose(*robot.ground_truth(), when))
+        ball = world.ball_position()
+        if ball is not None:
+            self.pub_ball.publish(convert.point(ball, when))
+
+    def publish_overhead(self, when, jpeg_quality):
+        """The view from above, drawn only while someone subscribes."""
+        if self.pub_overhead.get_subscription_count():
+            rgb = self.cameras.render_view(*self.overhead)
+            self.pub_overhead.publish(convert.jpeg(rgb, when, OVERHEAD_FRAME, jpeg_quality))
