@@ -1,212 +1,117 @@
 """The main job: the simulator and one kick_blue_ball per robot as separate processes.
 
 It starts the nodes exactly as a user would in several shells (on a ROS domain
-of their own), watches the run through the simulator's ground truth, shows
-progress, stops the nodes cleanly and prints a summary with a line per robot.
-It also writes a video: the overhead view beside every robot's eyes with its
-controller's detections drawn.
+of their own), the simulator paused. Once every controller and the demo's own
+observer (and the recorder, if asked for) are there, it starts the clock, so the
+run is watched from its first instant. It shows progress, stops the nodes cleanly
+and prints a summary with a line per robot. It also writes a video: the overhead
+view beside every robot's eyes with its controller's detections drawn.
 """
 import argparse
-import signal
-import subprocess
 import sys
 import time
 from pathlib import Path
 
-import cv2
-import numpy as np
-
 from miro_ball.common.isolation import isolated_env, private_domain
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
-from miro_ball.miro.interface import EYES, RobotTopics, default_robot_name
+from miro_ball.recording.node import NODE_NAME as RECORDER
+from miro_ball.run.episode import SETTLE_S
+from miro_ball.run.nodes import robot_names, run_nodes
+from miro_ball.run.processes import Processes
+from miro_ball.run.video import VIDEO_FPS
 
-VIDEO_FPS = 10.0  # frames per simulated second in the video (= overhead rate)
-VIDEO_HEIGHT = 540
-CONTROLLER = 'kick_blue_ball'
-
-
-class Processes:
-    """Child processes with a log file each; stopped with Ctrl+C (SIGINT) like a user
-    would, in the order given."""
-
-    def __init__(self, commands, env, log_dir):
-        self.procs = []
-        log_dir.mkdir(parents=True, exist_ok=True)
-        for name, cmd in commands:
-            log = open(log_dir / f'{name}.log', 'w')
-            self.procs.append((name, subprocess.Popen(cmd, env=env, stdout=log,
-                                                      stderr=subprocess.STDOUT), log))
-
-    def dead(self):
-        """Name and exit code of a child that stopped on its own, or None."""
-        for name, proc, _ in self.procs:
-            if proc.poll() is not None:
-                return name, proc.returncode
-        return None
-
-    def stop(self, grace_s=10.0):
-        """Stop each child in turn (controllers before the simulator, whose /clock they
-        wait on); returns the names of those that had to be killed."""
-        killed = []
-        for name, proc, log in self.procs:
-            if proc.poll() is None:
-                proc.send_signal(signal.SIGINT)
-                try:
-                    proc.wait(timeout=grace_s)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
-                    proc.wait()
-                    killed.append(name)
-            log.close()
-        return killed
+PROGRESS_EVERY_S = 2.0  # wall
+MOST_MISSING_SHOWN = 3
 
 
-def robot_names(world, parser):
-    """The world's robot names, as the simulator will call them; a world that does not load
-    is the parser's one-line error."""
-    from miro_sim_bullet.scene.world_file import load_world
-
-    try:
-        return [spec.name or default_robot_name() for spec in load_world(world).robots]
-    except ValueError as err:  # WorldError; a bad $MIRO_ROBOT_NAME fails in the node later
-        parser.error(str(err))
-
-
-def node_commands(args, robots):
-    """(log name, command) of every node: controllers first, then the simulator (and the
-    recorder)."""
-    controllers = [
-        (f'{CONTROLLER}_{name}',
-         [sys.executable, '-m', 'miro_ball', '--ros-args', '-p', 'use_sim_time:=true',
-          '-p', f'robot_name:={name}', '-p', f'mode:={args.mode}',
-          '-p', f'seed:={args.seed + index}'])
-        for index, name in enumerate(robots)]
-    sim = [sys.executable, '-m', 'miro_sim_bullet', '--ros-args',
-           '-p', f'world:={args.world}', '-p', f'renderer:={args.renderer}',
-           '-p', f'real_time_factor:={args.real_time_factor}',
-           '-p', f'overhead_rate:={VIDEO_FPS if args.video else 0.0}']
-    # The GUI first, so it stops first: it may be driving a robot.
-    gui = [('miro_gui', [sys.executable, '-m', 'miro_ball.gui', '--port', str(args.gui_port)])]
-    return (gui if args.gui else []) + controllers + [('miro_sim', sim)] \
-        + recorder_command(args, robots)
+def start(args, robots, procs, referee, stop):
+    """Start the clock once everyone is there; None, or why the run ends before it began."""
+    deadline = time.monotonic() + args.startup_timeout
+    while missing := referee.waiting_for(robots, RECORDER if args.record else None):
+        if stop.requested:
+            return 'interrupted'
+        if procs.dead():
+            return 'node %s exited with code %s' % procs.dead()
+        if time.monotonic() > deadline:
+            return (f'not started within {args.startup_timeout:g} s, waiting for '
+                    + ', '.join(missing[:MOST_MISSING_SHOWN])
+                    + (', ...' if len(missing) > MOST_MISSING_SHOWN else ''))
+        referee.spin_once(0.05)
+    referee.start_clock()
+    return None
 
 
-def recorder_command(args, robots):
-    """The recorder, last so it stops last: every topic but the raw eye images (20 MB/s a
-    robot, the same frames as the JPEGs, and published only while someone subscribes)."""
-    if not args.record:
-        return []
-    raw_eyes = [arg for name in robots for eye in EYES
-                for arg in ('-x', RobotTopics(name).eye_raw(eye))]
-    return [('record', [sys.executable, '-m', 'miro_ball.record', '-o', args.record,
-                        *raw_eyes])]
+def xy(point):
+    """'(x, y)' in m, with no '-0.00'."""
+    return '(%.2f, %.2f)' % tuple(round(v, 2) + 0.0 for v in point[:2])
 
 
-class Video:
-    """Overhead view | every robot's eyes (one robot: left over right; several: a row
-    each), one video frame per overhead image."""
+def start_line(referee):
+    """Where the robots and the ball are at the start, as the observer first saw them."""
+    monitor = referee.monitor
+    robots = ', '.join(f'{name} at {xy(w.start)}' for name, w in monitor.robots.items())
+    return f'  started at t = {referee.elapsed:.1f} s: {robots}; the ball at ' \
+           f'{xy(monitor.ball_start)}'
 
-    def __init__(self, path, robots):
-        self.path = path
-        self.robots = robots
-        rows, self.columns = (2, 1) if len(robots) == 1 else (len(robots), 2)
-        height = VIDEO_HEIGHT // rows
-        self.panel = (height * 16 // 9, height)
-        self.eyes = [np.zeros((height, self.panel[0], 3), np.uint8)
-                     for _ in range(rows * self.columns)]
-        self.writer = None
-        self.frames = 0
 
-    def eye(self, robot_index, side, bgr):
-        slot = side if len(self.robots) == 1 else 2 * robot_index + side
-        panel = cv2.resize(bgr, self.panel, interpolation=cv2.INTER_AREA)
-        if side == 0 and len(self.robots) > 1:
-            cv2.putText(panel, self.robots[robot_index], (6, 18), cv2.FONT_HERSHEY_SIMPLEX,
-                        0.5, (0, 0, 0), 1)
-        self.eyes[slot] = panel
-
-    def overhead(self, bgr, caption):
-        rows = [np.hstack(self.eyes[i:i + self.columns])
-                for i in range(0, len(self.eyes), self.columns)]
-        eyes = np.vstack(rows)
-        frame = np.hstack([cv2.resize(bgr, (VIDEO_HEIGHT, eyes.shape[0]),
-                                      interpolation=cv2.INTER_AREA), eyes])
-        cv2.putText(frame, caption, (8, 22), cv2.FONT_HERSHEY_SIMPLEX, 0.6, (0, 0, 0), 2)
-        if self.writer is None:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self.writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter_fourcc(*'mp4v'),
-                                          VIDEO_FPS, (frame.shape[1], frame.shape[0]))
-        self.writer.write(frame)
-        self.frames += 1
-
-    def close(self):
-        if self.writer is not None:
-            self.writer.release()
+def follow(args, procs, referee, stop):
+    """Follow the run until the ball is kicked, the limit passes or a node dies; returns
+    (outcome, real-time factor)."""
+    monitor = referee.monitor
+    said_start, last_report, first_clock, outcome = False, 0.0, None, 'limit'
+    while not stop.requested:
+        referee.spin_once(0.05)
+        now = time.monotonic()
+        if first_clock is None and monitor.sim_time > referee.start_time:
+            first_clock = (now, monitor.sim_time)
+        if not said_start and monitor.ball_start and all(
+                w.start for w in monitor.robots.values()):
+            said_start = True
+            print(start_line(referee), flush=True)
+        finished = ('kicked' if monitor.kicked and monitor.sim_time > monitor.kick_time + SETTLE_S
+                    else 'limit' if referee.elapsed >= args.limit else None)
+        if finished and not args.gui:
+            outcome = finished
+            break
+        if finished and outcome != finished:  # with the GUI, the run goes on
+            outcome = finished
+            print(f'  {finished}: still running for the GUI; Ctrl+C to stop', flush=True)
+        if procs.dead():
+            outcome = 'node %s exited with code %s' % procs.dead()
+            break
+        if said_start and now - last_report >= PROGRESS_EVERY_S:
+            last_report = now
+            print(f'  t = {referee.elapsed:5.1f} s simulated, ball moved '
+                  f'{monitor.moved:4.2f} m, {monitor.frames} frames processed', flush=True)
+    else:
+        outcome = 'interrupted'
+    wall = time.monotonic() - first_clock[0] if first_clock else 0.0
+    rtf = (monitor.sim_time - first_clock[1]) / wall if first_clock and wall > 0 else 0.0
+    return outcome, rtf
 
 
 def watch(args, robots, procs, domain_id, stop):
-    """Follow the run over ROS until the ball is kicked, the limit passes or a node dies."""
-    import rclpy
-    from rclpy.context import Context
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.parameter import Parameter
+    """The run over ROS, from its start; returns (outcome, monitor, real-time factor,
+    video)."""
+    from miro_ball.run.referee import Referee, ros_domain
+    from miro_ball.run.video import Video
 
-    from miro_ball.run.monitor import Monitor
-
-    context = Context()
-    rclpy.init(context=context, domain_id=domain_id)
-    node = rclpy.create_node('miro_demo_monitor', context=context, parameter_overrides=[
-        Parameter('use_sim_time', value=True)])
     name = args.world if len(robots) > 1 else args.mode
     video = Video(Path(args.out) / f'demo_{name}.mp4', robots) if args.video else None
-    monitor = None
-
-    def on_overhead(bgr):
-        status = 'KICKED' if monitor.kicked else args.mode
-        video.overhead(bgr, f't = {monitor.sim_time:5.1f} s   {status}')
-
-    monitor = Monitor(node, robots, on_eye=video.eye if video else None,
-                      on_overhead=on_overhead if video else None)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
-    wall_start, last_report, first_clock = time.monotonic(), 0.0, None
-    outcome = 'limit'
-    try:
-        while not stop.requested:
-            executor.spin_once(timeout_sec=0.05)
-            now = time.monotonic()
-            if first_clock is None and monitor.sim_time > 0:
-                first_clock = (now, monitor.sim_time)
-            finished = ('kicked' if monitor.kicked and monitor.sim_time > monitor.kick_time + 1.0
-                        else 'limit' if monitor.sim_time >= args.limit else None)
-            if finished and not args.gui:
-                outcome = finished
-                break
-            if finished and outcome != finished:  # with the GUI, the run goes on
-                outcome = finished
-                print(f'  {finished}: still running for the GUI; Ctrl+C to stop', flush=True)
-            if procs.dead():
-                outcome = 'node %s exited with code %s' % procs.dead()
-                break
-            if first_clock is None and now - wall_start > args.startup_timeout:
-                outcome = 'no /clock from the simulator'
-                break
-            if now - last_report >= 2.0:
-                last_report = now
-                frames = sum(w.frames for w in monitor.robots.values())
-                print(f'  t = {monitor.sim_time:5.1f} s simulated, ball moved '
-                      f'{monitor.moved:4.2f} m, {frames} frames processed', flush=True)
-        else:
-            outcome = 'interrupted'
-    finally:
-        if video:
-            video.close()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
-    wall = time.monotonic() - first_clock[0] if first_clock else 0.0
-    rtf = (monitor.sim_time - first_clock[1]) / wall if first_clock and wall > 0 else 0.0
-    return outcome, monitor, rtf, video
+    rtf = 0.0
+    with ros_domain(domain_id) as context:
+        referee = Referee(context, robots, 'miro_demo', video=video, video_note=args.mode,
+                          debug_frames=True)
+        try:
+            outcome = start(args, robots, procs, referee, stop)
+            if outcome is None:
+                outcome, rtf = follow(args, procs, referee, stop)
+        finally:
+            if video:
+                video.close()
+            referee.close()
+    return outcome, referee.monitor, rtf, video
 
 
 def gui_url(log, procs, wait_s=20.0):
@@ -229,12 +134,14 @@ def summary(outcome, monitor, rtf, video, killed, record=None):
         lines.append(f'  time to kick:         {monitor.kick_time:.1f} s simulated{by}')
     lines += [f'  simulated time:       {monitor.sim_time:.1f} s',
               f'  real-time factor:     {rtf:.2f}',
-              f'  frames processed:     {sum(w.frames for w in monitor.robots.values())}']
+              f'  frames processed:     {monitor.frames}']
     for name, w in monitor.robots.items():
         lines.append(f'  robot {name + ":":<14} {w.frames} frames, '
                      f'{"FELL" if w.fell else "stayed up"}')
     if video and video.frames:
-        lines.append(f'  video:                {video.path} ({video.frames} frames)')
+        first, last = video.times
+        lines.append(f'  video:                {video.path} ({video.frames} frames, t = '
+                     f'{first:.1f} to {last:.1f} s)')
     if record:
         lines.append(f'  recording:            {record} (rosbag2, MCAP; log in record.log)')
     if killed:
@@ -285,7 +192,12 @@ def main(argv=None):
           flush=True)
     stop = StopRequest()  # Ctrl+C ends the run with a summary, and stops the nodes
     janitor = SharedMemoryJanitor()  # for what a killed node leaves in /dev/shm
-    procs = Processes(node_commands(args, robots), isolated_env(domain_id), out)
+    procs = Processes(out, isolated_env(domain_id))
+    for log, command in run_nodes(
+            robots, args.world, args.renderer, args.real_time_factor,
+            VIDEO_FPS if args.video else 0.0, paused=True, mode=args.mode, seed=args.seed,
+            gui_port=args.gui_port if args.gui else None, record=args.record):
+        procs.start(log, command)
     if args.gui:
         url = gui_url(out / 'miro_gui.log', procs)
         print(f'miro_gui: open {url} in a browser' if url else 'miro_gui did not start',

@@ -3,7 +3,7 @@
 COMMAND (a student's script, our controller, any ROS 2 program) is run as a
 process of its own against seeded placements of robot and ball, each episode
 with a fresh simulator on a ROS domain of its own and MIRO_ROBOT_NAME set. See
-miro_ball/grading/grader.py for what an episode is.
+miro_ball/run/episode.py and process_rig.py for what an episode is.
 """
 import argparse
 import shutil
@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from miro_ball.run.judge import KICK_DISTANCE_M
-from miro_ball.run.scenarios import ARENA_FREE_RADIUS
+from miro_ball.run.placements import ARENA_FREE_RADIUS
 
 EXAMPLE = 'python -m miro_ball.grade --count 5 -- python -m miro_ball --ros-args -p ' \
           'use_sim_time:=true'
@@ -81,16 +81,12 @@ def parse_args(argv):
 
 
 def options_from(args, command, p):
-    from miro_ball.demo import robot_names
-    from miro_ball.grading.grader import Options
-    from miro_ball.miro.interface import check_name
+    from miro_ball.run.nodes import robot_names
+    from miro_ball.run.process_rig import Options
     from miro_sim_bullet.scene.world_file import load_world
 
-    try:
-        world = load_world(args.world)
-        robots = [check_name(name) for name in robot_names(args.world, p)]
-    except ValueError as err:  # WorldError, a bad $MIRO_ROBOT_NAME
-        p.error(str(err))
+    robots = robot_names(args.world, p)
+    world = load_world(args.world)
     if len(robots) != 1 or world.ball is None:
         p.error(f'world {args.world}: the grader needs one robot and the ball, it has '
                 f'{len(robots)} robot(s) and {"a" if world.ball else "no"} ball')
@@ -107,7 +103,7 @@ def main(argv=None):
     from miro_ball.common.stopping import StopRequest
     from miro_ball.grading.grader import grade
     from miro_ball.grading.scores import report, to_json
-    from miro_ball.run.scenarios import placements
+    from miro_ball.run.placements import placements
 
     stop = StopRequest()
     print(f'grading: {" ".join(command)}\n  {args.count} placement(s) (seed {args.seed}) in '

@@ -11,13 +11,21 @@ import sys
 
 import pytest
 
-from miro_ball.run.scenarios import Placement, placements, run_episode
 from miro_ball.miro.interface import default_robot_name
+from miro_ball.run.episode import run_episode
+from miro_ball.run.placements import Placement, placements
+from miro_ball.run.stepped_rig import SteppedRig
+
+
+def episode(context, placement=None, limit_s=40.0, **rig):
+    """An episode of the grader's, with the simulator and our controllers in this process,
+    stepped (SteppedRig: world, mode, ...)."""
+    return run_episode(SteppedRig(context, **rig), placement, limit_s=limit_s)
 
 
 @pytest.mark.parametrize('mode', ['improved', 'tutorial'])
 def test_each_mode_kicks_the_ball_in_the_default_world(ros_context, mode):
-    outcome = run_episode(ros_context, None, mode=mode, limit_s=30.0)
+    outcome = episode(ros_context, mode=mode, limit_s=30.0)
     assert outcome.kicked and not outcome.fell, outcome
     assert outcome.frames > 0
 
@@ -28,13 +36,13 @@ def test_each_mode_kicks_the_ball_in_the_default_world(ros_context, mode):
     placements(1, seed=7)[0],                                    # a seeded random one
 ], ids=['behind', 'near-wall', 'seed7'])
 def test_improved_mode_kicks_from_other_placements(ros_context, placement):
-    outcome = run_episode(ros_context, placement, mode='improved', limit_s=40.0)
+    outcome = episode(ros_context, placement, mode='improved')
     assert outcome.kicked and not outcome.fell, outcome
 
 
 def test_three_controllers_on_the_football_pitch_kick_the_ball(ros_context):
     """COM3528's football lab: miro01..miro03, each driven by its own kick_blue_ball."""
-    outcome = run_episode(ros_context, None, world='football_pitch', limit_s=40.0)
+    outcome = episode(ros_context, world='football_pitch')
     assert outcome.kicked and not outcome.fell, outcome
     assert outcome.frames > 0
 

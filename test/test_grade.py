@@ -7,8 +7,9 @@ import sys
 import pytest
 
 from miro_ball.grade import parse_args
-from miro_ball.grading.grader import last_bytes
-from miro_ball.grading.scores import EpisodeResult, printable_tail, report, to_json, total_line
+from miro_ball.grading.scores import notes, report, to_json, total_line
+from miro_ball.run.episode import EpisodeResult
+from miro_ball.run.process_rig import last_bytes, printable_tail
 
 PY = sys.executable
 PLACE = ((0.1, 0.2, 0.5), (0.6, -0.3))
@@ -25,13 +26,13 @@ def test_an_episode_is_won_by_kicking_without_falling():
 
 
 def test_what_went_wrong_with_the_command_is_said():
-    assert result().notes == []
-    assert result(exit_code=1, exited_after_s=0.24, ended='command exited').notes == [
+    assert notes(result()) == []
+    assert notes(result(exit_code=1, exited_after_s=0.24, ended='command exited')) == [
         'exited with code 1 after 0.2 s']
-    assert result(commands=0).notes == ['never published on control/cmd_vel']
-    assert 'flooded control/cmd_vel: 20000 messages' in result(commands=100000).notes[0]
-    assert result(killed=True).notes == ['ignored Ctrl+C, killed']
-    assert result(ended='the simulator did not take the placement').notes == [
+    assert notes(result(commands=0)) == ['never published on control/cmd_vel']
+    assert 'flooded control/cmd_vel: 20000 messages' in notes(result(commands=100000))[0]
+    assert notes(result(killed=True)) == ['ignored Ctrl+C, killed']
+    assert notes(result(ended='the simulator did not take the placement')) == [
         'the simulator did not take the placement']
 
 

@@ -16,8 +16,9 @@ from std_msgs.msg import Float32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.common.isolation import isolated_env
-from miro_ball.demo import node_commands, parse_args, Processes
 from miro_ball.run.monitor import Monitor
+from miro_ball.run.nodes import controller_command, sim_command
+from miro_ball.run.processes import Processes
 from miro_ball.miro.interface import default_robot_name, RobotTopics, SimTopics
 from miro_sim_bullet.physics.robot import CMD_TIMEOUT_S
 from rostools import drain, Probe, spin_until
@@ -36,20 +37,12 @@ MOVING, AT_REST = 0.05, 0.01  # m/s or rad/s, whichever is larger
 @pytest.fixture
 def nodes(tmp_path):
     """start(log name, 'sim' | 'paused sim' | 'controller') -> the node's Popen, started
-    as the demo starts it (free-running simulator); what still runs is stopped at the end."""
-    args, _ = parse_args(['--real-time-factor', '0', '--no-video'])
-    (_, controller), (_, sim) = node_commands(args, [ROBOT])
-    commands = {'sim': sim, 'paused sim': sim + ['-p', 'paused:=true'],
-                'controller': controller}
-    env = isolated_env(int(os.environ['ROS_DOMAIN_ID']))
-    started = []
-
-    def start(name, kind):
-        started.append(Processes([(name, commands[kind])], env, tmp_path))
-        return started[-1].procs[0][1]
-    yield start
-    for procs in reversed(started):
-        procs.stop()
+    as a run starts it (a free-running simulator); what still runs is stopped at the end."""
+    commands = {'sim': sim_command('miro', real_time_factor=0.0),
+                'paused sim': sim_command('miro', real_time_factor=0.0, paused=True),
+                'controller': controller_command(ROBOT)}
+    with Processes(tmp_path, isolated_env(int(os.environ['ROS_DOMAIN_ID']))) as procs:
+        yield lambda name, kind: procs.start(name, commands[kind])
 
 
 @pytest.fixture

@@ -1,6 +1,6 @@
 """The scenario benchmark plays the same episodes whatever the number of worker processes."""
 from miro_ball.bench.scenario_bench import run, table
-from miro_ball.run.scenarios import placements
+from miro_ball.run.placements import placements
 
 
 def test_outcomes_do_not_depend_on_the_number_of_jobs():

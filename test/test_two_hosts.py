@@ -23,7 +23,8 @@ import time
 import pytest
 
 from miro_ball.common.isolation import isolated_env
-from miro_ball.demo import node_commands, parse_args, Processes
+from miro_ball.run.nodes import controller_command, sim_command
+from miro_ball.run.processes import Processes
 from miro_ball.miro.interface import default_robot_name
 
 SUBNET = '10.231.0.{}/24'  # only ever inside the two namespaces made here
@@ -113,16 +114,14 @@ def machines(request):
 def test_simulator_and_controller_on_two_machines_kick_the_ball(machines, tmp_path):
     machines, discovery = machines
     robot = default_robot_name()
-    args, _ = parse_args(['--real-time-factor', '0', '--no-video'])
-    (_, controller), (_, sim) = node_commands(args, [robot])
     observer = [sys.executable, os.path.abspath(__file__), '--observe', str(LIMIT_S)]
     env = dict(isolated_env(int(os.environ['ROS_DOMAIN_ID'])), **discovery)
+    procs = Processes(tmp_path, env)
+    observer_proc = procs.start('observer', machines.command('a', observer))
+    procs.start('kick_blue_ball', machines.command('b', controller_command(robot)))
     # The simulator waits, paused, until the observer has seen the controller.
-    sim += ['-p', 'paused:=true']
-    procs = Processes([('observer', machines.command('a', observer)),
-                       ('kick_blue_ball', machines.command('b', controller)),
-                       ('miro_sim', machines.command('a', sim))], env, tmp_path)
-    observer_proc = procs.procs[0][1]
+    procs.start('miro_sim', machines.command('a', sim_command(
+        'miro', real_time_factor=0.0, paused=True)))
     try:
         observer_proc.wait(timeout=HANG_GUARD_S + 30.0)
     finally:

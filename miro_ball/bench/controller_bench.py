@@ -82,8 +82,8 @@ def bench_latency(count):
     limit_discovery()
     context = Context()
     rclpy.init(context=context, domain_id=private_domain(salt=75))
-    node = KickBlueBall(context=context, parameter_overrides=[
-        Parameter('robot_name', value=BENCH_ROBOT), Parameter('head_hold_s', value=0.0)])
+    node = KickBlueBall(context=context, robot=BENCH_ROBOT, parameter_overrides=[
+        Parameter('head_hold_s', value=0.0)])
     probe = rclpy.create_node('bench_probe', context=context)
     twists = []
     topics = RobotTopics(BENCH_ROBOT)
@@ -129,7 +129,8 @@ def bench_latency(count):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog='python -m miro_ball.bench.controller_bench', description=__doc__,
+    parser = argparse.ArgumentParser(prog='python -m miro_ball.bench.controller_bench',
+                                     description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--frames', type=int, default=300, help='detections per case')
     parser.add_argument('--latency', type=int, default=100, help='frames for the node latency')

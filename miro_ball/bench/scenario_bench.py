@@ -2,9 +2,11 @@
 
 Success = the ball moved >= 0.3 m within the limit (60 s simulated) and the
 robot never fell. Writes BENCHMARKS.md with the table and the machine it ran
-on. Each placement and its controller seed are fixed by --seed, and episodes
-run in simulated time, so a rerun plays the same placements, whatever --jobs.
-Episodes run in --jobs worker processes, each on a ROS domain of its own.
+on. An episode is the grader's (miro_ball.run.episode) with the simulator and our
+controller stepped in one process (SteppedRig). Each placement and its controller
+seed are fixed by --seed, and episodes run in simulated time, so a rerun plays the
+same placements, whatever --jobs. Episodes run in --jobs worker processes, each on
+a ROS domain of its own.
 """
 import argparse
 import multiprocessing
@@ -27,38 +29,27 @@ def percentile(values, q):
 
 
 def _worker_init(domains, limit):
-    """Each worker takes a ROS domain of its own from the queue; the nodes' progress lines
-    would drown the benchmark's own."""
+    """Each worker takes a ROS domain of its own from the queue."""
     global _DOMAIN, _LIMIT
-    from rclpy.logging import LoggingSeverity, set_logger_level
-
-    from miro_ball.miro.interface import CONTROLLER_NODE_NAME, SIM_NODE_NAME
-
     limit_discovery()
     _DOMAIN, _LIMIT = domains.get(), limit
-    for name in (CONTROLLER_NODE_NAME, SIM_NODE_NAME):
-        set_logger_level(name, LoggingSeverity.WARN)
 
 
 def _episode(job):
-    """Runs in a worker: one episode in a fresh context; returns (job, Outcome)."""
-    import rclpy
-    from rclpy.context import Context
-
-    from miro_ball.run.scenarios import run_episode
+    """Runs in a worker: one episode in a fresh context; returns (job, EpisodeResult)."""
+    from miro_ball.run.episode import run_episode
+    from miro_ball.run.referee import ros_domain
+    from miro_ball.run.stepped_rig import SteppedRig
 
     mode, index, placement, seed, renderer = job
-    context = Context()
-    rclpy.init(context=context, domain_id=_DOMAIN)
-    try:
-        return job, run_episode(context, placement, mode=mode, limit_s=_LIMIT,
-                                renderer=renderer, seed=seed)
-    finally:
-        rclpy.try_shutdown(context=context)
+    with ros_domain(_DOMAIN) as context:
+        # The nodes' progress lines would drown the benchmark's own.
+        rig = SteppedRig(context, mode=mode, renderer=renderer, seed=seed, quiet=True)
+        return job, run_episode(rig, placement, index + 1, _LIMIT)
 
 
 def run(modes, chosen, seed, limit, renderer, jobs, report=print):
-    """{mode: [Outcome per placement]}, episodes spread over ``jobs`` processes."""
+    """{mode: [EpisodeResult per placement]}, episodes spread over ``jobs`` processes."""
     work = [(mode, index, placement, seed + index, renderer)
             for mode in modes for index, placement in enumerate(chosen)]
     context = multiprocessing.get_context('spawn')  # no fork of DDS threads
@@ -72,7 +63,7 @@ def run(modes, chosen, seed, limit, renderer, jobs, report=print):
             mark = 'kick' if outcome.success else ('FELL' if outcome.fell else 'miss')
             kicked = f'{outcome.time_to_kick:5.1f} s' if outcome.kicked else '   -   '
             report(f'  {mode:<8} {index + 1:>3}/{len(chosen)}  {mark}  {kicked}  '
-                   f'(RTF {outcome.sim_time / outcome.wall_time:.2f})')
+                   f'(RTF {outcome.real_time_factor:.2f})')
     return results
 
 
@@ -82,7 +73,7 @@ def table(results, count):
     for mode, outcomes in results.items():
         times = [o.time_to_kick for o in outcomes if o.success]
         wins = sum(o.success for o in outcomes)
-        rtf = sum(o.sim_time for o in outcomes) / sum(o.wall_time for o in outcomes)
+        rtf = sum(o.sim_time for o in outcomes) / sum(o.clock_wall_time for o in outcomes)
 
         def fmt(value):
             return '-' if value is None else f'{value:.1f} s'
@@ -108,7 +99,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     if not 1 <= args.count <= 10000 or not 0 < args.limit <= 3600 or not 1 <= args.jobs <= 64:
         parser.error('--count must be in 1..10000, --limit in (0, 3600] and --jobs in 1..64')
-    from miro_ball.run.scenarios import placements
+    from miro_ball.run.placements import placements
 
     print(f'scenario benchmark: {args.count} placements (seed {args.seed}), modes '
           f'{", ".join(args.modes)}, limit {args.limit:g} s simulated, {args.jobs} jobs',

@@ -20,12 +20,13 @@ from pathlib import Path
 from miro_ball.common.isolation import isolated_env, limit_discovery, private_domain
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
-from miro_ball.demo import node_commands, Processes, robot_names
 from miro_ball.miro.interface import CLOCK
+from miro_ball.run.nodes import robot_names, run_nodes
+from miro_ball.run.processes import Processes
 
 RSS_TARGET_PCT = 2.0  # per 60 simulated minutes
 RTF_TREND_LIMIT_PCT = 10.0  # fitted change over the run, of the mean: the machine is shared
-GUI_MODULE = 'miro_ball.gui'  # started by the demo's node_commands
+GUI_MODULE = 'miro_ball.gui'  # started by run_nodes
 SECONDS_PER_MINUTE = 60.0
 MAX_CLOCK_STEP_S = 1.0  # /clock moves 0.02 s a message: more is a jump, not time passing
 
@@ -246,9 +247,8 @@ def summary_lines(samples):
 
 def usage(procs):
     """{label: (RSS MB, fds)} of every node process and its descendants that is alive."""
-    named = [(name, proc.pid) for name, proc, _ in procs.procs if proc.poll() is None]
     figures = {}
-    for label, pid in process_tree(named).items():
+    for label, pid in process_tree(procs.pids().items()).items():
         rss, fds = rss_mb(pid), fd_count(pid)
         if rss is not None and fds is not None:
             figures[label] = (rss, fds)
@@ -259,55 +259,51 @@ def run(args, robots, procs, domain_id, stop):
     """Sample at the first /clock, then every interval until the time is up, a node dies
     or Ctrl+C; returns (samples, why it ended)."""
     import rclpy
-    from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
-
     from rosgraph_msgs.msg import Clock
 
-    from miro_ball.run.monitor import Monitor
+    from miro_ball.run.monitor import Monitor, seconds
+    from miro_ball.run.referee import ros_domain
 
-    context = Context()
-    rclpy.init(context=context, domain_id=domain_id)
-    node = rclpy.create_node('miro_soak_monitor', context=context)
-    monitor = Monitor(node, robots)
-    simulated = SimulatedTime()
-    node.create_subscription(
-        Clock, CLOCK, lambda msg: simulated.update(msg.clock.sec + msg.clock.nanosec * 1e-9),
-        100)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
+    with ros_domain(domain_id) as context:
+        node = rclpy.create_node('miro_soak_monitor', context=context)
+        monitor = Monitor(node, robots)
+        simulated = SimulatedTime()
+        node.create_subscription(Clock, CLOCK, lambda msg: simulated.update(seconds(msg.clock)),
+                                 100)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        try:
+            return _sample(args, procs, stop, executor, monitor, simulated)
+        finally:
+            node.destroy_node()
 
-    def frames():
-        return sum(w.frames for w in monitor.robots.values())
 
+def _sample(args, procs, stop, executor, monitor, simulated):
     samples, outcome = [], 'done'
     started = time.monotonic()
-    try:
-        while simulated.last is None:  # the nodes are up once /clock runs
-            if stop.requested or time.monotonic() - started > args.startup_timeout:
-                return samples, 'interrupted' if stop.requested else 'no /clock'
-            executor.spin_once(timeout_sec=0.1)
-        start = Sample(time.monotonic(), simulated.elapsed, frames(), usage(procs))
-        samples.append(start)
-        end = start.wall + args.minutes * SECONDS_PER_MINUTE
-        while not stop.requested:
-            executor.spin_once(timeout_sec=0.05)
-            now = time.monotonic()
-            if procs.dead():
-                outcome = 'node %s exited with code %s' % procs.dead()
+    while simulated.last is None:  # the nodes are up once /clock runs
+        if stop.requested or time.monotonic() - started > args.startup_timeout:
+            return samples, 'interrupted' if stop.requested else 'no /clock'
+        executor.spin_once(timeout_sec=0.1)
+    start = Sample(time.monotonic(), simulated.elapsed, monitor.frames, usage(procs))
+    samples.append(start)
+    end = start.wall + args.minutes * SECONDS_PER_MINUTE
+    while not stop.requested:
+        executor.spin_once(timeout_sec=0.05)
+        now = time.monotonic()
+        if procs.dead():
+            outcome = 'node %s exited with code %s' % procs.dead()
+            break
+        if now - samples[-1].wall >= args.report_every or now >= end:
+            sample = Sample(now, simulated.elapsed, monitor.frames, usage(procs),
+                            simulated.jumps)
+            print('\n'.join(sample_lines(start, samples[-1], sample)), flush=True)
+            samples.append(sample)
+            if now >= end:
                 break
-            if now - samples[-1].wall >= args.report_every or now >= end:
-                sample = Sample(now, simulated.elapsed, frames(), usage(procs),
-                                simulated.jumps)
-                print('\n'.join(sample_lines(start, samples[-1], sample)), flush=True)
-                samples.append(sample)
-                if now >= end:
-                    break
-        else:
-            outcome = 'interrupted'
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
+    else:
+        outcome = 'interrupted'
     return samples, outcome
 
 
@@ -315,33 +311,21 @@ def idle_domain(first, tries=10, listen_s=2.0):
     """The first ROS domain from ``first`` on (1..100) where no node shows up within
     listen_s, or None: another run's /clock or ~/reset would spoil the figures."""
     import rclpy
-    from rclpy.context import Context
+
+    from miro_ball.run.referee import ros_domain
 
     for k in range(tries):
         domain = 1 + (first - 1 + k) % 100
-        context = Context()
-        rclpy.init(context=context, domain_id=domain)
-        try:
+        with ros_domain(domain) as context:
             node = rclpy.create_node('miro_soak_domain_check', context=context)
             time.sleep(listen_s)  # discovery runs in the middleware's own threads
             others = sorted(set(node.get_node_names()) - {node.get_name()})
             node.destroy_node()
-        finally:
-            rclpy.try_shutdown(context=context)
         if not others:
             return domain
         print(f'soak: ROS domain {domain} is in use ({", ".join(others[:3])}), trying the next',
               flush=True)
     return None
-
-
-def commands(args, robots):
-    """(log name, command) of the nodes, in the order they are stopped: the GUI, the
-    controllers, then the simulator, whose /clock the others wait on."""
-    demo_args = argparse.Namespace(mode='improved', seed=1, world=args.world,
-                                   renderer=args.renderer, real_time_factor=0.0, video=False,
-                                   gui=args.gui, gui_port=0, record=None)
-    return node_commands(demo_args, robots)
 
 
 def parse_args(argv):
@@ -387,7 +371,10 @@ def main(argv=None):
           f'ROS domain {domain_id}; logs in {logs}/', flush=True)
     stop = StopRequest()
     janitor = SharedMemoryJanitor()  # for what a killed node leaves in /dev/shm
-    procs = Processes(commands(args, robots), isolated_env(domain_id), logs)
+    procs = Processes(logs, isolated_env(domain_id))
+    for log, command in run_nodes(robots, args.world, args.renderer, real_time_factor=0.0,
+                                  gui_port=0 if args.gui else None):
+        procs.start(log, command)
     try:
         samples, outcome = run(args, robots, procs, domain_id, stop)
     finally:

@@ -1,0 +1,102 @@
+"""The nodes of a run as child processes: started by name with a log file each, stopped
+as a user stops them (Ctrl+C), killed if they do not, and nothing of theirs left behind.
+
+Each child leads a process group (and session) of its own, so a Ctrl+C in the
+terminal reaches only the program that started them, which stops them one by one in
+the order they were started (a controller before the simulator whose /clock it waits
+on). Stopping one is what a terminal does to a foreground job: SIGINT to its whole
+group (a shell script passes nothing on to the program it waits for); after the
+grace period SIGKILL to the group; and once its leader is gone, SIGKILL to whatever
+of the group is still there (the simulator's eye workers, a student's helpers).
+"""
+import os
+import signal
+import subprocess
+from dataclasses import dataclass
+
+
+@dataclass
+class Child:
+    name: str
+    proc: subprocess.Popen
+    log: object  # its open log file
+
+
+class Processes:
+    """Children started in a run: ``start`` them, ask which one ``dead``, ``stop`` them all.
+    As a context manager, they are stopped at the end of the block."""
+
+    def __init__(self, log_dir, env=None):
+        """log_dir: where each child's <name>.log goes; env: their environment (default
+        this process's)."""
+        self.log_dir = log_dir
+        self.env = env
+        self.children = []
+        log_dir.mkdir(parents=True, exist_ok=True)
+
+    def start(self, name, command, env=None):
+        """Start command as child ``name`` (its output in <name>.log); returns its Popen.
+        OSError if it can not be started."""
+        log = open(self.log_dir / f'{name}.log', 'w')
+        try:
+            proc = subprocess.Popen(command, env=self.env if env is None else env, stdout=log,
+                                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                    start_new_session=True)
+        except OSError:
+            log.close()
+            raise
+        self.children.append(Child(name, proc, log))
+        return proc
+
+    def dead(self):
+        """Name and exit code of a child that stopped on its own, or None."""
+        for child in self.children:
+            if child.proc.poll() is not None:
+                return child.name, child.proc.returncode
+        return None
+
+    def pids(self):
+        """{name: pid} of the children still running."""
+        return {child.name: child.proc.pid for child in self.children
+                if child.proc.poll() is None}
+
+    def stop(self, grace_s=10.0):
+        """Stop every child in the order started; returns the names of those that had to be
+        killed (they ignored Ctrl+C for grace_s)."""
+        killed = []
+        for child in self.children:
+            if not stop_group(child.proc, grace_s):
+                killed.append(child.name)
+            child.log.close()
+        self.children = []
+        return killed
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *_):
+        self.stop()
+
+
+def stop_group(proc, grace_s):
+    """Ctrl+C to proc's process group, SIGKILL after grace_s, then SIGKILL to what is left
+    of the group; False if proc itself had to be killed."""
+    stopped = True
+    if proc.poll() is None:
+        _signal_group(proc.pid, signal.SIGINT)
+        try:
+            proc.wait(timeout=grace_s)
+        except subprocess.TimeoutExpired:
+            stopped = False
+            _signal_group(proc.pid, signal.SIGKILL)
+            proc.wait()
+    # The group's id can not be taken by another process while any member is alive.
+    _signal_group(proc.pid, signal.SIGKILL)
+    return stopped
+
+
+def _signal_group(pgid, signum):
+    try:
+        os.killpg(pgid, signum)
+    except ProcessLookupError:  # nobody left in the group
+        pass
