@@ -2,6 +2,8 @@
 recorded topics, their ROS 2 Jazzy types, every message and simulated-time log times."""
 import errno
 import os
+import resource
+import shlex
 import signal
 import subprocess
 import sys
@@ -11,18 +13,21 @@ from mcap.reader import make_reader
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore
 from ruamel.yaml import YAML
+from std_msgs.msg import String
 
 from miro_ball.common.isolation import isolated_env
-from miro_ball.recording.bag import SplitBag, offered_qos
+from miro_ball.recording.bag import SplitBag, describe, offered_qos
 from miro_ball.recording.node import Recorder, RecordingFailed
 from miro_ball.recording.selection import Progress, Selection, cdr_stamp_ns, has_stamp, log_time_ns
 from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
 from rostools import Probe, advance_ticks, advance_until, kill_if_running, run_command, spin_until
+import test_tutorial as tutorial
 
 ROBOT = RobotTopics(default_robot_name())
 TYPES = get_typestore(Stores.ROS2_JAZZY)
@@ -43,6 +48,17 @@ def ns(stamp):
     return stamp.sec * 10**9 + stamp.nanosec
 
 
+def visible(folder):
+    """What a user sees in a folder (ls): its entries but the hidden ones."""
+    return sorted(p.name for p in folder.iterdir() if not p.name.startswith('.'))
+
+
+def listed(bag):
+    """What a bag's metadata.yaml lists, and metadata.yaml itself."""
+    info = YAML(typ='safe').load((bag / 'metadata.yaml').read_text())
+    return sorted(info['rosbag2_bagfile_information']['relative_file_paths'] + ['metadata.yaml'])
+
+
 # -- the pure parts -------------------------------------------------------------------------------
 def test_a_robot_name_selects_its_topics_and_ground_truth_only():
     other = RobotTopics('other')
@@ -58,6 +74,18 @@ def test_a_robot_name_selects_its_topics_and_ground_truth_only():
     assert not topics.wants(ROBOT.cliff)
     with pytest.raises(ValueError):
         Selection(['9lives'])
+
+
+def test_raw_eye_images_only_when_asked_for_or_named():
+    raw, other_raw = ROBOT.eye_raw('caml'), RobotTopics('other').eye_raw('camr')
+    for selection in (Selection(), Selection([ROBOT.name]), Selection([ROBOT.topic('sensors/*')])):
+        assert not selection.wants(raw) and selection.leaves_out_raw(raw)
+        assert selection.wants(ROBOT.eye_compressed('caml'))
+        assert selection.wants(ROBOT.camera_info('caml'))
+    assert Selection(raw_images=True).wants(raw) and Selection(raw_images=True).wants(other_raw)
+    named = Selection([raw, 'other'])  # named as a topic: recorded; other's are not named
+    assert named.wants(raw) and not named.wants(other_raw) and named.leaves_out_raw(other_raw)
+    assert not Selection([ROBOT.odom]).leaves_out_raw(raw)  # not selected anyway: no word
 
 
 def test_stamps_come_from_the_first_field_when_it_is_a_time():
@@ -82,7 +110,6 @@ def test_progress_says_how_many_topics_run_at_which_rate_and_which_went_silent()
     assert progress.line(2.5, 2.0).endswith('per topic 50/s x 2, 0.5/s x 1')
     progress.count(ROBOT.odom)
     assert progress.line(3.0, 2.0).endswith(f'0.5/s x 1; silent: {CLOCK}, {ROBOT.cliff}')
-    assert progress.summary()[0].split() == [CLOCK, '1']
 
 
 def test_a_write_error_leaves_the_finished_files_a_bag(tmp_path):
@@ -97,8 +124,28 @@ def test_a_write_error_leaves_the_finished_files_a_bag(tmp_path):
     recorded = read_bag(tmp_path / 'bag')[CLOCK][1]
     assert [t for t, _ in recorded] == [i * 10**9 for i in range(len(recorded))]
     assert len(recorded) == 16 and bag.split_index == 4
+    assert visible(tmp_path / 'bag') == listed(tmp_path / 'bag')  # and nothing else
+    assert not (tmp_path / 'bag' / '.unfinished').exists()
+    # What it says is what the bag holds: the finished files, not the messages written.
+    said = describe(bag.path, bag.contents())
+    assert said[0] == f'{bag.path}: a readable bag of 4 file(s), 16 messages on 1 topics, ' \
+                      't = 0.0 to 15.0 s simulated'
+    assert said[1].split() == [CLOCK, '16']
     with pytest.raises(ValueError):
         SplitBag(tmp_path / 'bag')  # never overwrites a bag
+
+
+def test_a_write_error_before_anything_was_finished_leaves_no_folder(tmp_path):
+    for existed in (False, True):
+        path = tmp_path / f'bag{existed}'
+        if existed:
+            path.mkdir()  # the user's own empty folder stays
+        bag = SplitBag(path)
+        bag.add_topic(CLOCK, 'rosgraph_msgs/msg/Clock', offered_qos(True, False, 10))
+        bag.write(CLOCK, 10**9, serialize_message(Clock(clock=Time(sec=1))))
+        bag.abort()
+        assert describe(path, bag.contents()) == [f'{path}: nothing was finished: no bag written']
+        assert path.exists() == existed and (not existed or not any(path.iterdir()))
 
 
 # -- against the simulator, in-process --------------------------------------------------------
@@ -107,11 +154,18 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
     bag = SplitBag(tmp_path / 'bag')
     recorder = Recorder(bag, Selection(exclude=[ROBOT.eye_raw('cam?')]), context=ros_context)
     executor.add_node(recorder)
-    advance_ticks(paused_sim, executor)  # the first /clock starts the recording
+    # Subscribed before the clock runs (the demo waits for that to start it); a latched
+    # topic's message from before is held for the first /clock.
+    latched = Probe(ros_context, executor, 'early').node.create_publisher(
+        String, '/latched', QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL))
+    latched.publish(String(data='before the clock'))
     interface = paused_sim.robots[ROBOT.name]
     assert spin_until(executor, lambda: interface.pub_odom.get_subscription_count()
                       and interface.pub_cliff.get_subscription_count()
-                      and interface.pub_eyes['caml'][0].get_subscription_count())
+                      and interface.pub_eyes['caml'][0].get_subscription_count()
+                      and latched.get_subscription_count())
+    advance_ticks(paused_sim, executor)  # the first /clock starts the recording
+    first_clock = round(paused_sim.sim.time * 1e9)
     start = paused_sim.sim.time
     advance_ticks(paused_sim, executor, 50)  # 1 s
     # A node that starts late is found (topics are looked up every second of wall time).
@@ -129,16 +183,17 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
     assert recorded[ROBOT.eye_compressed('caml')][0] == 'sensor_msgs/msg/CompressedImage'
     assert recorded[CLOCK][0] == 'rosgraph_msgs/msg/Clock'
     assert ROBOT.eye_raw('caml') not in recorded  # excluded
-    # Every tick after the subscription was made, nothing lost, at the message's own stamp.
-    odom = recorded[ROBOT.odom][1]
+    assert [(t, m.data) for t, m in recorded['/latched'][1]] == [(first_clock, 'before the clock')]
+    # Every tick after the first, nothing lost, at the message's own stamp.
+    odom = [(t, m) for t, m in recorded[ROBOT.odom][1] if t > first_clock]
     assert len(odom) == 50
     assert [t for t, _ in odom] == [ns(m.header.stamp) for _, m in odom]
     assert [t for t, _ in odom] == [round((start + 0.02 * (i + 1)) * 1e9) for i in range(50)]
     # Without a stamp: the /clock of the tick that carried it.
-    assert [t for t, _ in recorded[ROBOT.cliff][1]] == [t for t, _ in odom]
+    assert [t for t, _ in recorded[ROBOT.cliff][1] if t > first_clock] == [t for t, _ in odom]
     assert list(recorded[ROBOT.cliff][1][-1][1].data) == [1.0, 1.0]
     assert [t for t, _ in recorded[ROBOT.cmd_vel][1]] == [odom[-1][0]]
-    images = recorded[ROBOT.eye_compressed('caml')][1]
+    images = [(t, m) for t, m in recorded[ROBOT.eye_compressed('caml')][1] if t > first_clock]
     assert len(images) == 15  # 15 Hz for 1 s
     assert all(t == ns(m.header.stamp) for t, m in images)
     assert bytes(images[-1][1].data[:2]) == b'\xff\xd8'  # a JPEG, as published
@@ -155,7 +210,7 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
         assert schemas[odom.schema_id].name == 'nav_msgs/msg/Odometry'
         assert schemas[odom.schema_id].encoding == 'ros2msg'
         counted = sum(1 for _, channel, _ in reader.iter_messages(topics=[ROBOT.odom]))
-        assert counted == 50
+        assert counted == len(recorded[ROBOT.odom][1])
 
 
 def test_a_full_disk_ends_the_recording_and_keeps_the_finished_files(
@@ -164,9 +219,10 @@ def test_a_full_disk_ends_the_recording_and_keeps_the_finished_files(
     bag = SplitBag(tmp_path / 'bag', split_s=1.0, clock=lambda: now[0])
     recorder = Recorder(bag, Selection([ROBOT.odom]), context=ros_context)
     executor.add_node(recorder)
-    advance_ticks(paused_sim, executor)
     interface = paused_sim.robots[ROBOT.name]
     assert spin_until(executor, lambda: interface.pub_odom.get_subscription_count())
+    advance_ticks(paused_sim, executor)  # the first /clock
+    first_clock = round(paused_sim.sim.time * 1e9)
     advance_ticks(paused_sim, executor, 25)
     now[0] = 1.0
     bag.tick()  # the first file is finished
@@ -178,16 +234,21 @@ def test_a_full_disk_ends_the_recording_and_keeps_the_finished_files(
         advance_ticks(paused_sim, executor, 5)
     executor.remove_node(recorder)
     recorder.destroy_node()
-    stamps = [t for t, _ in read_bag(tmp_path / 'bag')[ROBOT.odom][1]]
+    stamps = [t for t, _ in read_bag(tmp_path / 'bag')[ROBOT.odom][1] if t > first_clock]
     assert len(stamps) == 25 and all(b - a == TICK_NS for a, b in zip(stamps, stamps[1:]))
-    assert not (tmp_path / 'bag' / 'bag_1').exists()  # the unfinished file is gone
+    assert visible(tmp_path / 'bag') == listed(tmp_path / 'bag') == ['bag_0.mcap', 'metadata.yaml']
+    assert not (tmp_path / 'bag' / '.unfinished').exists()  # the unfinished file is gone
 
 
 # -- the command, as a child process --------------------------------------------------------------
-def start_recorder(*args):
+def start_recorder(*args, disk_bytes=None):
+    """The command; disk_bytes: a file size limit, standing in for a small disk."""
     env = isolated_env(int(os.environ['ROS_DOMAIN_ID']))
+    limit = disk_bytes and (lambda: resource.setrlimit(resource.RLIMIT_FSIZE,
+                                                       (disk_bytes, disk_bytes)))
     return subprocess.Popen([sys.executable, '-m', 'miro_ball.record', *args], env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            preexec_fn=limit)
 
 
 def finished_count(bag, topic):
@@ -223,18 +284,54 @@ def test_the_command_records_a_robot_until_ctrl_c_twice(tmp_path, executor, paus
     assert f'{tmp_path / "bag"}: ' in output  # the summary
 
 
-def test_a_killed_recorder_leaves_a_readable_bag(tmp_path, executor, paused_sim):
+def test_a_killed_recorder_leaves_a_readable_bag_or_nothing_like_one(
+        tmp_path, executor, paused_sim):
+    # Killed in its first split (10 s by default), with messages written: the folder looks
+    # empty, not like a bag.
+    first = tmp_path / 'first'
+    proc = start_recorder('-o', str(first), ROBOT.odom)
+    try:
+        advance_until(paused_sim, executor,
+                      lambda: paused_sim.robots[ROBOT.name].pub_odom.get_subscription_count())
+        advance_ticks(paused_sim, executor, 20)
+    finally:
+        proc.kill()
+        proc.communicate()
+    assert visible(first) == [] and any(first.rglob('*.mcap'))  # written, but hidden
+    # Killed after finishing splits: what was finished is a bag, and nothing else is in sight.
     bag = tmp_path / 'bag'
     proc = start_recorder('-o', str(bag), ROBOT.odom, '--split-seconds', '0.2')
     try:
         advance_until(paused_sim, executor, lambda: (bag / 'metadata.yaml').exists())
-        for _ in range(20):
-            advance_ticks(paused_sim, executor)
+        advance_ticks(paused_sim, executor, 20)
+        with pytest.raises(ValueError, match='being recorded into by another recorder'):
+            SplitBag(bag)  # while it records, nobody else takes the folder
     finally:
         proc.kill()
         proc.communicate()
     stamps = [t for t, _ in read_bag(bag)[ROBOT.odom][1]]
     assert stamps and all(b - a == TICK_NS for a, b in zip(stamps, stamps[1:]))
+    assert visible(bag) == listed(bag)
+    # The next recorder given the first folder cleans up after the killed one and uses it.
+    again = SplitBag(first)
+    again.close()
+    assert sorted(p.name for p in first.iterdir()) == listed(first)
+
+
+def test_a_full_disk_in_the_first_split_says_no_bag_was_written(tmp_path, executor, paused_sim):
+    bag = tmp_path / 'bag'
+    # The raw eyes (0.7 MB a frame) onto a small disk, with the default split (10 s).
+    proc = start_recorder('-o', str(bag), ROBOT.name, '--raw-images', disk_bytes=4 * 2**20)
+    try:
+        advance_until(paused_sim, executor, lambda: proc.poll() is not None)
+        output, _ = proc.communicate(timeout=20)
+    finally:
+        kill_if_running(proc)
+    assert proc.returncode == 1, output
+    assert f'recording {ROBOT.eye_raw("caml")} ' in output
+    assert f'{bag}: nothing was finished: no bag written' in output
+    assert 'readable' not in output and 'Traceback' not in output
+    assert not bag.exists()
 
 
 def test_bad_arguments_are_one_line_errors(tmp_path):
@@ -254,7 +351,7 @@ def test_the_main_job_records_every_node_of_the_run(tmp_path):
     bag = tmp_path / 'run'
     # In real time, as the main job runs: free-running, the whole run can be over before
     # the controller's publisher has matched the recorder's new subscription.
-    cmd = [sys.executable, '-m', 'miro_ball.lab.demo', '--no-video', '--limit', '3',
+    cmd = [sys.executable, '-m', 'miro_ball.demo', '--no-video', '--limit', '3',
            '--real-time-factor', '1', '--out', str(tmp_path), '--record', str(bag)]
     _, output = run_command(cmd)
     assert f'recording:            {bag}' in output and 'FAILED' not in output, output
@@ -268,3 +365,41 @@ def test_the_main_job_records_every_node_of_the_run(tmp_path):
     # Simulated time: the run (3 s, and on while the nodes are stopped), not wall time.
     assert 2.5e9 < commands[-1] < 60e9
     assert 'Traceback' not in (tmp_path / 'record.log').read_text()
+
+
+def test_five_seconds_of_the_tutorials_recording_stay_under_10_mb(tmp_path, ros_context, executor):
+    # The simulator, the controller and then the recorder, as the tutorial has them typed.
+    shells = [(shell, shlex.split(body)) for kind, shell, body
+              in tutorial.steps(tutorial.TUTORIAL.read_text()) if kind == 'background']
+
+    def typed(module):
+        return next((shell, words) for shell, words in shells
+                    if any(words[i:i + 2] == ['-m', module] for i in range(len(words))))
+    sim, controller = typed('miro_sim_bullet'), typed('miro_ball')
+    record = typed('miro_ball.record')
+    bag = tmp_path / record[1][record[1].index('-o') + 1]
+    reader = tutorial.Reader(tmp_path)
+    probe = Probe(ros_context, executor)
+    clock, commands = probe.watch(Clock, CLOCK), probe.watch(TwistStamped, ROBOT.cmd_vel)
+    try:
+        for shell, words in (sim, controller):
+            reader.start(shell, shlex.join(words))
+        assert spin_until(executor, lambda: commands, 60)  # the controller is driving
+        reader.start(record[0], shlex.join(record[1]))
+        log = reader.shells[record[0]][1]
+        assert spin_until(executor, lambda: 'got /clock' in log.read_text(), 60)
+        # Six simulated seconds: the first goes to finding the topics and matching them.
+        start = ns(clock[-1].clock)
+        assert spin_until(executor, lambda: ns(clock[-1].clock) >= start + 6 * 10**9, 60)
+        reader.check_shells('recording')
+        for shell in (record, controller, sim):
+            reader.ctrl_c(shell[0])
+    finally:
+        reader.close()
+    with Reader(bag) as recorded:
+        seconds = recorded.duration * 1e-9
+        topics = {c.topic for c in recorded.connections if c.msgcount}
+    size = sum(f.stat().st_size for f in bag.iterdir())
+    assert seconds >= 5 and {ROBOT.eye_compressed('caml'), ROBOT.cmd_vel} <= topics
+    assert ROBOT.eye_raw('caml') not in topics and ROBOT.eye_raw('camr') not in topics
+    assert size / seconds * 5 < 10 * 10**6, f'{size / 1e6:.1f} MB for {seconds:.1f} s'

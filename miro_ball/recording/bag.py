@@ -7,9 +7,16 @@ lose everything. Hence the bag is written in splits, as `ros2 bag record
 and metadata.yaml is rewritten (atomically) to list every finished file. A hard
 stop loses at most the last split; what came before stays a valid bag.
 
-Each split is written by rosbags' Writer in a directory of its own inside the
-bag (the Writer makes a fresh directory per bag) and moved up when finished.
+The split in progress is written by rosbags' Writer in a hidden folder inside the
+bag, `.unfinished/` (the Writer makes a fresh folder per bag), and moved up when
+finished; metadata.yaml never lists it. So whatever stops the recorder, the bag
+folder shows only finished files: after a SIGKILL before the first split it looks
+empty, never like a bag. While it records, the recorder holds a lock on the bag
+folder; the next recorder given the folder finds the lock free, and so knows an
+`.unfinished/` there is a killed recorder's and removes it. A recording that ends
+with nothing finished (a full disk in the first split) removes the folder it made.
 """
+import fcntl
 import os
 import shutil
 import time
@@ -25,6 +32,7 @@ from ruamel.yaml import YAML
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 METADATA = 'metadata.yaml'
 INFO = 'rosbag2_bagfile_information'
+UNFINISHED = '.unfinished'  # the split being written: hidden, never listed
 
 
 class BagError(ValueError):
@@ -70,6 +78,22 @@ def merge_metadata(parts):
     return {INFO: info}
 
 
+def describe(path, info):
+    """Lines that say what the bag at path holds, from its metadata (None: nothing
+    finished): a first line, then each topic's message count."""
+    if info is None:
+        return [f'{path}: nothing was finished: no bag written']
+    counts = sorted((entry['topic_metadata']['name'], entry['message_count'])
+                    for entry in info['topics_with_message_count'])
+    start = info['starting_time']['nanoseconds_since_epoch'] * 1e-9
+    end = start + info['duration']['nanoseconds'] * 1e-9
+    span = f', t = {start:.1f} to {end:.1f} s simulated' if info['message_count'] else ''
+    width = max((len(topic) for topic, _ in counts), default=0)
+    return ([f'{path}: a readable bag of {len(info["files"])} file(s), '
+             f'{info["message_count"]} messages on {len(counts)} topics{span}']
+            + [f'  {topic:<{width}}  {n}' for topic, n in counts])
+
+
 class SplitBag:
     """Writes messages (raw CDR bytes) into a new rosbag2 directory at `path`."""
 
@@ -81,20 +105,41 @@ class SplitBag:
         self.parts = []  # metadata of each finished file
         self.writer = None
         self.connections = {}
-        if self.path.exists() and (not self.path.is_dir() or any(self.path.iterdir())):
+        self.created, self.lock = self._claim()
+        try:
+            self._open_split()
+        except OSError as err:
+            self.abort()
+            raise BagError(f'can not write into {self.path}: {err.strerror}') from None
+
+    def _claim(self):
+        """Make the folder (or take an empty one) and lock it while we record: (whether
+        we made it, the locked descriptor); BagError when it is taken."""
+        if self.path.exists() and not self.path.is_dir():
             raise BagError(f'{self.path} exists already (and is not an empty folder)')
+        created = not self.path.exists()
         try:
             self.path.mkdir(parents=True, exist_ok=True)
+            lock = os.open(self.path, os.O_RDONLY)
         except OSError as err:
             raise BagError(f'can not create {self.path}: {err.strerror}') from None
-        self._open_split()
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(lock)
+            raise BagError(f'{self.path} is being recorded into by another recorder') from None
+        shutil.rmtree(self.path / UNFINISHED, ignore_errors=True)  # a killed recorder's
+        if any(self.path.iterdir()):
+            os.close(lock)
+            raise BagError(f'{self.path} exists already (and is not an empty folder)')
+        return created, lock
 
     @property
     def split_index(self):
         return len(self.parts)
 
     def _split_dir(self):
-        return self.path / f'{self.path.name}_{self.split_index}'
+        return self.path / UNFINISHED / f'{self.path.name}_{self.split_index}'
 
     def _open_split(self):
         self.writer = Writer(self._split_dir(), version=Writer.VERSION_LATEST,
@@ -130,34 +175,52 @@ class SplitBag:
             self._open_split()
 
     def _finish_split(self):
+        """Close the file, then list it: the new metadata is written in full (hidden)
+        before the file moves up and the metadata replaces the last one, so a full disk
+        loses only this split and metadata.yaml never lists a file that is not there."""
         split_dir = self._split_dir()
         self.writer.close()
         self.writer = None
-        (split_dir / f'{split_dir.name}.mcap').replace(self.path / f'{split_dir.name}.mcap')
-        self.parts.append(_yaml().load((split_dir / METADATA).read_text())[INFO])
-        shutil.rmtree(split_dir)
-        self._write_metadata()
-
-    def _write_metadata(self):
+        parts = self.parts + [_yaml().load((split_dir / METADATA).read_text())[INFO]]
         text = StringIO()
-        _yaml().dump(merge_metadata(self.parts), text)
-        tmp = self.path / (METADATA + '.tmp')
+        _yaml().dump(merge_metadata(parts), text)
+        tmp = self.path / UNFINISHED / METADATA
         tmp.write_text(text.getvalue())
+        (split_dir / f'{split_dir.name}.mcap').replace(self.path / f'{split_dir.name}.mcap')
         os.replace(tmp, self.path / METADATA)
+        self.parts = parts
+        shutil.rmtree(self.path / UNFINISHED)
+
+    def contents(self):
+        """The metadata of what the finished files hold; None when nothing was finished."""
+        return merge_metadata(self.parts)[INFO] if self.parts else None
 
     def close(self):
-        """Finish the last file (unless it is empty and not the only one) and the metadata."""
+        """Finish the last file (unless it is empty and not the only one) and the metadata;
+        OSError (a full disk) as from write."""
         if self.writer is None:
             return
         if self.written or not self.parts:
             self._finish_split()
+            self._release()
         else:
             self.abort()
 
     def abort(self):
-        """Drop the unfinished file (after a write error); the finished ones stay a bag."""
+        """Drop the unfinished file (after a write error): the finished ones stay a bag,
+        and with none finished the folder we made goes too."""
         if self.writer is not None:
-            split_dir = self._split_dir()
             self.writer.abort()
             self.writer = None
-            shutil.rmtree(split_dir, ignore_errors=True)
+        shutil.rmtree(self.path / UNFINISHED, ignore_errors=True)
+        if not self.parts and self.created:
+            try:
+                self.path.rmdir()
+            except OSError:
+                pass  # someone put something there: not ours to remove
+        self._release()
+
+    def _release(self):
+        if self.lock is not None:
+            os.close(self.lock)
+            self.lock = None

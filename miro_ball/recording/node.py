@@ -4,15 +4,21 @@
 
 What `ros2 bag record` does, for a pip install without ROS tools. Every topic
 is subscribed raw: the CDR bytes that arrive are the bytes a rosbag2 stores, so
-nothing is decoded. Topics are looked up every second, so nodes that start late
-are recorded too. The recorder follows the simulator's /clock: it subscribes to
-the other topics once the first /clock has arrived, and logs each message at its
-simulated time (see miro_ball/recording/selection.py). Ctrl+C finishes the bag.
+nothing is decoded. Topics are looked up every second from the start, so nodes
+that start late are recorded too, and a supervisor that holds the clock (the
+demo) sees the recorder's subscriptions matched before it starts the run. The
+recorder follows the simulator's /clock: it records from the first /clock on and
+logs each message at its simulated time (see miro_ball/recording/selection.py);
+what a latched topic hands over before that is held for the first /clock, other
+messages before it are dropped. Ctrl+C finishes the bag.
+The robots' raw eye images are recorded only when asked for (--raw-images) or
+named as topics.
 """
 import argparse
 import importlib
 import sys
 import time
+from collections import defaultdict, deque
 
 import rclpy
 from rclpy.clock import Clock, ClockType
@@ -25,7 +31,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from miro_ball.common.cli import user_args
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
-from miro_ball.recording.bag import BagError, SplitBag, TYPESTORE, offered_qos
+from miro_ball.recording.bag import BagError, SplitBag, TYPESTORE, describe, offered_qos
 from miro_ball.recording.selection import Progress, Selection, cdr_stamp_ns, has_stamp, \
     import_name, log_time_ns
 from miro_ball.miro.interface import CLOCK, DEFAULT_ROBOT_NAME, RobotTopics
@@ -37,7 +43,7 @@ DEPTH = 100  # messages a subscription may queue while the recorder is busy
 
 
 class RecordingFailed(Exception):
-    """Writing the bag failed (a full disk); the finished files stay readable."""
+    """Writing the bag failed (a full disk); the unfinished file is dropped."""
 
 
 class Recorder(Node):
@@ -50,8 +56,10 @@ class Recorder(Node):
         self.progress = Progress()
         self.warn = Throttled(self.get_logger().warning)
         self.clock_ns = None  # the latest simulated time, from /clock
+        # Latched topics' messages that came before the first /clock, the newest per topic.
+        self.held = defaultdict(lambda: deque(maxlen=DEPTH))
         self.subs = {}
-        self.skipped = set()  # topics whose type can not be recorded (warned once)
+        self.skipped = set()  # topics left out with a word (said once)
         self.record_clock = selection.wants(CLOCK)
         if self.record_clock:
             self._add(CLOCK, 'rosgraph_msgs/msg/Clock')
@@ -60,6 +68,7 @@ class Recorder(Node):
         self.create_timer(DISCOVERY_S, self._on_timer, clock=steady)
         self.last_report = time.monotonic()
         self.get_logger().info(f'recording into {bag.path}/; waiting for {CLOCK}')
+        self._discover()
 
     # -- what arrives ---------------------------------------------------------------------------
     def _on_clock(self, data):
@@ -69,9 +78,16 @@ class Recorder(Node):
             self._write(CLOCK, self.clock_ns, data)
         if first:
             self.get_logger().info('got /clock: recording')
-            self._discover()
+            for topic, messages in self.held.items():
+                for stamped, data in messages:
+                    self._on_message(topic, stamped, False, data)
+            self.held.clear()
 
-    def _on_message(self, topic, stamped, data):
+    def _on_message(self, topic, stamped, latched, data):
+        if self.clock_ns is None:
+            if latched:
+                self.held[topic].append((stamped, data))
+            return
         stamp = cdr_stamp_ns(data) if stamped else None
         self._write(topic, log_time_ns(stamp, self.clock_ns), data)
 
@@ -80,8 +96,8 @@ class Recorder(Node):
         self.progress.count(topic)
 
     def _guarded(self, action, *args):
-        """A write to the bag; an error (a full disk) ends the recording, and the files
-        finished before stay a readable bag."""
+        """A write to the bag; an error (a full disk) ends the recording, and drops the
+        unfinished file (the summary says what the bag holds)."""
         try:
             action(*args)
         except OSError as err:
@@ -90,9 +106,9 @@ class Recorder(Node):
 
     # -- topics ---------------------------------------------------------------------------------
     def _on_timer(self):
+        self._discover()
         if self.clock_ns is None:
             return
-        self._discover()
         self._guarded(self.bag.tick)
         now = time.monotonic()
         if now - self.last_report >= PROGRESS_S:
@@ -102,7 +118,13 @@ class Recorder(Node):
 
     def _discover(self):
         for topic, types in self.get_topic_names_and_types():
-            if topic in self.bag.topics or topic in self.skipped or not self.selection.wants(topic):
+            if topic in self.bag.topics or topic in self.skipped:
+                continue
+            if self.selection.leaves_out_raw(topic):
+                self.skipped.add(topic)
+                self.get_logger().info(f'leaving out {topic}, raw eye images (about 20 MB/s a '
+                                       'robot): --raw-images records them')
+            if not self.selection.wants(topic):
                 continue
             publishers = self.get_publishers_info_by_topic(topic)
             if not publishers:
@@ -132,15 +154,9 @@ class Recorder(Node):
             reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
             durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
         self.subs[topic] = self.create_subscription(
-            msg_class, topic, lambda data: self._on_message(topic, stamped, data), profile,
-            raw=True)
+            msg_class, topic, lambda data: self._on_message(topic, stamped, latched, data),
+            profile, raw=True)
         self.get_logger().info(f'recording {topic} ({msgtype})')
-
-    def summary(self):
-        seconds = self.clock_ns * 1e-9 if self.clock_ns is not None else 0.0
-        return [f'{self.bag.path}: {sum(self.progress.total.values())} messages on '
-                f'{len(self.progress.total)} topics, up to t = {seconds:.1f} s simulated, '
-                f'{self.bag.split_index} file(s)'] + self.progress.summary()
 
 
 def parse_args(argv):
@@ -151,23 +167,27 @@ def parse_args(argv):
                     'types) that ros2 bag info/play, Foxglove and the rosbags library open.',
         epilog=f'Targets: a topic ({robot.odom}), a pattern (\'{robot.topic("sensors/*")}\') '
                f'or a robot name\n({robot.name}: all its topics and its ground truth); none = '
-               'every topic.\nLog times are simulated time: the message stamp where it has one, '
-               'else the latest /clock;\nnothing is recorded before the first /clock. Ctrl+C '
-               'finishes the bag; a hard stop or a full\ndisk loses at most the last '
-               '--split-seconds.')
+               f'every topic. The raw eye\nimages ({robot.eye_raw("caml")}, ...: about 20 MB/s a '
+               'robot) only when named as\ntopics or with --raw-images.\nLog times are '
+               'simulated time: the message stamp where it has one, else the latest /clock;\n'
+               'nothing is recorded before the first /clock. Ctrl+C finishes the bag; a hard '
+               'stop or a\nfull disk loses at most the last --split-seconds, and leaves no '
+               'unfinished file in sight.')
     parser.add_argument('-o', '--output', required=True, metavar='DIR',
                         help='the bag directory to create (must not exist, or be empty)')
     parser.add_argument('targets', nargs='*', metavar='TOPIC',
                         help='topics, patterns or robot names (default: every topic)')
     parser.add_argument('-x', '--exclude', action='append', default=[], metavar='PATTERN',
                         help='leave out topics matching this pattern (repeatable)')
+    parser.add_argument('--raw-images', action='store_true',
+                        help="record the robots' raw eye images too (sensors/caml, sensors/camr)")
     parser.add_argument('--split-seconds', type=float, default=10.0,
                         help='finish a file and start the next this often, wall time (10)')
     args = parser.parse_args(argv)
     if not 0.1 <= args.split_seconds <= 86400:
         parser.error('--split-seconds must be within 0.1 and 86400')
     try:
-        selection = Selection(args.targets, args.exclude)
+        selection = Selection(args.targets, args.exclude, args.raw_images)
     except ValueError as err:
         parser.error(str(err))
     return args, selection, parser
@@ -189,7 +209,7 @@ def main(argv=None):
     try:
         spin_until_stopped(executor, stop)
     except RecordingFailed as err:
-        node.get_logger().error(f'{err}; the files finished before are a readable bag')
+        node.get_logger().error(f'{err}: recording stopped')
         code = 1
     finally:
         try:
@@ -198,7 +218,7 @@ def main(argv=None):
             bag.abort()
             node.get_logger().error(f'finishing the last file: {err}')
             code = 1
-        for line in node.summary():
+        for line in describe(bag.path, bag.contents()):
             print(line, flush=True)
         node.destroy_node()
         rclpy.try_shutdown()

@@ -3,7 +3,9 @@
 Topic selection: an argument with a slash (or a wildcard) is a topic name or an
 fnmatch pattern ('/<robot>/sensors/*'); a bare name is a robot, which selects every
 topic under /<name>/ and the simulator's ground truth of that robot. Nothing
-named selects everything.
+named selects everything. The robots' raw eye images are left out unless asked
+for (raw_images) or named as topics: they are the JPEG frames again, uncompressed
+(about 20 MB/s a robot), and the simulator renders them only for a subscriber.
 
 Log time: a rosbag2 message carries one time, the one `ros2 bag play` paces by.
 Ours is simulated time, so a bag plays back at the pace the world ran: the
@@ -16,33 +18,53 @@ import fnmatch
 import struct
 from collections import Counter
 
-from miro_ball.miro.interface import RobotTopics, SimTopics, check_name
+from miro_ball.miro.interface import EYES, TOPIC, RobotTopics, SimTopics, check_name
 
 # A stamp further than this from the latest /clock is not simulated time.
 STAMP_WINDOW_NS = 10 * 10**9
 # Types whose first field, when of one of these types, is the message's time.
 STAMP_TYPES = ('std_msgs/msg/Header', 'builtin_interfaces/msg/Time')
 CDR_HEADER = 4  # encapsulation: 2 bytes kind (byte 1: 0 big-, 1 little-endian), 2 options
+# Every robot's raw eye images, whatever its name.
+RAW_EYES = tuple('/*/' + TOPIC['eye_raw'].name.format(eye=eye) for eye in EYES)
 
 
 class Selection:
-    """Which topics to record: include patterns (all when none), minus exclude patterns."""
+    """Which topics to record: include patterns (all when none), minus exclude patterns,
+    minus the raw eye images unless raw_images or named."""
 
-    def __init__(self, targets=(), exclude=()):
+    def __init__(self, targets=(), exclude=(), raw_images=False):
         self.include = [p for target in targets for p in self.patterns(target)] or ['*']
         self.exclude = [_absolute(p) for p in exclude]
+        self.raw_images = raw_images
+        self.named = {_absolute(t) for t in targets if '/' in t and not _is_pattern(t)}
 
     @staticmethod
     def patterns(target):
         """Topic patterns of one command-line target; ValueError for a bad robot name."""
-        if '/' in target or any(c in target for c in '*?['):
+        if '/' in target or _is_pattern(target):
             return [_absolute(target)]
         name = check_name(target, 'robot name (or a topic: start it with /)')
         return [RobotTopics(name).topic('*'), SimTopics().object_pose(name)]
 
     def wants(self, topic):
+        return self._matches(topic) and not self._raw_left_out(topic)
+
+    def leaves_out_raw(self, topic):
+        """True when the topic would be recorded but for being raw eye images."""
+        return self._matches(topic) and self._raw_left_out(topic)
+
+    def _matches(self, topic):
         return (any(fnmatch.fnmatchcase(topic, p) for p in self.include)
                 and not any(fnmatch.fnmatchcase(topic, p) for p in self.exclude))
+
+    def _raw_left_out(self, topic):
+        return (not self.raw_images and topic not in self.named
+                and any(fnmatch.fnmatchcase(topic, p) for p in RAW_EYES))
+
+
+def _is_pattern(target):
+    return any(c in target for c in '*?[')
 
 
 def _absolute(name):
@@ -92,7 +114,7 @@ class Progress:
 
     def line(self, sim_time_s, seconds):
         """One progress line: totals, how many topics ran at which rate over the last
-        `seconds`, and which went silent (the per-topic table is in the summary)."""
+        `seconds`, and which went silent (the bag's own table is in the summary)."""
         rates = Counter(round(n / seconds, 1) for n in self.recent.values())
         silent = sorted(set(self.total) - set(self.recent))
         self.recent.clear()
@@ -101,9 +123,4 @@ class Progress:
                 + (', '.join(f'{rate:g}/s x {k}' for rate, k in sorted(rates.items(), reverse=True))
                    or 'nothing new')
                 + (f'; silent: {", ".join(silent)}' if silent else ''))
-
-    def summary(self):
-        """Lines of the final report: each topic's count."""
-        width = max((len(t) for t in self.total), default=0)
-        return [f'  {topic:<{width}}  {n}' for topic, n in sorted(self.total.items())]
 
