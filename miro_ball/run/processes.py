@@ -6,13 +6,16 @@ terminal reaches only the program that started them, which stops them one by one
 the order they were started (a controller before the simulator whose /clock it waits
 on). Stopping one is what a terminal does to a foreground job: SIGINT to its whole
 group (a shell script passes nothing on to the program it waits for); after the
-grace period SIGKILL to the group; and once its leader is gone, SIGKILL to whatever
+grace period SIGKILL to the group; and once the grace is over, SIGKILL to whatever
 of the group is still there (the simulator's eye workers, a student's helpers).
 """
 import os
 import signal
 import subprocess
+import time
 from dataclasses import dataclass
+
+GROUP_POLL_S = 0.05
 
 
 @dataclass
@@ -79,8 +82,11 @@ class Processes:
 
 
 def stop_group(proc, grace_s):
-    """Ctrl+C to proc's process group, SIGKILL after grace_s, then SIGKILL to what is left
-    of the group; False if proc itself had to be killed."""
+    """Ctrl+C to proc's process group; SIGKILL to the group once grace_s have passed or, if
+    proc stopped in time, once the rest of the group has stopped too or the grace is over
+    (a shell dies at Ctrl+C at once, while the program it ran still cleans up). False if
+    proc itself had to be killed."""
+    deadline = time.monotonic() + grace_s
     stopped = True
     if proc.poll() is None:
         _signal_group(proc.pid, signal.SIGINT)
@@ -91,12 +97,16 @@ def stop_group(proc, grace_s):
             _signal_group(proc.pid, signal.SIGKILL)
             proc.wait()
     # The group's id can not be taken by another process while any member is alive.
+    while _signal_group(proc.pid, 0) and time.monotonic() < deadline:
+        time.sleep(GROUP_POLL_S)
     _signal_group(proc.pid, signal.SIGKILL)
     return stopped
 
 
 def _signal_group(pgid, signum):
+    """Send signum to the group; False if nobody is left in it."""
     try:
         os.killpg(pgid, signum)
-    except ProcessLookupError:  # nobody left in the group
-        pass
+    except ProcessLookupError:
+        return False
+    return True
