@@ -16,7 +16,7 @@ from miro_ball.common.isolation import isolated_env, private_domain
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
 from miro_ball.recording.node import NODE_NAME as RECORDER
-from miro_ball.run.episode import SETTLE_S
+from miro_ball.run.episode import over
 from miro_ball.run.nodes import robot_names, run_nodes
 from miro_ball.run.processes import Processes
 from miro_ball.run.video import VIDEO_FPS
@@ -56,8 +56,8 @@ def start_line(referee):
 
 
 def follow(args, procs, referee, stop):
-    """Follow the run until the ball is kicked, the limit passes or a node dies; returns
-    (outcome, real-time factor)."""
+    """Follow the run until it is over (episode.over: kicked, a robot fell, the limit) or a
+    node dies; returns (outcome, real-time factor)."""
     monitor = referee.monitor
     said_start, last_report, first_clock, outcome = False, 0.0, None, 'limit'
     while not stop.requested:
@@ -69,8 +69,7 @@ def follow(args, procs, referee, stop):
                 w.start for w in monitor.robots.values()):
             said_start = True
             print(start_line(referee), flush=True)
-        finished = ('kicked' if monitor.kicked and monitor.sim_time > monitor.kick_time + SETTLE_S
-                    else 'limit' if referee.elapsed >= args.limit else None)
+        finished = over(referee, args.limit)
         if finished and not args.gui:
             outcome = finished
             break

@@ -88,21 +88,28 @@ def run_episode(rig, placement=None, index=1, limit_s=60.0, settle_s=SETTLE_S,
     return result
 
 
+def over(referee, limit_s, settle_s=SETTLE_S):
+    """Why a run watched by referee is over, or None: 'fell' (a robot), 'kicked' (settle_s
+    after the kick, or at the limit), 'limit' (limit_s simulated s after the start)."""
+    monitor = referee.monitor
+    elapsed = referee.elapsed
+    if any(watch.fell for watch in monitor.robots.values()):
+        return 'fell'
+    if monitor.kicked and (elapsed >= monitor.kick_time - referee.start_time + settle_s
+                           or elapsed >= limit_s):
+        return 'kicked'
+    return 'limit' if elapsed >= limit_s else None
+
+
 def _run(rig, limit_s, settle_s, progress):
     """Advance until the episode ends; returns why."""
     referee = rig.referee
-    monitor = referee.monitor
     next_progress = time.monotonic() + PROGRESS_EVERY_S
     while True:
         rig.advance()
-        elapsed = referee.elapsed
-        if any(watch.fell for watch in monitor.robots.values()):
-            return 'fell'
-        if monitor.kicked and (elapsed >= monitor.kick_time - referee.start_time + settle_s
-                               or elapsed >= limit_s):
-            return 'kicked'
-        if elapsed >= limit_s:
-            return 'limit'
+        ended = over(referee, limit_s, settle_s)
+        if ended:
+            return ended
         early = rig.ended_early()
         if early:
             return early

@@ -9,7 +9,7 @@ environment every node of the run shares.
 import sys
 
 from miro_ball.controller.names import NODE_NAME as CONTROLLER
-from miro_ball.miro.interface import EYES, robot_name, RobotTopics
+from miro_ball.miro.interface import robot_name
 
 PY = sys.executable
 
@@ -48,12 +48,9 @@ def gui_command(port):
     return [PY, '-m', 'miro_ball.gui', '--port', str(port)]
 
 
-def record_command(out, robots):
-    """The recorder: every topic but the raw eye images (20 MB/s a robot, the same frames as
-    the JPEGs, and published only while someone subscribes)."""
-    raw_eyes = [arg for name in robots for eye in EYES
-                for arg in ('-x', RobotTopics(name).eye_raw(eye))]
-    return [PY, '-m', 'miro_ball.record', '-o', str(out), *raw_eyes]
+def record_command(out):
+    """The recorder, as it records by default: every topic but the raw eye images."""
+    return [PY, '-m', 'miro_ball.record', '-o', str(out)]
 
 
 def run_nodes(robots, world, renderer='auto', real_time_factor=1.0, overhead_rate=0.0,
@@ -66,5 +63,5 @@ def run_nodes(robots, world, renderer='auto', real_time_factor=1.0, overhead_rat
     controllers = [(controller_log(name), controller_command(name, mode, seed + index))
                    for index, name in enumerate(robots)]
     sim = ('miro_sim', sim_command(world, renderer, real_time_factor, overhead_rate, paused))
-    recorder = [('record', record_command(record, robots))] if record else []
+    recorder = [('record', record_command(record))] if record else []
     return gui + controllers + [sim] + recorder
