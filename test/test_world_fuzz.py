@@ -52,8 +52,11 @@ shape = dict(position=vector(3), yaw=coordinate, mass=st.sampled_from([0.0, 0.0,
 SECTIONS = {
     'description': st.text(st.characters(exclude_categories=['Cs']), max_size=20),
     'robot': st.one_of(table(pose=vector(3), floor=coordinate),
+                       # Mostly distinct names: two robots of one name is one error, and
+                       # worlds with several robots should load too.
                        st.lists(table(['name'], name=name, pose=vector(3), floor=coordinate),
-                                min_size=1, max_size=3)),
+                                min_size=1, max_size=3,
+                                unique_by=lambda robot: repr(robot.get('name')))),
     'ball': table(position=vector(2), radius=extent, mass=extent, floor=coordinate, **surface),
     'ground': table(height=coordinate, colour=vector(3, unit), size=vector(2, extent)),
     'box': st.lists(table(['size'], size=vector(3, extent), **shape), max_size=3),
@@ -118,10 +121,12 @@ def test_a_world_file_loads_and_steps_or_fails_in_one_line(tmp_path, doc):
 
 
 def test_the_generator_reaches_worlds_that_load(tmp_path):
-    """The property above is only worth something if some generated worlds get built."""
+    """The property above is only worth something if some generated worlds get built.
+    The same draws every run (derandomize): a check of the generator's reach is no
+    lottery (with fresh draws each run, no two-robot world loaded in 1 run of 4)."""
     loaded = []
 
-    @settings(max_examples=300, deadline=None, database=None)
+    @settings(max_examples=300, deadline=None, database=None, derandomize=True)
     @given(doc=document)
     def probe(doc):
         path = tmp_path / 'probe.toml'
