@@ -19,14 +19,21 @@ def guard_clock(node, warn):
     if getattr(unchecked, 'guarded', False):  # a second observer on the same node
         return unchecked.watch
 
+    watch = ClockWatch(node)
+    latest = []
+
     def checked(msg):
         if msg.clock.sec < 0:
             warn('bad clock', f'{CLOCK}: negative time {msg.clock.sec} s ignored')
             return
+        now = (msg.clock.sec, msg.clock.nanosec)
+        if latest and now < latest[-1]:
+            watch.went_back()
+        latest[:] = [now]
         unchecked(msg)
 
     checked.guarded = True
-    checked.watch = ClockWatch(node)
+    checked.watch = watch
     # Future subscriptions (use_sim_time switched on later) and the current one.
     source.clock_callback = checked
     for subscription in node.subscriptions:

@@ -3,13 +3,22 @@
 Twenty students on one network and one ROS domain see each other's simulators:
 /clock then jumps between two timelines. A node that follows /clock cannot tell
 that from a simulator restart by the time alone, so it asks the ROS graph who
-publishes /clock, once a wall second and whenever time goes back.
+publishes /clock, once a wall second and whenever time goes back. The graph alone
+is not enough either: a simulator killed with SIGKILL stays in the graphs of the
+nodes that knew it for about 20 s (Fast DDS's lease), so a follower calls /clock
+shared only when it also went back twice within JUMPS_WINDOW_S: two timelines
+taking turns, not one restart.
 """
+import collections
+import time
+
 from rclpy.clock import Clock, ClockType
 
 from miro_ball.miro.interface import CLOCK
 
 CHECK_EVERY_S = 1.0  # wall time
+JUMPS_WINDOW_S = 3.0  # wall time
+UNKNOWN = '_NODE_NAME_UNKNOWN_'  # what the graph says before it knows a node's name
 
 
 def clock_publishers(node):
@@ -26,23 +35,35 @@ def shared_domain_line(publishers, domain):
 
 
 class ClockWatch:
-    """Keeps ``contested`` (more publishers on /clock than the node's ``own``, or than the
-    one simulator a node with none of its own follows) up to date and says so once, in one
-    line, each time it starts."""
+    """Keeps ``contested`` (more publishers on /clock than the node's ``own``, or, for a
+    node with none of its own, than the one simulator it follows, its clock having gone
+    back twice lately) up to date and says so once, in one line, each time it starts."""
 
     def __init__(self, node, own=0):
         self.node = node
         self.own = own
         self.contested = False
+        self._said = False
+        self._backs = collections.deque()  # wall times /clock went back
         self.timer = node.create_timer(CHECK_EVERY_S, self.check,
                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
 
+    def went_back(self):
+        """The followed /clock just went back (a restart, or two timelines)."""
+        self._backs.append(time.monotonic())
+
     def check(self):
         """Look again now; True while another simulator shares the domain."""
+        while self._backs and time.monotonic() - self._backs[0] > JUMPS_WINDOW_S:
+            self._backs.popleft()
         publishers = clock_publishers(self.node)
-        contested = len(publishers) > max(self.own, 1)
-        if contested and not self.contested:
+        taking_turns = self.own > 0 or len(self._backs) >= 2
+        contested = len(publishers) > max(self.own, 1) and taking_turns
+        # A publisher's node name reaches the graph after the publisher: name them once known.
+        if contested and not self._said and not any(UNKNOWN in name for name in publishers):
             self.node.get_logger().warning(
                 shared_domain_line(publishers, self.node.context.get_domain_id()))
+            self._said = True
+        self._said = self._said and contested
         self.contested = contested
         return contested

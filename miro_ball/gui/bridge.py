@@ -362,6 +362,7 @@ class GuiBridge(Node):
         now = time.monotonic()
         sim = msg.clock.sec + msg.clock.nanosec * 1e-9
         if self.sim_time is not None and sim < self.sim_time:
+            self._clock_watch.went_back()
             self._clock_samples.clear()  # a reset, or a new simulator
             self.sim_paused = None
         self.sim_time = sim
