@@ -2,7 +2,8 @@
 # One entry point for a new user: sets up .venv (and, as root, the Debian
 # packages) on first use, then runs what was asked.
 #   ./dev.sh demo [args]   headless simulator + controller, summary and video
-#   ./dev.sh test [args]   the test suite (pytest); no args: twice, the 2nd as robot miro02
+#   ./dev.sh test [args]   the test suite (pytest); no args: every tier, then the tiers where
+#                          the robot's name matters as robot miro02; -m unit: the quick tier
 #   ./dev.sh bench         simulator, detection and scenario benchmarks
 #   ./dev.sh soak [args]   long free run: memory, open files, speed per minute (--minutes N)
 #   ./dev.sh setup         only the set-up
@@ -55,11 +56,11 @@ case "$cmd" in
   demo) setup; exec "$PY" -m miro_ball.demo "$@" ;;
   test) setup
     if [ $# -gt 0 ]; then exec "$PY" -m pytest "$@"; fi
-    # The whole suite twice: as is, and under another robot name (the MDK's multi-robot
-    # convention), so that no test or node leans on the default name.
+    # Every tier, then again under another robot name (the MDK's multi-robot convention)
+    # wherever a robot's name is used, so that no test or node leans on the default name.
     "$PY" -m pytest
-    MIRO_ROBOT_NAME=miro02 exec "$PY" -m pytest -q ;;
+    MIRO_ROBOT_NAME=miro02 exec "$PY" -m pytest -q -m 'not unit' ;;
   bench) setup; exec "$PY" -m miro_ball.bench.sim_bench "$@" ;;
   soak) setup; exec "$PY" -m miro_ball.bench.soak "$@" ;;
-  *) sed -n '2,8p' "$0"; exit 2 ;;
+  *) sed -n '2,9p' "$0"; exit 2 ;;
 esac
