@@ -280,13 +280,18 @@ def test_survives_bad_inputs(make_rig):
     assert rig.node.frames_processed == 2 and rig.node.state == 'approach'
 
 
-def test_carries_on_when_the_clock_jumps_back(make_rig):
-    rig = make_rig(*short_hold())
+def approaching(rig):
+    """The rig at t = 10.4 s, its node approaching a ball seen ahead."""
     rig.set_clock(10.0)
     rig.advance(0.3)
     rig.both_eyes(*AHEAD)
     rig.advance(0.1)
     assert rig.node.state == 'approach'
+    return rig
+
+
+def test_carries_on_when_the_clock_jumps_back(make_rig):
+    rig = approaching(make_rig(*short_hold()))
     rig.set_clock(1.0)  # the simulator restarted
     rig.advance(0.2)
     stamp = rig.twists[-1].header.stamp
@@ -297,12 +302,7 @@ def test_carries_on_when_the_clock_jumps_back(make_rig):
 
 
 def test_two_clock_publishers_are_named_once_and_restart_it_once_at_most(make_rig, capfd):
-    rig = make_rig(*short_hold())
-    rig.set_clock(10.0)
-    rig.advance(0.3)
-    rig.both_eyes(*AHEAD)
-    rig.advance(0.1)
-    assert rig.node.state == 'approach'
+    rig = approaching(make_rig(*short_hold()))
     other = rclpy.create_node('other_sim', context=rig.probe.context)
     other.create_publisher(Clock, CLOCK, 10)
     rig.wait_until(lambda: rig.node.count_publishers(CLOCK) == 2, 'a second /clock publisher')
