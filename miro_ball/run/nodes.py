@@ -38,8 +38,11 @@ def controller_command(robot, mode='improved', seed=1):
 
 def sim_command(world, renderer='auto', real_time_factor=1.0, overhead_rate=0.0,
                 paused=False):
-    """The simulator; paused: until someone calls its ~/pause service with false."""
-    return [PY, '-m', 'miro_sim_bullet', '--ros-args', '-p', f'world:={world}',
+    """The simulator; paused: until someone calls its ~/pause service with false. Our runs
+    claim a ROS domain of their own (common/isolation.py), so the simulator need not spend
+    peer_check_s looking for another one there."""
+    return [PY, '-m', 'miro_sim_bullet', '--ros-args', '-p', 'peer_check_s:=0',
+            '-p', f'world:={world}',
             '-p', f'renderer:={renderer}', '-p', f'real_time_factor:={real_time_factor}',
             '-p', f'overhead_rate:={overhead_rate}', '-p', f'paused:={str(paused).lower()}']
 

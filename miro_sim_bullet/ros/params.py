@@ -38,8 +38,10 @@ class SimParams:
     jpeg_quality: int = field(default=80,
                               metadata={'help': 'JPEG quality of sensors/cam?/compressed',
                                         'range': (1, 100)})
+    # A running simulator is usually found in 30 ms, but now and then only at its next
+    # Fast DDS announcement, which comes every 3 s (measured: 1.4 s and 1.9 s).
     peer_check_s: float = field(
-        default=1.0, metadata={'help': 'wall seconds to look for another simulator (/clock '
+        default=3.5, metadata={'help': 'wall seconds to look for another simulator (/clock '
                                        'publisher) on the ROS domain before starting, and '
                                        'refuse if there is one; 0 = do not look',
                                'range': (0.0, 10.0)})
