@@ -105,8 +105,8 @@ class SimNode(Node):
         self.paused = params.paused
         self._restart_schedule(keep_time=True)
         if old.paused and not params.paused:
-            # The overhead view shows the instant the run resumes (a demo's first video
-            # frame is its start, whatever steps placed the robots before).
+            # The overhead view shows the instant the run resumes (an episode's first video
+            # frame is its start, whatever steps placed robot and ball before).
             self._next_overhead = min(self._next_overhead, self.sim.time)
 
     # -- what the simulator's services do to time ---------------------------------------------
