@@ -10,12 +10,10 @@ then names each other, once.
 """
 import time
 
-from miro_ball.common.clock_watch import clock_publishers
+from miro_ball.common.clock_watch import clock_publishers, UNKNOWN
 from miro_ball.miro.interface import CLOCK
 
 POLL_S = 0.05  # wall time between two looks at the graph
-# What the graph shows in place of a node's name until discovery has brought it.
-UNKNOWN_NAME = '_NODE_NAME_UNKNOWN_'
 
 
 class SharedDomain(Exception):
@@ -30,7 +28,7 @@ def other_clock_publishers(node, wait_s):
         others = clock_publishers(node)
         # Its own is in the graph from its creation; another simulator has the same name.
         others.remove(node.get_fully_qualified_name())
-        named = not any(UNKNOWN_NAME in name for name in others)
+        named = not any(UNKNOWN in name for name in others)
         if (others and named) or time.monotonic() >= deadline:
             return others
         time.sleep(POLL_S)
