@@ -31,6 +31,9 @@ COSMETIC_CALIB = (0.0, 0.5, 0.0, 0.0, 1.0 / 3.0, 1.0 / 3.0)
 CAM_ELEVATION_RAD = math.radians(45.0)
 CAM_DIVERGENCE_RAD = math.radians(27.0)
 CAM_HFOV_DEG_SIM = 120.0
+# The real lens's half fields of view on the 16:9 frame (MDK CAM_HORI/VERT_HALF_FOV).
+CAM_HORI_HALF_FOV_RAD = math.radians(60.6)
+CAM_VERT_HALF_FOV_RAD = math.radians(31.8)
 FRAME_SIZES = ((1280, 720), (640, 360), (320, 240))
 
 # Cliff (section 4): a value below this is a drop.
