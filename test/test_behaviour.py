@@ -10,7 +10,7 @@ from miro_ball.controller.behaviour import (APPROACH, AVOID, ball_bearing, Behav
                                             ImprovedBehaviour, KICK, LOCK_ON, LOST,
                                             make_behaviour, MESSAGES, SEARCH, TutorialBehaviour)
 from miro_ball.controller.detection import Ball, normalise
-from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.camera_model import Intrinsics
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, FRAME_SIZES, WHEEL_MAX_SPEED_M_PER_S
 from miro_ball.miro.kinematics import wheel_speed2cmd_vel
 

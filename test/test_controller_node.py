@@ -19,7 +19,7 @@ from std_msgs.msg import Float32MultiArray
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
 from miro_ball.controller.node import build_parser, KickBlueBall, main
 from miro_ball.bench.synthetic import Disc, jpeg, render
-from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.camera_model import Intrinsics
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
 from miro_ball.controller.names import debug_topic
 from miro_ball.miro.interface import CLOCK, default_robot_name, EYES, RobotTopics

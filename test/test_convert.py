@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from geometry_msgs.msg import PoseStamped
 
-from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.camera_model import Intrinsics
 from miro_sim_bullet.physics.sensors import Sensors
 from miro_sim_bullet.ros import convert
 

@@ -7,7 +7,7 @@ import pytest
 
 from miro_ball.miro.constants import LIFT_RAD_CALIB
 from miro_ball.controller.detection import BallDetector
-from miro_ball.miro.camera import Intrinsics, project
+from miro_ball.miro.camera_model import Intrinsics, project
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.renderer import probe_egl, view_matrix_from_pose

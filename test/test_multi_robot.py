@@ -12,7 +12,7 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, Imu, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt32
 
 from miro_ball.examples.ball_mover import BallMover, ball_y, parse_args
-from miro_ball.miro.camera import Intrinsics, project
+from miro_ball.miro.camera_model import Intrinsics, project
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras

@@ -9,7 +9,7 @@ import threading
 import numpy as np
 import pytest
 
-from miro_ball.miro.camera import Intrinsics, project
+from miro_ball.miro.camera_model import Intrinsics, project
 from miro_sim_bullet.bullet import pybullet as p
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render import gl_renderer

@@ -51,7 +51,7 @@ def _pybullet_egl(sim):
 
 def _serve(connection, kind, world):
     """Worker: builds the world with its renderer, then times batches on request."""
-    from miro_ball.miro.camera import Intrinsics
+    from miro_ball.miro.camera_model import Intrinsics
     from miro_sim_bullet.physics.world import SimWorld
     from miro_sim_bullet.render.cameras import Cameras
     from miro_sim_bullet.render.renderer import view_matrix_from_pose

@@ -15,7 +15,7 @@ from typing import NamedTuple, Optional, Sequence, Tuple
 
 from miro_ball.common.params import check_ranges
 from miro_ball.controller.detection import to_pixels
-from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.camera_model import Intrinsics
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, CLIFF_THRESHOLD, WHEEL_MAX_SPEED_M_PER_S
 from miro_ball.miro.interface import EYE_SIDE, EYES
 from miro_ball.miro.kinematics import cmd_vel2wheel_speed, wheel_speed2cmd_vel

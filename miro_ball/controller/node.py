@@ -40,7 +40,7 @@ from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERAS, mak
 from miro_ball.controller.detection import annotate, BallDetector, DetectionParams
 from miro_ball.controller.names import DEBUG_TOPIC, NODE_NAME
 from miro_ball.controller.params import ControllerParams, GROUPS
-from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.camera_model import Intrinsics
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES
 from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYE_QOS, EYES, frame_id,
                                       robot_namespace, robot_of_namespace, RobotTopics,

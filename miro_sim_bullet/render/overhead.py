@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 
-from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.camera_model import Intrinsics
 
 SIZE_PX = 480
 HFOV_DEG = 50.0

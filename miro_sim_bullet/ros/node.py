@@ -26,7 +26,7 @@ from miro_ball.common.params import declare, help_lines, LiveParams
 from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
-from miro_ball.miro.camera import Intrinsics
+from miro_ball.miro.camera_model import Intrinsics
 from miro_ball.miro.interface import CLOCK, CLOCK_QOS, robot_name, SIM_NODE_NAME
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
