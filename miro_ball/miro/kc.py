@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from miro_ball.miro.constants import (CAM_DIVERGENCE_RAD, CAM_ELEVATION_RAD, JOINT_LIMITS_RAD,
-                                      KIN_CALIB_RAD, LIFT, PITCH, TILT_RAD, WHEEL_RADIUS_M, YAW)
+                                      KIN_CALIB_RAD, WHEEL_RADIUS_M)
 
 WORLD, FOOT, BODY, NECK, GIMBAL, HEAD, CAML, CAMR, SONAR = range(-1, 8)
 FRAME_NAMES = {WORLD: 'world', FOOT: 'foot', BODY: 'body', NECK: 'neck', GIMBAL: 'gimbal',

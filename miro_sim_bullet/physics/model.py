@@ -12,15 +12,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from miro_ball.miro.constants import (CAM_DIVERGENCE_RAD, CAM_ELEVATION_RAD, JOINT_LIMITS_RAD, LIFT,
-                                 PITCH, TILT_RAD, WHEEL_RADIUS_M, WHEEL_TRACK_M, YAW)
+from miro_ball.miro.constants import (JOINT_LIMITS_RAD, LIFT, PITCH, TILT_RAD, WHEEL_RADIUS_M,
+                                      WHEEL_TRACK_M, YAW)
+from miro_ball.miro.kc import (AXLE_HEIGHT_M as AXLE_HEIGHT, camera_in_head, EAR_IN_HEAD, EYE_IN_HEAD,
+                               LIFT_JOINT_IN_BODY, YAW_JOINT_IN_NECK)
 from miro_sim_bullet.bullet import pybullet as pb
 
-AXLE_HEIGHT = WHEEL_RADIUS_M
-LIFT_JOINT_IN_BODY = (0.0022, 0.0, 0.0807 - AXLE_HEIGHT)
-YAW_JOINT_IN_NECK = (0.0, 0.0, 0.1201)
-EYE_IN_HEAD = (0.0377, 0.0431, 0.0568)  # left eye; the right eye mirrors y
-SONAR_IN_HEAD = (0.082, 0.0, 0.035)
 CLIFF_IN_BODY = (0.062, 0.055, 0.085 - AXLE_HEIGHT)  # left; right mirrors y
 CLIFF_PITCH_DOWN = 0.52  # rad, the sensors look forward and down
 CLIFF_RANGE = 0.5
@@ -28,7 +25,6 @@ SONAR_RANGE = (0.03, 1.0)
 SONAR_HALF_CONE = math.atan(0.309)  # cone radius 0.309 m at 1 m
 BODY_COM = (-0.060, 0.0, 0.050 - AXLE_HEIGHT)
 TAIL_JOINT_IN_BODY = (-0.143, 0.0, 0.085 - AXLE_HEIGHT)
-EAR_IN_HEAD = (-0.0474, 0.0519, 0.0827)
 
 WHITE = (0.92, 0.92, 0.90, 1.0)
 GREY = (0.35, 0.35, 0.37, 1.0)
@@ -45,28 +41,6 @@ KIN_LINKS = {LIFT: NECK, YAW: GIMBAL, PITCH: HEAD}
 # Cosmetic order: droop, wag, eyelid l/r, ear l/r; value 0..1 -> angle range.
 COSMETIC_LINKS = (TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L, EAR_R)
 COSMETIC_RANGES = ((0.0, 0.6), (-0.6, 0.6), (0.0, 0.9), (0.0, 0.9), (-0.5, 0.5), (0.5, -0.5))
-
-
-def rot_y(angle):
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def rot_z(angle):
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def eye_in_head(side):
-    """(position, rotation) of an eye camera in the HEAD frame, side +1 left / -1 right.
-
-    The camera frame is x forward along the optical axis, y left, z up. The
-    MDK turns the eye by the divergence (azimuth) first, then raises it by the
-    elevation, both about HEAD axes.
-    """
-    x, y, z = EYE_IN_HEAD
-    rotation = rot_y(-CAM_ELEVATION_RAD) @ rot_z(side * CAM_DIVERGENCE_RAD)
-    return np.array([x, side * y, z]), rotation
 
 
 @dataclass
@@ -129,7 +103,7 @@ class MiroModel:
         head_collision = pb.createCollisionShapeArray(
             [box, box], halfExtents=[[0.043, 0.063, 0.0575], [0.036, 0.035, 0.028]],
             collisionFramePositions=[[-0.018, 0, 0.0315], [0.060, 0, 0.002]], **kw)
-        eye_positions = [eye_in_head(side)[0] - 0.013 * eye_in_head(side)[1][:, 0]
+        eye_positions = [camera_in_head(side)[0] - 0.013 * camera_in_head(side)[1][:, 0]
                          for side in (1, -1)]
         head_visual = pb.createVisualShapeArray(
             [box, box, pb.GEOM_SPHERE, pb.GEOM_SPHERE],

@@ -11,6 +11,7 @@ import numpy as np
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       KIN_CALIB_RAD, TILT_RAD, WHEEL_RADIUS_M)
+from miro_ball.miro.kc import camera_in_head, SONAR_IN_HEAD
 from miro_ball.miro.kinematics import clamp_wheel_speeds, cmd_vel2wheel_speed
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics import model as rb
@@ -171,7 +172,7 @@ class MiroRobot:
 
     def _read_sonar(self):
         pos, rot = self.link_frame(rb.HEAD)
-        start = pos + rot @ np.array(rb.SONAR_IN_HEAD)
+        start = pos + rot @ np.array(SONAR_IN_HEAD)
         lo, hi = rb.SONAR_RANGE
         ends = start + hi * SONAR_DIRECTIONS @ rot.T
         found = [h[2] * hi for h in self._rays([start] * len(ends), ends) if h[0] >= 0]
@@ -216,7 +217,7 @@ class MiroRobot:
     def eye_pose(self, side):
         """World (position, rotation) of an eye camera, side +1 left / -1 right."""
         head_pos, head_rot = self.link_frame(rb.HEAD)
-        eye_pos, eye_rot = rb.eye_in_head(side)
+        eye_pos, eye_rot = camera_in_head(side)
         return head_pos + head_rot @ eye_pos, head_rot @ eye_rot
 
     # -- snapshots for the eye workers --------------------------------------------------------
