@@ -10,7 +10,7 @@ from miro_ball.controller.behaviour import (APPROACH, AVOID, ball_bearing, Behav
                                             ImprovedBehaviour, KICK, LOCK_ON, LOST,
                                             make_behaviour, MESSAGES, SEARCH, TutorialBehaviour)
 from miro_ball.controller.detection import Ball, normalise
-from miro_ball.miro.camera_model import Intrinsics
+from miro_ball.miro.camera_model import CameraModel, Intrinsics
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, FRAME_SIZES, WHEEL_MAX_SPEED_M_PER_S
 from miro_ball.miro.kinematics import wheel_speed2cmd_vel
 
@@ -23,7 +23,8 @@ SEARCH_WHEELS = (DEFAULTS.search_speed, -DEFAULTS.search_speed)  # clockwise
 
 def column(angle, camera=DEFAULT_CAMERA):
     """Normalised image column x where a direction angle rad left of the eye's axis appears."""
-    return (camera.cx - camera.fx * math.tan(angle)) / camera.width - 0.5
+    k = camera.intrinsics
+    return (k.cx - k.fx * math.tan(angle)) / k.width - 0.5
 
 
 # Where a ball straight ahead appears in the (left, right) eye: they look 27 deg outwards.
@@ -111,7 +112,7 @@ def test_bearing_from_eye_geometry():
         0.0, abs=1e-9)
     assert eye_bearing(CENTRED_FAR[1], DEFAULT_CAMERA, -CAM_DIVERGENCE_RAD) == pytest.approx(
         0.0, abs=1e-9)
-    half_pixel = 0.5 / DEFAULT_CAMERA.fx  # rad, near the axis
+    half_pixel = 0.5 / DEFAULT_CAMERA.intrinsics.fx  # rad, near the axis
     assert eye_bearing(ball(0.0), DEFAULT_CAMERA, CAM_DIVERGENCE_RAD) == pytest.approx(
         CAM_DIVERGENCE_RAD, abs=half_pixel)
     # The right edge of the frame (the last pixel's outer side) is 60 deg right of the axis.
@@ -134,7 +135,7 @@ def test_default_camera_keeps_the_120_deg_bearings(width, height):
     # the principal point, now the image centre (w - 1) / 2 rather than w / 2 in
     # pixel-centre coordinates: at most half a pixel.
     cameras = (DEFAULT_CAMERA.scaled_to(width, height),) * 2
-    half_pixel = 0.5 / cameras[0].fx
+    half_pixel = 0.5 / cameras[0].intrinsics.fx
     rng = random.Random(7)
     for _ in range(200):
         left, right = ball(rng.uniform(-0.5, 0.5)), ball(rng.uniform(-0.5, 0.5))
@@ -154,7 +155,7 @@ def camera_info_k(hfov_deg, width=1280, height=720):
 def test_bearing_follows_camera_info(width, height):
     # A 90 deg camera_info (-p hfov_deg:=90 on the simulator), given at 1280x720 whatever
     # the frames' size: a pixel column u is atan((u - cx) / fx) off the axis (+ left).
-    camera = Intrinsics.from_k(1280, 720, camera_info_k(90.0)).scaled_to(width, height)
+    camera = CameraModel(1280, 720, hfov_deg=90.0).scaled_to(width, height)
     fx, cx = width / 2, (width - 1) / 2  # tan(45 deg) = 1; pixel centres are integers
     rng = random.Random(width)
     for _ in range(200):
@@ -171,7 +172,7 @@ def test_bearing_follows_camera_info(width, height):
 def test_camera_model_steers_the_improved_behaviour():
     # A ball 10 deg left of the robot as a 90 deg left eye sees it: the 120 deg default
     # would put it on the other side.
-    narrow = Intrinsics.from_k(640, 360, camera_info_k(90.0, 640, 360))
+    narrow = CameraModel(640, 360, hfov_deg=90.0)
     seen = ball(column(math.radians(10) - CAM_DIVERGENCE_RAD, narrow))
     steer = ImprovedBehaviour(BehaviourParams()).step(0.0, seen, None, FLOOR,
                                                       (narrow, DEFAULT_CAMERA))

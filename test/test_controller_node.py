@@ -19,7 +19,7 @@ from std_msgs.msg import Float32MultiArray
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
 from miro_ball.controller.node import build_parser, KickBlueBall, main
 from miro_ball.bench.synthetic import Disc, jpeg, render
-from miro_ball.miro.camera_model import Intrinsics
+from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
 from miro_ball.controller.names import debug_topic
 from miro_ball.miro.interface import CLOCK, default_robot_name, EYES, RobotTopics
@@ -31,7 +31,7 @@ TICK = 0.02
 DEFAULTS = BehaviourParams()
 SEARCH_SPIN = -2 * DEFAULTS.search_speed / 0.164  # rad/s, clockwise (improved)
 TUTORIAL_SPIN = -2 * DEFAULTS.slow / 0.164
-NARROW = Intrinsics.from_k(640, 360, camera_info_k(90.0, 640, 360))  # -p hfov_deg:=90
+NARROW = CameraModel(640, 360, hfov_deg=90.0)  # -p hfov_deg:=90
 
 
 def ball_frame(x=None, r=0.04, width=640, height=360):
@@ -380,7 +380,7 @@ def test_camera_model_follows_camera_info(make_rig):
     rig = make_rig()
     assert rig.node.cameras == [DEFAULT_CAMERA, DEFAULT_CAMERA]
     rig.camera_info(1, 1280, 720, camera_info_k(90.0))
-    assert rig.node.cameras == [DEFAULT_CAMERA, Intrinsics.from_k(1280, 720, camera_info_k(90.0))]
+    assert rig.node.cameras == [DEFAULT_CAMERA, CameraModel(1280, 720, hfov_deg=90.0)]
 
 
 @pytest.mark.parametrize('width,height,k', [

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from geometry_msgs.msg import PoseStamped
 
-from miro_ball.miro.camera_model import Intrinsics
+from miro_ball.miro.camera_model import CameraModel, Intrinsics
 from miro_sim_bullet.physics.sensors import Sensors
 from miro_sim_bullet.ros import convert
 
@@ -47,11 +47,22 @@ def test_sensor_messages_carry_the_readings():
 
 
 def test_camera_info_matches_the_intrinsics():
-    k = Intrinsics.from_hfov(640, 360, 90.0)
-    info = convert.camera_info(k, convert.stamp(0.0), 'miro/caml_optical')
+    camera = CameraModel(640, 360, hfov_deg=90.0)
+    k = camera.intrinsics
+    info = convert.camera_info(camera, convert.stamp(0.0), 'miro/caml_optical')
     again = Intrinsics.from_k(info.width, info.height, info.k)
     assert (again.fx, again.cx, again.cy) == pytest.approx((320.0, 319.5, 179.5))
     assert list(info.p) == [k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0]
+    assert (info.distortion_model, list(info.d)) == ('plumb_bob', [0.0] * 5)
+
+
+@pytest.mark.parametrize('lens', ['pinhole', 'miro'])
+def test_camera_info_carries_the_lens_back(lens):
+    # What a ROS tool (and our controller) rebuilds from camera_info is the lens drawn.
+    camera = CameraModel(640, 360, lens=lens)
+    info = convert.camera_info(camera, convert.stamp(0.0), 'miro/caml_optical')
+    assert info.distortion_model == ('plumb_bob' if lens == 'pinhole' else 'equidistant')
+    assert CameraModel.from_camera_info(info) == camera
 
 
 def test_jpeg_keeps_the_ball_blue():

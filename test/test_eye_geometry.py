@@ -7,7 +7,7 @@ import pytest
 
 from miro_ball.miro.constants import LIFT_RAD_CALIB
 from miro_ball.controller.detection import BallDetector
-from miro_ball.miro.camera_model import Intrinsics, project
+from miro_ball.miro.camera_model import CameraModel, LENSES
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.renderer import probe_egl, view_matrix_from_pose
@@ -57,6 +57,7 @@ def blue_centroid(rgb):
     return u.mean(), v.mean()
 
 
+@pytest.mark.parametrize('lens', LENSES)
 @pytest.mark.parametrize('size', [(640, 360), (320, 240), (1280, 720)])
 @pytest.mark.parametrize('ball_xy, seen_by', [
     ((1.0, 0.0), {+1, -1}),   # dead ahead: both eyes
@@ -64,21 +65,19 @@ def blue_centroid(rgb):
     ((0.7, -0.7), {-1}),      # well to the right: right eye only
     ((1.2, 0.3), {+1, -1}),
 ])
-def test_ball_appears_where_the_pinhole_model_predicts(small_ball, size, ball_xy, seen_by):
+def test_ball_appears_where_the_camera_model_predicts(small_ball, lens, size, ball_xy,
+                                                      seen_by):
     sim, cameras = small_ball
-    intrinsics = Intrinsics.from_hfov(*size, 120.0)
+    camera = CameraModel(*size, lens=lens)
     sim.place_ball(*ball_xy)
     sim.run(0.3)
     centre = sim.ball_position()
     for side in (+1, -1):
-        rgb, = cameras.render_eyes([(sim.robot, side)], intrinsics)
+        rgb, = cameras.render_eyes([(sim.robot, side)], camera)
         assert rgb.shape == (size[1], size[0], 3)
         found = blue_centroid(rgb)
-        pos, rot = sim.robot.eye_pose(side)
-        predicted = project(intrinsics, pos, rot, centre)
-        inside = predicted is not None and 0 <= predicted[0] < size[0] and \
-            0 <= predicted[1] < size[1]
-        assert inside == (side in seen_by)
+        predicted = camera.project_from(*sim.robot.eye_pose(side), centre)
+        assert (predicted is not None) == (side in seen_by)
         if side in seen_by:
             assert found is not None
             assert math.dist(found, predicted) < 2.0 * max(1.0, size[0] / 640)
@@ -90,12 +89,12 @@ def test_ball_is_blue_after_jpeg_and_nothing_else_is(small_ball):
     """What the controller relies on: after JPEG, its own colour mask covers the ball, lit
     side and shaded side, and nothing else (floor, walls, sky, the robot)."""
     sim, cameras = small_ball
-    intrinsics = Intrinsics.from_hfov(640, 360, 120.0)
+    camera = CameraModel(640, 360)
     detector = BallDetector()
     for xy in ((1.0, 0.2), (0.5, 0.1), (0.7, 0.4)):
         sim.place_ball(*xy)
         sim.run(0.2)
-        rgb, = cameras.render_eyes([(sim.robot, +1)], intrinsics)
+        rgb, = cameras.render_eyes([(sim.robot, +1)], camera)
         ok, jpeg = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
         seen = detector.mask(cv2.imdecode(jpeg, cv2.IMREAD_COLOR)) > 0
         ball = blue_mask(rgb)
@@ -114,11 +113,11 @@ def test_eye_worker_processes_render_exactly_what_the_simulator_would():
         world.robot.set_kinematic_targets([0.0, math.radians(50), math.radians(20), 0.0])
         world.robot.set_cmd_vel(0.2, 0.5)
         world.run(1.0)  # robot, head and (maybe) ball have moved since the workers' copy
-        intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
+        camera = CameraModel(320, 240)
         requests = [(world.robot, +1), (world.robot, -1)]
-        from_workers = cameras.render_eyes(requests, intrinsics)
+        from_workers = cameras.render_eyes(requests, camera)
         in_process = [cameras.renderer.render(
-            view_matrix_from_pose(*world.robot.eye_pose(side)), intrinsics)
+            view_matrix_from_pose(*world.robot.eye_pose(side)), camera.intrinsics)
             for side in (+1, -1)]
         for a, b in zip(from_workers, in_process):
             assert np.array_equal(a, b)

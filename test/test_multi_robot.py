@@ -12,7 +12,7 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, Imu, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt32
 
 from miro_ball.examples.ball_mover import BallMover, ball_y, parse_args
-from miro_ball.miro.camera_model import Intrinsics, project
+from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
@@ -100,11 +100,11 @@ def test_each_robot_sees_from_its_own_eyes():
         x, y, yaw = miro03.pose()
         world.place_ball(x + 0.8 * math.cos(yaw), y + 0.8 * math.sin(yaw))
         world.run(0.3)
-        intrinsics = Intrinsics.from_hfov(640, 360)
+        camera = CameraModel(640, 360)
         requests = [(robot, side) for robot in (miro03, miro01) for side in (+1, -1)]
-        images = cameras.render_eyes(requests, intrinsics)
+        images = cameras.render_eyes(requests, camera)
         for (robot, side), rgb in zip(requests[:2], images[:2]):
-            predicted = project(intrinsics, *robot.eye_pose(side), world.ball_position())
+            predicted = camera.project_from(*robot.eye_pose(side), world.ball_position())
             found = blue_centroid(rgb)
             assert found is not None and math.dist(found, predicted) < 10.0
         for rgb in images[2:]:

@@ -9,7 +9,7 @@ import threading
 import numpy as np
 import pytest
 
-from miro_ball.miro.camera_model import Intrinsics, project
+from miro_ball.miro.camera_model import CameraModel, Intrinsics
 from miro_sim_bullet.bullet import pybullet as p
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render import gl_renderer
@@ -232,12 +232,13 @@ def test_overhead_view_shows_ball_and_robots_where_they_are(sims, kind):
     position, rotation, intrinsics = overhead_camera(sim.description)
     image = cameras.render_view(position, rotation, intrinsics)
     assert image.shape == (intrinsics.height, intrinsics.width, 3)
-    want = project(intrinsics, position, rotation, sim.ball_position())
+    overhead = CameraModel.from_intrinsics(intrinsics)
+    want = overhead.project_from(position, rotation, sim.ball_position())
     got = centroid(image, 'blue')
     assert math.dist(got, want) < 1.5
     for robot in sim.robots.values():
         body, _ = robot.model.body_frame()
-        u, v = (round(c) for c in project(intrinsics, position, rotation, body))
+        u, v = (round(c) for c in overhead.project_from(position, rotation, body))
         r, g, b = image[v - 2:v + 3, u - 2:u + 3].astype(int).transpose(2, 0, 1)
         assert (abs(g - r) < 10).all() and (abs(g - b) < 10).all(), robot.name
     r, g, _ = image[intrinsics.height // 2 + 30, intrinsics.width // 2].astype(int)
@@ -250,13 +251,13 @@ def test_all_eyes_in_one_pass_equal_eyes_one_by_one(sims):
     when the framebuffer holds fewer, are the images each eye gets on its own."""
     sim, cameras = sims('football_pitch', 'egl')
     sim.run(0.3)
-    intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
+    camera = CameraModel(320, 240)
     requests = [(robot, side) for robot in sim.robots.values() for side in (1, -1)]
-    together = cameras.render_eyes(requests, intrinsics)
-    alone = [cameras.render_eyes([request], intrinsics)[0] for request in requests]
+    together = cameras.render_eyes(requests, camera)
+    alone = [cameras.render_eyes([request], camera)[0] for request in requests]
     gl = cameras.renderer._backend.gl
-    gl.max_height = 2 * intrinsics.height + 1  # two views per pass
-    in_passes = cameras.render_eyes(requests, intrinsics)
+    gl.max_height = 2 * camera.height + 1  # two views per pass
+    in_passes = cameras.render_eyes(requests, camera)
     for a, b, c in zip(together, alone, in_passes):
         # Identical but for a few edge pixels: llvmpipe rounds a view's window coordinates
         # a little differently at another offset in the framebuffer.
@@ -268,18 +269,17 @@ def test_all_eyes_in_one_pass_equal_eyes_one_by_one(sims):
 @pytest.mark.parametrize('kind', KINDS)
 def test_renderer_survives_a_world_reset(sims, kind):
     sim, cameras = sims('miro', kind)
-    intrinsics = Intrinsics.from_hfov(320, 240, 120.0)
-    first = cameras.render_eyes([(sim.robot, -1)], intrinsics)[0]
+    camera = CameraModel(320, 240)
+    first = cameras.render_eyes([(sim.robot, -1)], camera)[0]
     sim.place_ball(0.3, 0.4)
     sim.robot.set_cmd_vel(0.2, 1.0)
     sim.run(1.0)
-    moved = cameras.render_eyes([(sim.robot, -1)], intrinsics)[0]
+    moved = cameras.render_eyes([(sim.robot, -1)], camera)[0]
     sim.reset()
-    again = cameras.render_eyes([(sim.robot, -1)], intrinsics)[0]
+    again = cameras.render_eyes([(sim.robot, -1)], camera)[0]
     assert not np.array_equal(first, moved)
     assert np.array_equal(first, again)
-    pos, rot = sim.robot.eye_pose(-1)
-    want = project(intrinsics, pos, rot, sim.ball_position())
+    want = camera.project_from(*sim.robot.eye_pose(-1), sim.ball_position())
     assert math.dist(centroid(again, 'blue'), want) < 3.0
 
 
@@ -312,8 +312,7 @@ def test_no_egl_falls_back_to_tiny_with_one_log_line(monkeypatch):
         assert cameras.renderer.name == 'tiny'
         assert log == ['camera renderer: tiny (no EGL on this box; falling back to '
                        'TinyRenderer)']
-        image = cameras.render_eyes([(sim.robot, 1)],
-                                    Intrinsics.from_hfov(320, 240, 120.0))[0]
+        image = cameras.render_eyes([(sim.robot, 1)], CameraModel(320, 240))[0]
         assert image.shape == (240, 320, 3)
         client = p.connect(p.DIRECT)
         try:

@@ -3,8 +3,8 @@
 Each tick the controller calls ``step(t, left, right, cliff, cameras)`` with the
 time in seconds (monotonic), the latest fresh detection of each eye (a
 detection.Ball or None), the latest fresh cliff reading ([left, right], 1 = floor,
-or None when unknown) and each eye's pinhole (camera.Intrinsics) at the size of the
-frame its detection came from. It gets back a Command: wheel speeds in m/s, the
+or None when unknown) and each eye's camera model (camera_model.CameraModel) at the
+size of the frame its detection came from. It gets back a Command: wheel speeds in m/s, the
 state name and the messages to log for behaviour changes that happened during the
 tick.
 """
@@ -15,7 +15,7 @@ from typing import NamedTuple, Optional, Sequence, Tuple
 
 from miro_ball.common.params import check_ranges
 from miro_ball.controller.detection import to_pixels
-from miro_ball.miro.camera_model import Intrinsics
+from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, CLIFF_THRESHOLD, WHEEL_MAX_SPEED_M_PER_S
 from miro_ball.miro.interface import EYE_SIDE, EYES
 from miro_ball.miro.kinematics import cmd_vel2wheel_speed, wheel_speed2cmd_vel
@@ -33,9 +33,9 @@ MESSAGES = {
 }
 LOST = 'lost the ball'
 
-# MiRo's simulated eyes (120 deg pinholes, the simulator's default frame size): the
-# model of both eyes until their camera_info says otherwise.
-DEFAULT_CAMERA = Intrinsics.from_hfov(640, 360)
+# MiRo's simulated eyes (120 deg pinholes, the simulator's default frame size and lens):
+# the model of both eyes until their camera_info says otherwise.
+DEFAULT_CAMERA = CameraModel(640, 360)
 DEFAULT_CAMERAS = (DEFAULT_CAMERA,) * len(EYES)
 
 
@@ -102,23 +102,23 @@ class Command(NamedTuple):
     messages: Tuple[str, ...] = ()
 
 
-def eye_bearing(ball, camera: Intrinsics, eye_azimuth):
+def eye_bearing(ball, camera: CameraModel, eye_azimuth):
     """Bearing (rad, + = left of the robot) of a detection in one eye.
 
-    camera is the eye's pinhole at the size of the frame the ball was found in: the
-    ball's pixel column gives the angle off the optical axis, and the eye's own
-    azimuth (+27 deg left, -27 right) is added. Elevation and the eyes' lateral
-    offset are ignored: the error is a few degrees and the steering closes the
-    loop anyway.
+    camera is the eye's model at the size of the frame the ball was found in: the
+    ball's pixel gives the angle off the optical axis across the image (through the
+    lens), and the eye's own azimuth (+27 deg left, -27 right) is added. The eyes'
+    elevation and lateral offset are ignored: the error is a few degrees and the
+    steering closes the loop anyway.
     """
-    column = to_pixels(ball, (camera.height, camera.width))[0]
-    return eye_azimuth + camera.bearing(column)
+    u, v, _ = to_pixels(ball, (camera.height, camera.width))
+    return eye_azimuth + camera.bearing(u, v)
 
 
-def ball_bearing(left, right, cameras: Sequence[Intrinsics]) -> Optional[float]:
+def ball_bearing(left, right, cameras: Sequence[CameraModel]) -> Optional[float]:
     """Mean bearing from the eyes that see the ball, or None if neither does.
 
-    cameras: (left, right) pinholes, each at the size of its eye's frame.
+    cameras: (left, right) camera models, each at the size of its eye's frame.
     """
     bearings = [eye_bearing(ball, camera, EYE_SIDE[eye] * CAM_DIVERGENCE_RAD)
                 for eye, ball, camera in zip(EYES, (left, right), cameras) if ball is not None]

@@ -40,7 +40,7 @@ from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERAS, mak
 from miro_ball.controller.detection import annotate, BallDetector, DetectionParams
 from miro_ball.controller.names import DEBUG_TOPIC, NODE_NAME
 from miro_ball.controller.params import ControllerParams, GROUPS
-from miro_ball.miro.camera_model import Intrinsics
+from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES
 from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYE_QOS, EYES, frame_id,
                                       robot_namespace, robot_of_namespace, RobotTopics,
@@ -67,8 +67,8 @@ def topics():
     used = []
     for eye, side in zip(EYES, SIDES):
         used += [_uses('eye_compressed', side + ' eye, JPEG', eye=eye),
-                 _uses('camera_info', '%s eye pinhole (until one arrives: %g deg)'
-                       % (side, CAM_HFOV_DEG_SIM), eye=eye)]
+                 _uses('camera_info', '%s eye camera model, lens included (until one '
+                       'arrives: %g deg pinhole)' % (side, CAM_HFOV_DEG_SIM), eye=eye)]
     used += [_uses('cliff', '[L, R], 1 floor, <0.7 drop'),
              _uses('cmd_vel', 'every tick'),
              _uses('kinematic_targets', 'head pose at start')]
@@ -103,8 +103,8 @@ class KickBlueBall(Node):
     frames_processed  camera frames decoded and run through the detector
     rejected          Counter of ignored inputs by kind (empty, corrupt, size, cliff,
                       camera_info)
-    cameras           each eye's pinhole (camera.Intrinsics) from its latest usable
-                      camera_info, at that camera_info's resolution
+    cameras           each eye's camera model (camera_model.CameraModel) from its latest
+                      usable camera_info, at that camera_info's resolution
     last_command      (left, right) wheel speeds of the latest twist, m/s
     last_tick         node time (s) of the latest control tick, None before the first
     robot             the robot it drives: the last part of its namespace
@@ -240,15 +240,17 @@ class KickBlueBall(Node):
         self._debug_image(eye, msg.header, frame, ball)
 
     def _on_camera_info(self, eye, msg):
-        """Adopt the eye's pinhole; an unusable camera_info leaves the previous one."""
+        """Adopt the eye's camera model; an unusable camera_info leaves the previous one."""
         try:
-            camera = Intrinsics.from_k(msg.width, msg.height, msg.k)
-        except ValueError as err:
+            camera = CameraModel.from_camera_info(msg)
+        except (ValueError, TypeError) as err:
             return self._reject('camera_info', '%s: camera_info unusable: %s' % (EYES[eye], err))
         if camera != self.cameras[eye]:
-            self.get_logger().info('%s: camera_info %dx%d, fx %.1f, cx %.1f (%.1f deg wide)' % (
-                EYES[eye], camera.width, camera.height, camera.fx, camera.cx,
-                math.degrees(2 * math.atan(camera.width / (2 * camera.fx)))))
+            edge = camera.bearing(-0.5, camera.intrinsics.cy)
+            self.get_logger().info('%s: camera_info %dx%d, fx %.1f, cx %.1f, %s (%.1f deg wide)'
+                                   % (EYES[eye], camera.width, camera.height,
+                                      camera.intrinsics.fx, camera.intrinsics.cx,
+                                      camera.distortion_model, 2 * math.degrees(edge)))
         self.cameras[eye] = camera
 
     def _on_cliff(self, msg):

@@ -160,9 +160,9 @@ class CameraModel:
     def from_camera_info(cls, msg):
         """From a sensor_msgs/CameraInfo (any object with its fields); ValueError if it is
         not a camera this model can use."""
-        distortion_model = msg.distortion_model or PLUMB_BOB
+        distortion_model = getattr(msg, 'distortion_model', '') or PLUMB_BOB
         return cls.from_intrinsics(Intrinsics.from_k(msg.width, msg.height, list(msg.k)),
-                                   distortion_model, list(msg.d))
+                                   distortion_model, list(getattr(msg, 'd', ())))
 
     # -- what camera_info says --------------------------------------------------------------
     width = property(lambda self: self.intrinsics.width)

@@ -1,5 +1,7 @@
 """The cameras of a simulated world: any robot's eyes and any camera pose, drawn from
 the world's PyBullet client (physics knows nothing of them)."""
+import cv2
+
 from miro_sim_bullet.render.eye_workers import EyeWorkers
 from miro_sim_bullet.render.renderer import Renderer, view_matrix_from_pose
 
@@ -16,6 +18,7 @@ class Cameras:
         self.renderer = Renderer(world.client, kind=kind, log=log)
         self._generation = world.generation  # the bodies the renderer has read
         self.eye_workers = None
+        self._plans = {}  # CameraModel -> its render plan (the lens maps take ~20 ms)
         if eye_workers and self.renderer.kind == 'tiny':
             self.eye_workers = EyeWorkers(world.description, world.dt, world.robot_name)
             log('eyes rendered in 2 worker processes')
@@ -27,13 +30,22 @@ class Cameras:
             self._generation = self.world.generation
         return self.renderer
 
-    def render_eyes(self, requests, intrinsics):
+    def render_eyes(self, requests, camera):
         """RGB images, one per (robot, side) in requests (side +1 left, -1 right), all of
-        this instant."""
+        this instant, as the eyes' CameraModel ``camera`` sees: a pinhole is drawn as it
+        is, a distorting lens drawn wider and resampled through it."""
+        if camera not in self._plans:
+            self._plans[camera] = camera.render_plan()
+        drawn, maps = self._plans[camera]
         views = [view_matrix_from_pose(*robot.eye_pose(side)) for robot, side in requests]
         if self.eye_workers is None:
-            return self._current().render_many(views, intrinsics)
-        return self.eye_workers.render(self.world.snapshot(), views, intrinsics)
+            images = self._current().render_many(views, drawn)
+        else:
+            images = self.eye_workers.render(self.world.snapshot(), views, drawn)
+        if maps is None:
+            return images
+        return [cv2.remap(image, *maps, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+                for image in images]
 
     def render_view(self, position, rotation, intrinsics):
         """RGB image from any camera pose (x forward, y left, z up)."""

@@ -82,12 +82,9 @@ def battery(s, when, robot):
     return msg
 
 
-def camera_info(intrinsics, when, frame_id):
-    k = intrinsics
-    msg = CameraInfo(width=k.width, height=k.height, distortion_model='plumb_bob',
-                     d=[0.0] * 5, k=[v for row in k.K() for v in row],
-                     r=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-                     p=[v for row in k.P() for v in row])
+def camera_info(camera, when, frame_id):
+    """The eye's CameraModel as camera_info (K, P, and the lens's distortion)."""
+    msg = CameraInfo(**camera.camera_info_fields())
     msg.header.stamp, msg.header.frame_id = when, frame_id
     return msg
 

@@ -26,7 +26,7 @@ from miro_ball.common.params import declare, help_lines, LiveParams
 from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
-from miro_ball.miro.camera_model import Intrinsics
+from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import CLOCK, CLOCK_QOS, robot_name, SIM_NODE_NAME
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
@@ -41,7 +41,7 @@ from miro_sim_bullet.scene.world_file import WorldError, bundled_worlds
 
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 FIXED_PARAMS = ('world', 'physics_dt', 'frame_width', 'frame_height',
-                'camera_rate', 'hfov_deg', 'renderer', 'eye_workers', 'peer_check_s')
+                'camera_rate', 'hfov_deg', 'lens', 'renderer', 'eye_workers', 'peer_check_s')
 
 
 class SimNode(Node):
@@ -70,7 +70,7 @@ class SimNode(Node):
         self.sim = SimWorld(p.world, physics_dt=p.physics_dt, robot_name=unnamed_robot)
         self.cameras = Cameras(self.sim, p.renderer, log=self.get_logger().info,
                                eye_workers=p.eye_workers)
-        self.intrinsics = Intrinsics.from_hfov(p.frame_width, p.frame_height, p.hfov_deg)
+        self.camera = CameraModel(p.frame_width, p.frame_height, p.lens, p.hfov_deg)
         self.paused = p.paused
         self.frames_published = 0
         self.render_seconds = []  # wall time of each camera instant (all eyes)
@@ -202,9 +202,9 @@ class SimNode(Node):
         when = convert.stamp(self.sim.time)
         started = time.perf_counter()
         images = self.cameras.render_eyes([(i.robot, side) for i, _, side in wanted],
-                                          self.intrinsics)
+                                          self.camera)
         for (interface, eye, _), rgb in zip(wanted, images):
-            interface.publish_eye(eye, rgb, when, self.intrinsics, self.params.jpeg_quality)
+            interface.publish_eye(eye, rgb, when, self.camera, self.params.jpeg_quality)
         self.frames_published += len(wanted)
         self.render_seconds.append(time.perf_counter() - started)
 

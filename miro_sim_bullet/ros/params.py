@@ -2,6 +2,7 @@
 from dataclasses import dataclass, field
 
 from miro_ball.common.params import check_ranges
+from miro_ball.miro.camera_model import LENSES, PINHOLE
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES
 from miro_sim_bullet.physics.world import PHYSICS_DT_S
 
@@ -30,8 +31,14 @@ class SimParams:
                                metadata={'help': 'eye camera frames per simulated second',
                                          'range': (0.1, 100.0)})
     hfov_deg: float = field(default=CAM_HFOV_DEG_SIM,
-                            metadata={'help': 'eye camera horizontal field of view, deg',
-                                      'range': (1.0, 179.0)})
+                            metadata={'help': 'eye camera horizontal field of view, deg '
+                                              '(pinhole lens)', 'range': (1.0, 179.0)})
+    # Pinhole by default: the tutorial's Gazebo eyes are pinholes too (the MDK's
+    # use_wideanglecamera_eyes=0), and a pinhole costs a third of the drawing.
+    lens: str = field(default=PINHOLE,
+                      metadata={'help': 'eye camera lens: pinhole (hfov_deg wide, no distortion) '
+                                        "| miro (MiRo's wide-angle lens, 120 x 62 deg, "
+                                        'equidistant distortion in camera_info)'})
     renderer: str = field(default='auto', metadata={'help': ' | '.join(RENDERERS)})
     eye_workers: bool = field(
         default=True, metadata={'help': 'with TinyRenderer, render eyes in 2 worker processes'})
@@ -56,7 +63,8 @@ class SimParams:
             raise ValueError(f"frame size {size[0]}x{size[1]} is not one of MiRo's: "
                              + ', '.join(f'{w}x{h}' for w, h in FRAME_SIZES))
         checks = (('world', self.world != '', 'a world name or a path'),
-                  ('renderer', self.renderer in RENDERERS, ' or '.join(RENDERERS)))
+                  ('renderer', self.renderer in RENDERERS, ' or '.join(RENDERERS)),
+                  ('lens', self.lens in LENSES, ' or '.join(LENSES)))
         for name, ok, rule in checks:
             if not ok:
                 raise ValueError(f'parameter {name} must be {rule}, got {getattr(self, name)!r}')

@@ -147,11 +147,11 @@ class RobotInterface:
         return [(eye, EYE_SIDE[eye]) for eye in EYES
                 if any(p.get_subscription_count() for p in self.pub_eyes[eye])]
 
-    def publish_eye(self, eye, rgb, when, intrinsics, jpeg_quality):
+    def publish_eye(self, eye, rgb, when, camera, jpeg_quality):
         compressed, raw, info = self.pub_eyes[eye]
         frame = frame_id(self.name, f'{eye}_optical')
         if compressed.get_subscription_count():
             compressed.publish(convert.jpeg(rgb, when, frame, jpeg_quality))
         if raw.get_subscription_count():
             raw.publish(convert.raw_image(rgb, when, frame))
-        info.publish(convert.camera_info(intrinsics, when, frame))
+        info.publish(convert.camera_info(camera, when, frame))
