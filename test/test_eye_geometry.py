@@ -4,10 +4,13 @@ import math
 import cv2
 import numpy as np
 import pytest
+from hypothesis import assume, given, HealthCheck, settings, strategies as st
 
-from miro_ball.miro.constants import LIFT_RAD_CALIB
+from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT, LIFT_RAD_CALIB, PITCH, TILT_RAD, YAW
 from miro_ball.controller.detection import BallDetector
 from miro_ball.miro.camera_model import CameraModel, LENSES
+from miro_ball.miro.kc import CAML, CAMR, FOOT, KinematicChain, WORLD
+from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.renderer import probe_egl, view_matrix_from_pose
@@ -124,3 +127,62 @@ def test_eye_worker_processes_render_exactly_what_the_simulator_would():
     finally:
         cameras.close()
         world.close()
+
+
+MARKER_HALF = 0.01  # a 2 cm red square flat on the floor
+# What the issue asks of pixel -> floor, points up to 1 m away: m per lens.
+FLOOR_TOLERANCE = {'pinhole': 0.02, 'miro': 0.03}
+
+
+@pytest.fixture(scope='module')
+def marked_floor():
+    """(a SimWorld 'empty' with a red floor marker, its marker body, its Cameras)"""
+    world = SimWorld('empty')
+    kw = dict(physicsClientId=world.client)
+    shape = pb.createVisualShape(pb.GEOM_BOX, halfExtents=(MARKER_HALF, MARKER_HALF, 0.0005),
+                                 rgbaColor=(1, 0, 0, 1), **kw)
+    # Not static (a mass), so the renderer draws it where it is put; no collision shape.
+    marker = pb.createMultiBody(baseMass=0.001, baseVisualShapeIndex=shape, **kw)
+    world.place_ball(-3.0, 3.0)  # out of every view: it would hide the mark
+    cameras = Cameras(world, 'auto')
+    yield world, marker, cameras
+    cameras.close()
+    world.close()
+
+
+def red_centroid(rgb):
+    r, g, b = (rgb[:, :, i].astype(int) for i in range(3))
+    v, u = np.nonzero((r > 100) & (g < 60) & (b < 60))
+    return (u.mean(), v.mean()) if len(u) >= 4 else None
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.filter_too_much,
+                                                                  HealthCheck.too_slow])
+@given(lens=st.sampled_from(LENSES), eye=st.sampled_from((CAML, CAMR)),
+       head=st.tuples(*(st.floats(*JOINT_LIMITS_RAD[j]) for j in (LIFT, YAW, PITCH))),
+       distance=st.floats(0.25, 1.0), bearing=st.floats(-1.2, 1.2))
+def test_pixel_to_floor_finds_a_floor_mark_where_it_is(marked_floor, lens, eye, head,
+                                                       distance, bearing):
+    """As a student would: the head somewhere, the joints as sensors/kinematic_joints
+    reports them, the mark's pixel in the eye image -> the floor point in FOOT."""
+    world, marker, cameras = marked_floor
+    camera = CameraModel(640, 360, lens=lens)
+    robot = world.robot
+    robot.place(0.0, 0.0, 0.0)
+    robot.set_kinematic_targets((TILT_RAD, *head))
+    world.run(0.6)  # the head gets there, the body settles
+    kc = KinematicChain(robot.sensors.kinematic_positions)
+    x, y = distance * math.cos(bearing), distance * math.sin(bearing)
+    predicted = camera.floor_to_pixel(kc, eye, x, y)
+    assume(predicted is not None and 8 < predicted[0] < 632 and 8 < predicted[1] < 352)
+    gx, gy, gz, gyaw = robot.ground_truth()  # FOOT in the world
+    kc.set_pose(gx, gy, gyaw, gz)
+    world_xy = kc.change_frame_abs(FOOT, WORLD, (x, y, 0.0))
+    pb.resetBasePositionAndOrientation(marker, (world_xy[0], world_xy[1], 0.0005),
+                                       (0, 0, 0, 1), physicsClientId=world.client)
+    rgb, = cameras.render_eyes([(robot, 1 if eye == CAML else -1)], camera)
+    found = red_centroid(rgb)
+    assert found is not None
+    floor = camera.pixel_to_floor(kc, eye, *found)
+    assert floor is not None
+    assert math.dist(floor, (x, y)) < FLOOR_TOLERANCE[lens]
