@@ -30,6 +30,12 @@ def test_each_mode_kicks_the_ball_in_the_default_world(ros_context, mode):
     assert outcome.frames > 0
 
 
+def test_improved_mode_kicks_through_miros_wide_angle_lens(ros_context):
+    # The controller's bearings come from camera_info: the lens's distortion included.
+    outcome = episode(ros_context, mode='improved', limit_s=30.0, lens='miro')
+    assert outcome.kicked and not outcome.fell, outcome
+
+
 @pytest.mark.parametrize('placement', [
     Placement(robot=(0.0, 0.0, 0.0), ball=(-0.6, 0.1)),          # ball behind the robot
     Placement(robot=(-0.3, 0.2, 1.0), ball=(0.85, -0.45)),       # ball near the wall

@@ -18,6 +18,7 @@ from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Im
 from std_msgs.msg import Float32MultiArray, UInt16MultiArray, UInt32, UInt32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
+from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics, default_robot_name, robot_name
 from miro_sim_bullet.physics.world import PHYSICS_DT_S
@@ -194,6 +195,21 @@ def test_eye_cameras_publish_matching_stereo_frames(sim_node, probe, executor):
     # The ball at (0.6, -0.3) is to MiRo's right: blue in the right eye's JPEG.
     blue = (image[:, :, 0] > 120) & (image[:, :, 1] < 80) & (image[:, :, 2] < 80)
     assert blue.sum() > 200
+
+
+def test_miro_lens_is_drawn_and_published_in_camera_info(make_sim, probe, executor):
+    sim_node = make_sim(lens='miro')
+    frames = probe.watch(CompressedImage, T.eye_compressed('caml'))
+    info = probe.watch(CameraInfo, T.camera_info('caml'))
+    spin_until(executor, lambda: sim_node.robots[T.name].pub_eyes['caml'][0]
+               .get_subscription_count() > 0)
+    run(sim_node, executor, 0.2)
+    spin_until(executor, lambda: frames and info)
+    assert info[-1].distortion_model == 'equidistant' and len(info[-1].d) == 4
+    camera = CameraModel.from_camera_info(info[-1])
+    assert camera == CameraModel(640, 360, lens='miro')
+    assert cv2.imdecode(np.frombuffer(bytes(frames[-1].data), np.uint8),
+                        cv2.IMREAD_COLOR).shape == (360, 640, 3)
 
 
 def test_cameras_render_only_while_subscribed(sim_node, executor):

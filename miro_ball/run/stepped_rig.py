@@ -20,12 +20,14 @@ TICK_TIMEOUT_S = 5.0
 class SteppedRig:
     """mode, seed (of the first robot's controller; the next get seed + 1, ...) and
     controller_params ((name, value) ROS parameters) of the controllers; quiet: their and
-    the simulator's info lines left out (the benchmark's own lines would drown)."""
+    the simulator's info lines left out (the benchmark's own lines would drown); lens:
+    the simulator's eye lens (pinhole or miro)."""
 
     def __init__(self, context, world='miro', mode='improved', renderer='auto', seed=1,
-                 controller_params=(), quiet=False):
+                 controller_params=(), quiet=False, lens='pinhole'):
         self.context = context
         self.world, self.mode, self.renderer, self.seed = world, mode, renderer, seed
+        self.lens = lens
         self.controller_params = controller_params
         self.quiet = quiet
         self.sim_node = self.referee = None
@@ -41,7 +43,7 @@ class SteppedRig:
         self._quieten(SIM_NODE_NAME)
         self.sim_node = SimNode(context=self.context, parameter_overrides=[
             Parameter('paused', value=True), Parameter('world', value=self.world),
-            Parameter('renderer', value=self.renderer)])
+            Parameter('renderer', value=self.renderer), Parameter('lens', value=self.lens)])
         self.sim = self.sim_node.sim
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.sim_node)
