@@ -37,7 +37,7 @@ class SimParams:
     # use_wideanglecamera_eyes=0), and a pinhole costs a third of the drawing.
     lens: str = field(default=PINHOLE,
                       metadata={'help': 'eye camera lens: pinhole (hfov_deg wide, no distortion) '
-                                        "| miro (MiRo's wide-angle lens, 120 x 62 deg, "
+                                        "| miro (MiRo's wide-angle lens, 121 x 64 deg, "
                                         'equidistant distortion in camera_info)'})
     renderer: str = field(default='auto', metadata={'help': ' | '.join(RENDERERS)})
     eye_workers: bool = field(
