@@ -2,8 +2,9 @@
 
 Milliseconds to render the eyes of one camera instant in the same scene (a bundled world
 after 0.5 s, the robots' eyes from their own poses, the head panning between instants)
-with each renderer: ours (egl), TinyRenderer (tiny) and, for reference, PyBullet's own
-eglRenderer plugin as PyBullet ships it (pybullet-egl). Each renderer lives in a process
+with each renderer: ours (egl), TinyRenderer (tiny), ours through MiRo's wide-angle lens
+(egl-miro-lens: drawn wider and resampled) and, for reference, PyBullet's own eglRenderer
+plugin as PyBullet ships it (pybullet-egl). Each renderer lives in a process
 of its own (the plugin must), and they take turns batch by batch, so that a busy moment
 of the machine hits all of them alike. Figures are medians over all instants.
 """
@@ -17,7 +18,8 @@ BATCH = 10  # instants per turn
 CASES = (('miro', 1), ('football_pitch', 3))  # world, robots whose eyes are rendered
 SIZES = ((640, 360), (320, 240), (1280, 720))
 HFOV_DEG = 120.0
-KINDS = ('egl', 'tiny', 'pybullet-egl')
+MIRO_LENS = 'egl-miro-lens'
+KINDS = ('egl', 'tiny', MIRO_LENS, 'pybullet-egl')
 
 
 def _pybullet_egl(sim):
@@ -51,28 +53,36 @@ def _pybullet_egl(sim):
 
 def _serve(connection, kind, world):
     """Worker: builds the world with its renderer, then times batches on request."""
-    from miro_ball.miro.camera_model import Intrinsics
+    from miro_ball.miro.camera_model import CameraModel, MIRO, PINHOLE
     from miro_sim_bullet.physics.world import SimWorld
     from miro_sim_bullet.render.cameras import Cameras
     from miro_sim_bullet.render.renderer import view_matrix_from_pose
 
     sim = SimWorld(world)
-    cameras = None if kind == 'pybullet-egl' else Cameras(sim, kind, log=lambda _: None)
+    lens = MIRO if kind == MIRO_LENS else PINHOLE
+    cameras = None if kind == 'pybullet-egl' else Cameras(sim, 'egl' if lens == MIRO else kind,
+                                                          log=lambda _: None)
     try:
-        render = _pybullet_egl(sim) if cameras is None else cameras.renderer.render_many
+        if cameras is None:
+            plugin = _pybullet_egl(sim)
+            def render(views, camera):
+                return plugin(views, camera.intrinsics)
+        else:
+            render = cameras.render_views
         sim.run(0.5)
         connection.send(('ready', kind if cameras is None else cameras.renderer.name))
         turn = 0
         while (job := connection.recv()) is not None:
             (width, height), robots = job
-            intrinsics = Intrinsics.from_hfov(width, height, HFOV_DEG)
+            camera = CameraModel(width, height, lens, HFOV_DEG)
+            render([], camera)  # the lens's resampling maps are made once, before timing
             times = []
             for _ in range(BATCH):
                 turn += 1
                 views = [view_matrix_from_pose(*_panned(robot.eye_pose(side), turn))
                          for robot in list(sim.robots.values())[:robots] for side in (1, -1)]
                 start = time.perf_counter()
-                render(views, intrinsics)
+                render(views, camera)
                 times.append(time.perf_counter() - start)
             connection.send(times)
     finally:

@@ -34,10 +34,14 @@ class Cameras:
         """RGB images, one per (robot, side) in requests (side +1 left, -1 right), all of
         this instant, as the eyes' CameraModel ``camera`` sees: a pinhole is drawn as it
         is, a distorting lens drawn wider and resampled through it."""
+        return self.render_views(
+            [view_matrix_from_pose(*robot.eye_pose(side)) for robot, side in requests], camera)
+
+    def render_views(self, views, camera):
+        """RGB images through CameraModel ``camera`` from OpenGL view matrices."""
         if camera not in self._plans:
             self._plans[camera] = camera.render_plan()
         drawn, maps = self._plans[camera]
-        views = [view_matrix_from_pose(*robot.eye_pose(side)) for robot, side in requests]
         if self.eye_workers is None:
             images = self._current().render_many(views, drawn)
         else:
