@@ -32,6 +32,11 @@ def test_pixel_to_ray_and_back(lens, size, seed):
     assert np.linalg.norm(rays, axis=-1) == pytest.approx(1.0)
     back_u, back_v = camera.ray_to_pixel(rays)
     assert np.abs(back_u - u).max() < 1e-6 and np.abs(back_v - v).max() < 1e-6
+    a, b = camera.pixel_to_normalised(u, v)
+    assert a == pytest.approx(-rays[:, 1] / rays[:, 0]) and b == pytest.approx(
+        -rays[:, 2] / rays[:, 0])
+    back_u, back_v = camera.normalised_to_pixel(a, b)
+    assert np.abs(back_u - u).max() < 1e-6 and np.abs(back_v - v).max() < 1e-6
 
 
 @settings(max_examples=60, deadline=None)

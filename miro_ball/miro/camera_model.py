@@ -231,6 +231,18 @@ class CameraModel:
             seen = (ahead > 1e-9) & self.in_frame(u, v)
         return np.where(seen, u, np.nan), np.where(seen, v, np.nan)
 
+    def pixel_to_normalised(self, u, v):
+        """Normalised image coordinates (a, b) = (X/Z, Y/Z) of pixel(s), the lens undone
+        (a right, b down: what a pinhole with f = 1 would see)."""
+        ray = self.pixel_to_ray(u, v)
+        return -ray[..., 1] / ray[..., 0], -ray[..., 2] / ray[..., 0]
+
+    def normalised_to_pixel(self, a, b):
+        """Pixel(s) (u, v) of normalised image coordinates, through the lens; NaN off the
+        frame."""
+        a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
+        return self.ray_to_pixel(np.stack([np.ones_like(a), -a, -b], axis=-1))
+
     def in_frame(self, u, v):
         """True where (u, v) lies on the frame (pixel edges included)."""
         k = self.intrinsics
