@@ -174,8 +174,9 @@ def _aim(chain, tilt, start, target, eye):
                      if on_axis else min(tried, key=lambda t: _angle(t[1])))
     error = _angle(offsets)
     reachable = error <= REACH_TOLERANCE_RAD
+    reason = '' if reachable else _why(chain, tilt, head, target, eye)
     return Gaze(joints=(tilt, *(float(j) for j in head)), eye=eye, error_rad=error,
-                reachable=reachable, reason='' if reachable else _why(chain, tilt, head, target, eye))
+                reachable=reachable, reason=reason)
 
 
 def _first_guess(chain, tilt, target, eye):
