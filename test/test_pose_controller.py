@@ -53,7 +53,8 @@ def test_it_arrives_from_anywhere_within_its_tolerances(start, goal, tolerance):
 def test_every_command_is_within_the_wheels_and_the_given_top_speeds(pose, goal, max_forward,
                                                                     max_turn):
     controller = PoseController(goal, max_forward=max_forward, max_turn=max_turn,
-                                min_forward=min(0.03, max_forward))
+                                min_forward=min(0.03, max_forward),
+                                min_turn=min(0.2, max_turn))
     forward, turn = controller.command(pose)
     assert wheels_within_limits(forward, turn)
     assert abs(forward) <= max_forward + 1e-12 and abs(turn) <= max_turn + 1e-12
@@ -61,7 +62,7 @@ def test_every_command_is_within_the_wheels_and_the_given_top_speeds(pose, goal,
 
 def test_at_the_goal_it_has_arrived_and_stays_still():
     controller = PoseController((0.5, -0.2, 1.0))
-    assert controller.command((0.51, -0.2, 1.02)) == (0.0, 0.0) and controller.arrived
+    assert controller.command((0.505, -0.2, 1.01)) == (0.0, 0.0) and controller.arrived
 
 
 def test_a_goal_just_behind_is_backed_onto_and_one_far_behind_turned_to():
@@ -82,6 +83,7 @@ def test_at_the_goal_point_it_turns_on_the_spot_to_the_goal_heading():
 @pytest.mark.parametrize('settings_', [dict(position_tolerance=0.0), dict(max_forward=0.5),
                                        dict(max_turn=5.0), dict(turn_gain=math.nan),
                                        dict(min_forward=0.35, max_forward=0.3),
+                                       dict(min_turn=3.0, max_turn=2.0),
                                        dict(reverse_within=-1.0)])
 def test_settings_it_can_not_use_are_refused(settings_):
     with pytest.raises(ValueError):

@@ -8,9 +8,10 @@
 Two phases. Away from the goal MiRo steers towards the goal point while it drives, faster
 the farther it is and slower the more the point is off to the side (on the spot when it is
 beside or behind); a point close behind it it backs onto instead of turning round. Once
-within half the position tolerance it turns on the spot to the goal heading, and drives
-again only if it has strayed beyond the whole tolerance (so it does not dither at the
-edge). Every command keeps each wheel within MiRo's 0.4 m/s, the turn taking priority.
+within half the position tolerance it turns on the spot to the goal heading. It aims at
+half of each tolerance and counts as there until it strays beyond a whole one, so it
+neither stops at the very edge nor dithers there. Every command keeps each wheel within
+MiRo's 0.4 m/s, the turn taking priority.
 Pure Python: the caller reads odometry and sends the commands, at any rate (MiRo's
 platform runs at 50 Hz).
 """
@@ -34,27 +35,30 @@ class PoseController:
     position_tolerance (m) and heading_tolerance (rad): how close is there. max_forward
     (m/s) and max_turn (rad/s): its top speeds (MiRo's wheels allow 0.4 m/s and 4.9 rad/s).
     forward_gain and turn_gain (1/s): m/s per m left to go, rad/s per rad left to turn.
-    min_forward (m/s): the slowest it creeps up to the goal. reverse_within (m): a goal
+    min_forward (m/s) and min_turn (rad/s): the slowest it creeps up to the goal point and
+    turns to the goal heading. reverse_within (m): a goal
     behind MiRo nearer than this is backed onto. ValueError for values it can not use.
     """
 
     def __init__(self, goal, position_tolerance=0.02, heading_tolerance=math.radians(3.0),
                  max_forward=0.3, max_turn=2.5, forward_gain=1.5, turn_gain=4.0,
-                 min_forward=0.03, reverse_within=0.2):
+                 min_forward=0.03, min_turn=0.2, reverse_within=0.2):
         x, y, theta = (float(v) for v in goal)
         numbers = dict(position_tolerance=position_tolerance,
                        heading_tolerance=heading_tolerance, max_forward=max_forward,
                        max_turn=max_turn, forward_gain=forward_gain, turn_gain=turn_gain,
-                       min_forward=min_forward, reverse_within=reverse_within)
+                       min_forward=min_forward, min_turn=min_turn,
+                       reverse_within=reverse_within)
         if not all(math.isfinite(v) for v in (x, y, theta, *numbers.values())):
             raise ValueError(f'goal and settings must be finite, got goal {goal} and {numbers}')
         if not all(v > 0 for name, v in numbers.items() if name != 'reverse_within') \
                 or reverse_within < 0:
             raise ValueError(f'settings must be positive, got {numbers}')
         if max_forward > WHEEL_MAX_SPEED_M_PER_S or max_turn > MAX_TURN_RAD_S \
-                or min_forward > max_forward:
+                or min_forward > max_forward or min_turn > max_turn:
             raise ValueError(f'need min_forward <= max_forward <= {WHEEL_MAX_SPEED_M_PER_S} '
-                             f'm/s and max_turn <= {MAX_TURN_RAD_S:.2f} rad/s, got {numbers}')
+                             f'm/s and min_turn <= max_turn <= {MAX_TURN_RAD_S:.2f} rad/s, '
+                             f'got {numbers}')
         self.goal = (x, y, theta)
         for name, value in numbers.items():
             setattr(self, name, float(value))
@@ -73,12 +77,17 @@ class PoseController:
             self._turning_on_the_spot = True
         elif distance > self.position_tolerance:
             self._turning_on_the_spot = False
-        self.arrived = (distance <= self.position_tolerance
-                        and abs(heading_error) <= self.heading_tolerance)
+        if self.arrived:
+            self.arrived = (distance <= self.position_tolerance
+                            and abs(heading_error) <= self.heading_tolerance)
+        else:
+            self.arrived = (self._turning_on_the_spot
+                            and abs(heading_error) <= self.heading_tolerance / 2.0)
         if self.arrived:
             return 0.0, 0.0
         if self._turning_on_the_spot:
-            return self._limited(0.0, self.turn_gain * heading_error)
+            turn = max(self.min_turn, self.turn_gain * abs(heading_error))
+            return self._limited(0.0, math.copysign(turn, heading_error))
         x, y, theta = pose
         bearing = wrap(math.atan2(self.goal[1] - y, self.goal[0] - x) - theta)
         direction = 1.0

@@ -1,0 +1,163 @@
+"""The Robot object against the simulator, used as a student's script uses it: the test's
+main thread is the script, the simulator runs in-process on a thread of its own."""
+import math
+import threading
+import time
+
+import cv2
+import numpy as np
+import pytest
+from geometry_msgs.msg import Pose2D
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
+
+from miro_ball.controller.detection import BallDetector
+from miro_ball.miro.interface import default_robot_name, RobotTopics
+from miro_ball.miro.kc import EYE_SIDE
+from miro_ball.robot import Robot
+
+NAME = default_robot_name()
+BALL = (0.6, -0.3, 0.1)  # where the default world's ball rests (its centre)
+# Twice real time: the robot's 50 Hz loop keeps up with it on a busy machine.
+REAL_TIME_FACTOR = 2.0
+HANG_S = 120.0  # wall seconds: only against a hang
+
+
+class RunningSimulator:
+    """The simulator's node running by itself (not paused) in the test's main thread, which
+    is where it renders; ``script(fn)`` runs fn(robot) meanwhile in a thread of its own, with
+    a Robot connected, as a student's script would, and raises what it raised."""
+
+    def __init__(self, node, executor):
+        self.node, self.executor = node, executor
+
+    def robot(self):
+        """The simulator's own robot: the ground truth."""
+        return self.node.sim.robots[NAME]
+
+    def script(self, fn):
+        failed = []
+
+        def run():
+            try:
+                with Robot() as miro:
+                    fn(miro)
+            except BaseException as err:  # noqa: B902 - handed to the main thread
+                failed.append(err)
+        thread = threading.Thread(target=run, daemon=True)
+        thread.start()
+        deadline = time.monotonic() + HANG_S
+        while thread.is_alive():
+            assert time.monotonic() < deadline, 'the script hangs'
+            self.executor.spin_once(timeout_sec=0.01)
+        if failed:
+            raise failed[0]
+
+
+@pytest.fixture
+def sim(ros_context):
+    from miro_sim_bullet.ros.node import SimNode
+
+    node = SimNode(context=ros_context, parameter_overrides=[
+        Parameter('world', value='miro'), Parameter('real_time_factor', value=REAL_TIME_FACTOR)])
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    yield RunningSimulator(node, executor)
+    executor.shutdown()
+    node.destroy_node()
+
+
+def test_no_simulator_is_said_in_one_line():
+    with pytest.raises(TimeoutError, match=f"no robot '{NAME}' on ROS domain .* simulator"):
+        Robot(timeout=1.0)
+
+
+def test_a_bad_name_is_refused():
+    with pytest.raises(ValueError, match='robot name'):
+        Robot('1x')
+
+
+def test_it_reads_where_the_robot_is_and_its_sensors(sim):
+    def script(miro):
+        assert tuple(miro.pose) == pytest.approx(sim.robot().pose(), abs=0.01)
+        assert len(miro.joints) == 4
+        assert miro.joints[1] == pytest.approx(math.radians(34), abs=0.02)
+        sensors = miro.sensors
+        assert sensors.battery == pytest.approx(4.8) and sensors.cliff == (1.0, 1.0)
+        assert sensors.sonar > 0 and len(sensors.light) == 4 and sensors.touch_body == 0
+        before = miro.now
+        miro.sleep(0.5)
+        assert miro.now == pytest.approx(before + 0.5, abs=0.03)
+    sim.script(script)
+
+
+def test_drive_moves_it_until_stop(sim):
+    def script(miro):
+        miro.drive(0.2, 0.0)
+        miro.sleep(1.5)  # longer than MiRo's half-second command timeout: drive() holds
+        miro.stop()
+        miro.sleep(0.3)
+        x, y, _ = miro.pose
+        assert x == pytest.approx(0.3, abs=0.05) and abs(y) < 0.02
+        assert (x, y) == pytest.approx(sim.robot().pose()[:2], abs=0.01)
+        miro.sleep(0.5)
+        assert miro.pose.x == pytest.approx(x, abs=0.005)  # stopped
+    sim.script(script)
+
+
+def test_look_at_puts_the_ball_on_an_eyes_axis_and_in_the_middle_of_its_image(sim):
+    def script(miro):
+        gaze = miro.look_at(*BALL)
+        assert gaze.reachable, gaze
+        miro.sleep(1.0)  # the head's servos
+        assert miro.joints[1:] == pytest.approx(gaze.joints[1:], abs=0.01)
+        position, rotation = sim.robot().eye_pose(EYE_SIDE[gaze.eye])
+        to_ball = np.array(sim.node.sim.ball_position()) - position
+        cosine = rotation[:, 0] @ to_ball / np.linalg.norm(to_ball)
+        assert math.degrees(math.acos(cosine)) < 2.0
+        eye = 'caml' if EYE_SIDE[gaze.eye] > 0 else 'camr'
+        image, camera = miro.images[eye], miro.cameras[eye]
+        assert image.shape == (camera.height, camera.width, 3)
+        found = BallDetector().find_circle(cv2.cvtColor(image, cv2.COLOR_RGB2BGR))
+        assert found is not None
+        centre = (camera.intrinsics.cx, camera.intrinsics.cy)
+        assert math.dist(found[:2], centre) < 15  # px: 2 degrees is ~13 px here
+    sim.script(script)
+
+
+def test_look_at_says_when_it_can_not(sim):
+    def script(miro):
+        gaze = miro.look_at(0.2, 0.0, 0.0)  # the floor under its nose
+        assert not gaze.reachable and gaze.reason
+        with pytest.raises(ValueError, match='frame'):
+            miro.look_at(1.0, 0.0, 0.0, frame='map')
+    sim.script(script)
+
+
+def test_drive_to_arrives_within_its_tolerances(sim):
+    def script(miro):
+        for goal in ((0.3, 0.2, math.pi / 2), (0.0, 0.0, 0.0)):
+            assert miro.drive_to(*goal, timeout=20.0)
+            miro.sleep(0.2)
+            x, y, theta = sim.robot().pose()
+            assert math.dist((x, y), goal[:2]) < 0.025
+            assert abs(math.remainder(theta - goal[2], math.tau)) < math.radians(4)
+    sim.script(script)
+
+
+def test_drive_to_gives_up_when_its_time_is_up(sim):
+    def script(miro):
+        assert not miro.drive_to(1.0, 0.0, 0.0, timeout=0.5)
+        assert miro.pose.x < 0.3
+    sim.script(script)
+
+
+def test_garbage_on_a_topic_is_ignored(sim):
+    probe = sim.node.create_publisher(Pose2D, RobotTopics(NAME).body_pose, 10)
+
+    def script(miro):
+        for _ in range(20):
+            probe.publish(Pose2D(x=math.nan, y=0.0, theta=0.0))
+            miro.sleep(0.02)
+            assert all(math.isfinite(v) for v in miro.pose)
+    sim.script(script)
