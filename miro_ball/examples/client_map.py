@@ -13,7 +13,7 @@ are grey; what stands up (the ball, the walls) lies on the floor behind where it
 stands, as the eye sees it. --spin turns MiRo on the spot so that it maps all
 around (at 0.5 rad/s a full turn takes 13 s).
 
-    python -m miro_ball.examples.client_map [--size 3.0] [--resolution 0.01] [--out map.png] [--spin 0]
+    python -m miro_ball.examples.client_map [--size 3.0] [--resolution 0.01] [--spin 0.5]
 """
 import bisect
 import math
@@ -40,9 +40,9 @@ PUBLISH_PERIOD_S = 0.5  # simulated s between maps on ~/map
 WRITE_EVERY = 4  # published maps between writes of --out (every 2 s)
 HISTORY_S = 1.0  # simulated s of poses and joints kept to pair frames with
 MAX_PENDING = 8  # frames waiting for the pose after them (~0.25 s of both eyes)
-# Frames without a camera_info before a warning: at the start the first frame may come
-# before the first camera_info (each is published right after its frame).
-INFO_PATIENCE = 15
+# Frames in a row that can not be painted before a warning: at the start the first
+# frames come before the first pose, joints or camera_info (published after its frame).
+PATIENCE = 15
 KC_EYE = {'caml': CAML, 'camr': CAMR}
 MAX_ODOM_M = 1e5  # odometry beyond this is nonsense (and would put the map out of reach)
 
@@ -56,13 +56,10 @@ class Track:
         self.span_s = span_s
         self.angles = angles
         self.times, self.values = [], []
-        self.first = math.inf  # the first sample's time, since the start or a reset
 
     def add(self, t, values):
         if self.times and t < self.times[-1]:  # time went back: the world was reset
             self.times, self.values = [], []
-        if not self.times:
-            self.first = t
         self.times.append(t)
         self.values.append(np.asarray(values, float))
         while self.times[0] < t - self.span_s:
@@ -107,7 +104,7 @@ class Mapper(Client):
         self.joints = Track(HISTORY_S)  # tilt, lift, yaw, pitch
         self.cameras = {}  # eye -> CameraModel from its camera_info
         self.pending = []  # (stamp s, eye, RGB image) waiting for the pose after them
-        self.without_info = dict.fromkeys(EYES, 0)  # frames before the eye's camera_info
+        self.skipped = 0  # frames in a row that could not be painted
         self.published = 0
         self.warn = Throttled(self.get_logger().warning)
         for eye in EYES:
@@ -135,9 +132,7 @@ class Mapper(Client):
         self.pending.append((seconds(msg.header.stamp), eye, cv2.cvtColor(bgr,
                                                                           cv2.COLOR_BGR2RGB)))
         if len(self.pending) > MAX_PENDING:
-            self.pending.pop(0)
-            self.warn('pending', 'eye frames dropped: no odometry and joints after them '
-                                 f'({self.topics.odom}, {self.topics.kinematic_joints})')
+            self.skip(self.pending.pop(0)[1], 'no pose and joints after it')
         self.paint_ready()
 
     def on_camera_info(self, eye, msg):
@@ -179,25 +174,28 @@ class Mapper(Client):
         for frame in self.pending:
             if frame[0] <= known:
                 self.paint(*frame)
-            elif frame[0] <= known + HISTORY_S:  # not from before a reset of the world
+            elif frame[0] <= known + HISTORY_S:
                 waiting.append(frame)
+            else:  # no pose or joints yet, or a frame from before a reset of the world
+                self.skip(frame[1], 'no pose and joints of its instant')
         self.pending = waiting
 
+    def skip(self, eye, why):
+        """A frame that can not be painted: said when it goes on for a while."""
+        self.skipped += 1
+        if self.skipped > PATIENCE:
+            self.warn(why, f'{eye}: frames ignored: {why} ({self.topics.odom}, '
+                           f'{self.topics.kinematic_joints}, {self.topics.camera_info(eye)})')
+
     def paint(self, t, eye, rgb):
-        if t < max(self.poses.first, self.joints.first):
-            return  # from before the client heard the pose and the joints: nothing to pair
-        camera = self.cameras.get(eye)
+        camera, pose, joints = self.cameras.get(eye), self.poses.at(t), self.joints.at(t)
         if camera is None:
-            self.without_info[eye] += 1
-            if self.without_info[eye] > INFO_PATIENCE:
-                self.warn(f'{eye}_no_info', f'{eye}: frames ignored: no '
-                                            f'{self.topics.camera_info(eye)} yet')
+            self.skip(eye, 'no camera_info yet')
             return
-        pose, joints = self.poses.at(t), self.joints.at(t)
         if pose is None or joints is None:
-            self.warn('unpaired', f'{eye}: frame of {t:.3f} s ignored: it is older than the '
-                                  f'{HISTORY_S:g} s of poses and joints kept')
+            self.skip(eye, 'no pose and joints of its instant')
             return
+        self.skipped = 0
         self.kc.set_joints(*joints)
         self.kc.set_pose(*pose)
         try:
