@@ -50,6 +50,7 @@ setup(
             'client_show = miro_ball.examples.client_show:main',
             'client_follower = miro_ball.examples.client_follower:main',
             'client_test = miro_ball.examples.client_test:main',
+            'client_look = miro_ball.examples.client_look:main',
             'client_map = miro_ball.examples.client_map:main',
             'miro_gui = miro_ball.gui.app:main',
             'grade = miro_ball.grade:main',
