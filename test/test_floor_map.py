@@ -12,8 +12,7 @@ from miro_ball.miro.camera_model import CameraModel, LENSES
 from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT, PITCH, TILT_RAD, YAW
 from miro_ball.miro.kc import CAML, CAMR, FOOT, KinematicChain, WORLD
 from miro_sim_bullet.bullet import pybullet as pb
-from miro_sim_bullet.physics.world import SimWorld
-from miro_sim_bullet.render.cameras import Cameras
+from test_eye_geometry import FLOOR_TOLERANCE, marked_floor, red_centroid  # noqa: F401 (a fixture)
 
 RED, GREEN, SKY = (200, 30, 30), (30, 160, 30), (0, 0, 0)
 head_poses = st.tuples(*(st.floats(*JOINT_LIMITS_RAD[j]) for j in (LIFT, YAW, PITCH)))
@@ -124,27 +123,6 @@ def test_an_image_that_is_not_the_cameras_is_refused(image):
         FloorMap().add_view(image, CameraModel(640, 360), chain(), CAML)
 
 
-MARK_HALF = 0.02  # a 4 cm red square flat on the simulated floor
-# What the issue asks of pixel -> floor for points up to 1 m away, m per lens.
-FLOOR_TOLERANCE = {'pinhole': 0.02, 'miro': 0.03}
-
-
-@pytest.fixture(scope='module')
-def marked_floor():
-    """(a SimWorld 'empty' with a red mark on the floor, the mark, its Cameras)"""
-    world = SimWorld('empty')
-    kw = dict(physicsClientId=world.client)
-    shape = pb.createVisualShape(pb.GEOM_BOX, halfExtents=(MARK_HALF, MARK_HALF, 0.0005),
-                                 rgbaColor=(1, 0, 0, 1), **kw)
-    # A mass, so that the renderer draws it where it is put; no collision shape.
-    mark = pb.createMultiBody(baseMass=0.001, baseVisualShapeIndex=shape, **kw)
-    world.place_ball(-3.0, 3.0)  # out of every view
-    cameras = Cameras(world, 'auto')
-    yield world, mark, cameras
-    cameras.close()
-    world.close()
-
-
 @pytest.mark.parametrize('lens', LENSES)
 @pytest.mark.parametrize('eye, head, spot', [  # head: lift, yaw, pitch (deg); spot in FOOT
     (CAML, (60, 0, 8), (0.63, 0.29)), (CAMR, (60, 35, 8), (0.45, 0.1)),
@@ -166,11 +144,10 @@ def test_the_simulators_eye_puts_a_floor_mark_where_it_is(marked_floor, lens, ey
     pb.resetBasePositionAndOrientation(mark, (where[0], where[1], 0.0005), (0, 0, 0, 1),
                                        physicsClientId=world.client)
     rgb, = cameras.render_eyes([(robot, 1 if eye == CAML else -1)], camera)
-    fmap = FloorMap(3.0, 0.01, centre=(x, y))
+    fmap = FloorMap(3.0, 0.005, centre=(x, y))  # the mark is 2 cm wide
     assert fmap.add_view(rgb, camera, kc, eye) > 0
-    r, g, b = (fmap.image()[..., i].astype(int) for i in range(3))
-    rows, cols = np.nonzero((r > 100) & (g < 60) & (b < 60))
-    assert rows.size > 4  # 16 cells of 1 cm
-    found = [c.mean() for c in fmap.cell_to_world(rows, cols)]
+    found = red_centroid(fmap.image())  # (col, row)
+    assert found is not None
+    found = fmap.cell_to_world(found[1], found[0])
     print(f'{lens} {head} {spot}: mark {math.dist(found, where[:2]):.4f} m from where it is')
     assert math.dist(found, where[:2]) < FLOOR_TOLERANCE[lens]

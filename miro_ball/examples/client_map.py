@@ -34,6 +34,7 @@ from miro_ball.mapping.floor_map import FloorMap, MAX_RANGE_M
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import EYE_QOS, EYES, frame_id
 from miro_ball.miro.kc import CAML, CAMR, KinematicChain
+from miro_ball.miro.kinematics import finite
 
 TICK = 0.02  # s: MiRo's 50 Hz platform tick, the rate of the spin command
 PUBLISH_PERIOD_S = 0.5  # simulated s between maps on ~/map
@@ -144,7 +145,7 @@ class Mapper(Client):
     def on_odom(self, msg):
         p = msg.pose.pose.position
         pose = (p.x, p.y, heading(msg.pose.pose.orientation))
-        if not (all(math.isfinite(v) for v in pose) and max(map(abs, pose)) < MAX_ODOM_M):
+        if not (finite(*pose) and max(map(abs, pose)) < MAX_ODOM_M):
             self.warn('odom', f'{self.topics.odom} ignored: pose {pose} is not a place')
             return
         if self.map is None:
@@ -159,7 +160,7 @@ class Mapper(Client):
 
     def on_joints(self, msg):
         joints = list(msg.position)
-        if len(joints) != 4 or not all(math.isfinite(v) for v in joints):
+        if len(joints) != 4 or not finite(*joints):
             self.warn('joints', f'{self.topics.kinematic_joints} ignored: need 4 finite '
                                 f'positions [tilt, lift, yaw, pitch], got {joints[:8]}')
             return
