@@ -25,6 +25,9 @@ class Pose(NamedTuple):
     y: float
     theta: float
 
+    def __str__(self):
+        return f'Pose(x={self.x:.3f}, y={self.y:.3f}, theta={self.theta:.3f})'
+
 
 @dataclass(frozen=True)
 class Sensors:
