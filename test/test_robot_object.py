@@ -49,7 +49,8 @@ class RunningSimulator:
         """The simulator's own robot: the ground truth."""
         return self.node.sim.robots[NAME]
 
-    def script(self, fn):
+    def script(self, fn, meanwhile=lambda: None):
+        """meanwhile() is called in the main thread between the simulator's turns."""
         failed = []
 
         def run():
@@ -64,6 +65,7 @@ class RunningSimulator:
         while thread.is_alive():
             assert time.monotonic() < deadline, 'the script hangs'
             self.executor.spin_once(timeout_sec=0.01)
+            meanwhile()
         if failed:
             raise failed[0]
 
@@ -103,6 +105,25 @@ def test_it_reads_where_the_robot_is_and_its_sensors(sim):
         miro.sleep(0.5)
         assert miro.now == pytest.approx(before + 0.5, abs=0.03)
     sim.script(script)
+
+
+def test_sleep_counts_simulated_time_across_a_reset_of_the_world(sim):
+
+    reset = []  # the simulated time when the world was reset
+
+    def reset_once():
+        if sim.node.sim.time > 2.0 and not reset:
+            reset.append(sim.node.sim.time)
+            sim.node.reset()
+
+    def script(miro):
+        miro.sleep(1.5)
+        started = miro.now
+        assert started < 2.0
+        miro.sleep(1.0)  # the world is reset during this second: time starts again from 0
+        assert reset
+        assert (reset[0] - started) + miro.now == pytest.approx(1.0, abs=0.05)
+    sim.script(script, meanwhile=reset_once)
 
 
 def test_drive_moves_it_until_stop(sim):
@@ -164,7 +185,7 @@ def test_drive_to_gives_up_when_its_time_is_up(sim):
     sim.script(script)
 
 
-def test_garbage_on_a_topic_is_ignored(sim):
+def test_garbage_on_a_topic_is_ignored_with_a_warning_now_and_then(sim, capfd):
     probe = sim.node.create_publisher(Pose2D, RobotTopics(NAME).body_pose, 10)
 
     def script(miro):
@@ -173,6 +194,9 @@ def test_garbage_on_a_topic_is_ignored(sim):
             miro.sleep(0.02)
             assert all(math.isfinite(v) for v in miro.pose)
     sim.script(script)
+    warnings = [line for line in capfd.readouterr().err.splitlines()
+                if 'sensors/body_pose ignored' in line]
+    assert len(warnings) == 1, warnings  # one in 5 s
 
 
 # -- the look client ---------------------------------------------------------------------------

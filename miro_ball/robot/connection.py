@@ -58,6 +58,19 @@ class Connection:
         """Simulated seconds (0 until the first /clock)."""
         return self.node.get_clock().now().nanoseconds * 1e-9
 
+    def stopwatch(self):
+        """A function giving the simulated seconds since now; time that goes back (the
+        world was reset) counts from where it went back to."""
+        last, elapsed = self.now(), 0.0
+
+        def elapsed_s():
+            nonlocal last, elapsed
+            now = self.now()
+            elapsed += max(0.0, now - last)
+            last = now
+            return elapsed
+        return elapsed_s
+
     def subscribe(self, msg_type, topic, qos, callback):
         """A subscription whose messages go to ``callback`` and then wake the waiters."""
         def arrived(msg):

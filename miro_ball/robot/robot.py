@@ -123,8 +123,8 @@ class Robot:
 
     def sleep(self, seconds):
         """Wait ``seconds`` of simulated time (while the simulator is paused, so is this)."""
-        until = self.now + seconds
-        self._ros.wait_until(lambda: self.now >= until, f'{seconds:g} simulated s')
+        elapsed = self._ros.stopwatch()
+        self._ros.wait_until(lambda: elapsed() >= seconds, f'{seconds:g} simulated s')
 
     def set_head(self, lift, yaw, pitch):
         """Move the neck to these angles (rad), held to MiRo's limits: lift 8..60 degrees
@@ -155,9 +155,9 @@ class Robot:
         ran out first. Keep the way clear: it drives straight at the goal."""
         controller = PoseController((x, y, theta), position_tolerance, heading_tolerance)
         count = self._readings.count
-        deadline = self.now + timeout
+        elapsed = self._ros.stopwatch()
         try:
-            while self.now < deadline:
+            while elapsed() < timeout:
                 heard = count['pose']
                 command = controller.command(self.pose)
                 if controller.arrived:
