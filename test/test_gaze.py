@@ -57,7 +57,7 @@ def within_limits(joints):
     return all(lo - 1e-12 <= j <= hi + 1e-12 for j, (lo, hi) in zip(joints, JOINT_LIMITS_RAD))
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=40, deadline=None)
 @given(start=head_poses, aim=head_poses, eye=eyes, distance=st.floats(0.3, 2.5),
        pose=floor_poses, either=st.booleans())
 def test_the_target_lands_on_the_aimed_eyes_axis_in_the_simulator(world, start, aim, eye,
@@ -74,7 +74,7 @@ def test_the_target_lands_on_the_aimed_eyes_axis_in_the_simulator(world, start, 
     assert simulated_error_deg(world, gaze, target) < math.degrees(REACH_TOLERANCE_RAD)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=20, deadline=None)
 @given(head=head_poses, x=st.floats(0.0, 0.35), y=st.floats(-0.15, 0.15), eye=eyes)
 def test_the_floor_just_ahead_is_out_of_reach_and_said_so(world, head, x, y, eye):
     """The eyes look up: the floor under MiRo's nose is below anything they can aim at. The
