@@ -16,14 +16,11 @@ import threading
 import time
 
 from miro_ball.common.isolation import isolated_env, limit_discovery, private_domain
+from miro_ball.common.stamps import seconds
 from miro_ball.gui.process import GuiProcess
 from miro_ball.miro.interface import EYES
 
 CHROMIUM = '/usr/bin/chromium'
-
-
-def seconds(stamp):
-    return stamp.sec + stamp.nanosec * 1e-9
 
 
 def cpu_seconds(pid):

@@ -14,6 +14,7 @@ import sys
 
 import rclpy
 from geometry_msgs.msg import TwistStamped
+from sensor_msgs.msg import CameraInfo, CompressedImage
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -25,9 +26,10 @@ from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
-from miro_ball.miro.interface import (CONTROL_QOS, DEFAULT_ROBOT_NAME, frame_id, robot_name,
-                                      robot_namespace, robot_of_namespace, RobotTopics,
-                                      SENSOR_QOS)
+from miro_ball.miro.camera_model import CameraModel
+from miro_ball.miro.interface import (CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES, frame_id,
+                                      robot_name, robot_namespace, robot_of_namespace,
+                                      RobotTopics, SENSOR_QOS)
 
 SILENCE_NOTICE_S = 2.0  # wall seconds
 
@@ -81,7 +83,9 @@ class Client(Node):
         self.options = options
         self.robot = robot_of_namespace(self.get_namespace())
         self.topics = RobotTopics()
-        guard_clock(self, Throttled(self.get_logger().warning))
+        self.warn = Throttled(self.get_logger().warning)
+        self.cameras = {}  # eye -> its CameraModel, once watch_eyes has heard camera_info
+        guard_clock(self, self.warn)
         self._heard = False
         self._silence_timer = self.create_timer(SILENCE_NOTICE_S, self._on_silence,
                                                 clock=Clock(clock_type=ClockType.STEADY_TIME))
@@ -92,6 +96,21 @@ class Client(Node):
             self._heard = True
             callback(msg)
         return self.create_subscription(msg_type, topic, heard, profile(qos))
+
+    def watch_eyes(self, on_image):
+        """Both eyes: on_image(eye, msg) for every JPEG frame, and each eye's camera model
+        (lens included) from its camera_info in self.cameras."""
+        for eye in EYES:
+            self.subscribe(CompressedImage, self.topics.eye_compressed(eye),
+                           lambda msg, eye=eye: on_image(eye, msg), EYE_QOS)
+            self.subscribe(CameraInfo, self.topics.camera_info(eye),
+                           lambda msg, eye=eye: self._on_camera_info(eye, msg), EYE_QOS)
+
+    def _on_camera_info(self, eye, msg):
+        try:
+            self.cameras[eye] = CameraModel.from_camera_info(msg)
+        except ValueError as err:
+            self.warn(f'{eye}_info', f'{eye}: camera_info ignored: {err}')
 
     def advertise(self, msg_type, topic, qos=CONTROL_QOS):
         return self.create_publisher(msg_type, topic, profile(qos))

@@ -17,6 +17,7 @@ from std_msgs.msg import UInt32
 
 from miro_ball.examples._client import Client, heading, make_parser, number, run
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
+from miro_ball.miro.pose_controller import wrap
 
 TICK = 0.02  # s
 REACHED = 0.03  # m: close enough to a corner
@@ -30,10 +31,6 @@ def corners(path, size):
     if path == 'line':
         return [(size, 0.0), (0.0, 0.0)]
     return [(size, 0.0), (size, size), (0.0, size), (0.0, 0.0)]  # to the left
-
-
-def wrap(angle):
-    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 def steer(pose, goal, speed):

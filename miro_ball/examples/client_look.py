@@ -17,49 +17,30 @@ Try it with the ball mover:
 import sys
 
 import numpy as np
-from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
+from sensor_msgs.msg import JointState
 
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
-from miro_ball.common.throttle import Throttled
+from miro_ball.common.stamps import seconds
 from miro_ball.controller.detection import BallDetector
 from miro_ball.examples._client import Client, make_parser, number, run
-from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_NAMES
 from miro_ball.miro.gaze import look_at
-from miro_ball.miro.interface import EYE_QOS, EYES
-from miro_ball.miro.kc import CAML, CAMR, KinematicChain
+from miro_ball.miro.kc import EYE_FRAMES, KinematicChain
 from miro_ball.miro.kinematics import finite
 
-KC_EYE = {'caml': CAML, 'camr': CAMR}
-
-
-def seconds(stamp):
-    return stamp.sec + stamp.nanosec * 1e-9
 
 
 class Look(Client):
     def __init__(self, options, context=None):
         super().__init__('client_look', options, context)
         self.detector = BallDetector()
-        self.cameras = {}  # eye -> CameraModel from its camera_info
         self.pending = {}  # eye -> (stamp s, BGR frame) waiting for the joints of its instant
         self.joints = None  # the latest (tilt, lift, yaw, pitch)
         self.start = None
         self.out_of_reach = None  # the reason last said, while the ball is out of reach
-        self.warn = Throttled(self.get_logger().warning)
         self.head = self.advertise(JointState, self.topics.kinematic_targets)
-        for eye in EYES:
-            self.subscribe(CompressedImage, self.topics.eye_compressed(eye),
-                           lambda msg, eye=eye: self.on_image(eye, msg), EYE_QOS)
-            self.subscribe(CameraInfo, self.topics.camera_info(eye),
-                           lambda msg, eye=eye: self.on_camera_info(eye, msg), EYE_QOS)
+        self.watch_eyes(self.on_image)
         self.subscribe(JointState, self.topics.kinematic_joints, self.on_joints)
-
-    def on_camera_info(self, eye, msg):
-        try:
-            self.cameras[eye] = CameraModel.from_camera_info(msg)
-        except ValueError as err:
-            self.warn(f'{eye} info', f'{self.topics.camera_info(eye)} ignored: {err}')
 
     def on_image(self, eye, msg):
         try:
@@ -97,7 +78,7 @@ class Look(Client):
         if (camera.width, camera.height) != (width, height):
             camera = camera.scaled_to(width, height)
         kc = KinematicChain(self.joints)
-        ball = camera.pixel_to_plane(kc, KC_EYE[eye], circle[0], circle[1],
+        ball = camera.pixel_to_plane(kc, EYE_FRAMES[eye], circle[0], circle[1],
                                      z=self.options.ball_radius)
         if not np.all(np.isfinite(ball)):
             return None  # seen at or above the horizon: no point on the ball's plane

@@ -25,15 +25,14 @@ import cv2
 import numpy as np
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import CameraInfo, CompressedImage, Image, JointState
+from sensor_msgs.msg import Image, JointState
 
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
-from miro_ball.common.throttle import Throttled
+from miro_ball.common.stamps import seconds
 from miro_ball.examples._client import Client, heading, make_parser, number, run
 from miro_ball.mapping.floor_map import FloorMap, MAX_RANGE_M
-from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.interface import EYE_QOS, EYES, frame_id
-from miro_ball.miro.kc import CAML, CAMR, KinematicChain
+from miro_ball.miro.interface import EYE_QOS, frame_id
+from miro_ball.miro.kc import EYE_FRAMES, KinematicChain
 from miro_ball.miro.kinematics import finite
 
 TICK = 0.02  # s: MiRo's 50 Hz platform tick, the rate of the spin command
@@ -44,7 +43,6 @@ MAX_PENDING = 8  # frames waiting for the pose after them (~0.25 s of both eyes)
 # Frames in a row that can not be painted before a warning: at the start the first
 # frames come before the first pose, joints or camera_info (published after its frame).
 PATIENCE = 15
-KC_EYE = {'caml': CAML, 'camr': CAMR}
 MAX_ODOM_M = 1e5  # odometry beyond this is nonsense (and would put the map out of reach)
 
 
@@ -86,10 +84,6 @@ class Track:
         return a + step * (t - t0) / (t1 - t0)
 
 
-def seconds(stamp):
-    return stamp.sec + stamp.nanosec * 1e-9
-
-
 class Mapper(Client):
     def __init__(self, options, context=None):
         super().__init__('client_map', options, context)
@@ -103,16 +97,10 @@ class Mapper(Client):
         self.kc = KinematicChain()
         self.poses = Track(HISTORY_S, angles=(2,))  # x, y, heading
         self.joints = Track(HISTORY_S)  # tilt, lift, yaw, pitch
-        self.cameras = {}  # eye -> CameraModel from its camera_info
         self.pending = []  # (stamp s, eye, RGB image) waiting for the pose after them
         self.skipped = 0  # frames in a row that could not be painted
         self.published = 0
-        self.warn = Throttled(self.get_logger().warning)
-        for eye in EYES:
-            self.subscribe(CompressedImage, self.topics.eye_compressed(eye),
-                           lambda msg, eye=eye: self.on_image(eye, msg), EYE_QOS)
-            self.subscribe(CameraInfo, self.topics.camera_info(eye),
-                           lambda msg, eye=eye: self.on_camera_info(eye, msg), EYE_QOS)
+        self.watch_eyes(self.on_image)
         self.subscribe(Odometry, self.topics.odom, self.on_odom)
         self.subscribe(JointState, self.topics.kinematic_joints, self.on_joints)
         # The map is an image, so the eyes' profile: a late subscriber wants the newest.
@@ -135,12 +123,6 @@ class Mapper(Client):
         if len(self.pending) > MAX_PENDING:
             self.skip(self.pending.pop(0)[1], 'no pose and joints after it')
         self.paint_ready()
-
-    def on_camera_info(self, eye, msg):
-        try:
-            self.cameras[eye] = CameraModel.from_camera_info(msg)
-        except ValueError as err:
-            self.warn(f'{eye}_info', f'{eye}: camera_info ignored: {err}')
 
     def on_odom(self, msg):
         p = msg.pose.pose.position
@@ -200,7 +182,7 @@ class Mapper(Client):
         self.kc.set_joints(*joints)
         self.kc.set_pose(*pose)
         try:
-            self.map.add_view(rgb, camera, self.kc, KC_EYE[eye])
+            self.map.add_view(rgb, camera, self.kc, EYE_FRAMES[eye])
         except ValueError as err:  # a frame of another size than camera_info's
             self.warn(f'{eye}_size', f'{eye}: frame ignored: {err}')
 

@@ -31,11 +31,12 @@ from std_srvs.srv import SetBool, Trigger
 from miro_ball.common.clock_watch import clock_publishers, ClockWatch, shared_domain_line
 from miro_ball.common.jpeg import MAX_SIDE, ImageRejected, jpeg_size
 from miro_ball.common.qos import profile
+from miro_ball.common.stamps import seconds
 from miro_ball.common.throttle import Throttled
+from miro_ball.controller.names import debug_topic
 from miro_ball.gui import protocol as p
 from miro_ball.gui import readouts as r
 from miro_ball.miro.constants import JOINT_NAMES, PLATFORM_TICK_S
-from miro_ball.controller.names import debug_topic
 from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
                                       frame_id, RobotTopics, SENSOR_QOS, SimTopics, robots_in)
 
@@ -235,7 +236,7 @@ class GuiBridge(Node):
             if problem:
                 self.warn(f'image:{topic}', f'{topic}: image not shown: {problem}')
                 return
-            stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+            stamp = seconds(msg.header.stamp)
             with self._lock:
                 self._seq += 1
                 self._frames[channel] = Frame(self._seq, stamp, data)
@@ -360,7 +361,7 @@ class GuiBridge(Node):
     # -- simulated time --------------------------------------------------------------------------
     def _on_clock(self, msg):
         now = time.monotonic()
-        sim = msg.clock.sec + msg.clock.nanosec * 1e-9
+        sim = seconds(msg.clock)
         if self.sim_time is not None and sim < self.sim_time:
             self._clock_watch.went_back()
             self._clock_samples.clear()  # a reset, or a new simulator

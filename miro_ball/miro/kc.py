@@ -24,6 +24,7 @@ import numpy as np
 
 from miro_ball.miro.constants import (CAM_DIVERGENCE_RAD, CAM_ELEVATION_RAD, JOINT_LIMITS_RAD,
                                       KIN_CALIB_RAD, WHEEL_RADIUS_M)
+from miro_ball.miro.interface import EYES
 
 WORLD, FOOT, BODY, NECK, GIMBAL, HEAD, CAML, CAMR, SONAR = range(-1, 8)
 FRAME_NAMES = {WORLD: 'world', FOOT: 'foot', BODY: 'body', NECK: 'neck', GIMBAL: 'gimbal',
@@ -31,6 +32,7 @@ FRAME_NAMES = {WORLD: 'world', FOOT: 'foot', BODY: 'body', NECK: 'neck', GIMBAL:
 _PARENT = {FOOT: WORLD, BODY: FOOT, NECK: BODY, GIMBAL: NECK, HEAD: GIMBAL, CAML: HEAD,
            CAMR: HEAD, SONAR: HEAD}
 EYE_SIDE = {CAML: 1, CAMR: -1}  # +1 left, -1 right: the sign of the eye's y
+EYE_FRAMES = dict(zip(EYES, (CAML, CAMR)))  # the eyes' topic names -> their frames
 
 # Where each joint is in its parent (the MDK's numbers, the axle height taken off where
 # the MDK measures from the floor).

@@ -7,6 +7,7 @@ showed it. Image callbacks are optional; they get each frame decoded to BGR.
 """
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
+from miro_ball.common.stamps import seconds
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.names import debug_topic
 from miro_ball.miro.constants import WHEEL_RADIUS_M
@@ -22,10 +23,6 @@ def decode(msg):
         return decode_jpeg(msg.data)
     except ImageRejected:
         return None
-
-
-def seconds(stamp):
-    return stamp.sec + stamp.nanosec * 1e-9
 
 
 # Every overhead image is a video frame: a second's worth is queued, so an observer busy
