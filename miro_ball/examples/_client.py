@@ -112,6 +112,16 @@ class Client(Node):
         except ValueError as err:
             self.warn(f'{eye}_info', f'{eye}: camera_info ignored: {err}')
 
+    def checked_joints(self, msg):
+        """sensors/kinematic_joints' (tilt, lift, yaw, pitch), or None (with a warning)
+        when the message does not hold four finite positions."""
+        joints = tuple(msg.position)
+        if len(joints) != 4 or not all(math.isfinite(j) for j in joints):
+            self.warn('joints', f'{self.topics.kinematic_joints} ignored: need 4 finite '
+                      f'positions [tilt, lift, yaw, pitch], got {list(joints)[:8]}')
+            return None
+        return joints
+
     def advertise(self, msg_type, topic, qos=CONTROL_QOS):
         return self.create_publisher(msg_type, topic, profile(qos))
 

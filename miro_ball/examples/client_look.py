@@ -26,7 +26,6 @@ from miro_ball.examples._client import Client, make_parser, number, run
 from miro_ball.miro.constants import JOINT_NAMES
 from miro_ball.miro.gaze import look_at
 from miro_ball.miro.kc import EYE_FRAMES, KinematicChain
-from miro_ball.miro.kinematics import finite
 
 
 
@@ -49,10 +48,8 @@ class Look(Client):
             self.warn(eye, f'{eye}: frame ignored: {err}')
 
     def on_joints(self, msg):
-        joints = tuple(msg.position)
-        if len(joints) != 4 or not finite(*joints):
-            self.warn('joints', f'{self.topics.kinematic_joints} ignored: need 4 finite '
-                      f'positions, got {list(joints)[:8]}')
+        joints = self.checked_joints(msg)
+        if joints is None:
             return
         self.joints = joints
         now = seconds(msg.header.stamp)

@@ -141,10 +141,8 @@ class Mapper(Client):
         self.paint_ready()
 
     def on_joints(self, msg):
-        joints = list(msg.position)
-        if len(joints) != 4 or not finite(*joints):
-            self.warn('joints', f'{self.topics.kinematic_joints} ignored: need 4 finite '
-                                f'positions [tilt, lift, yaw, pitch], got {joints[:8]}')
+        joints = self.checked_joints(msg)
+        if joints is None:
             return
         self.joints.add(seconds(msg.header.stamp), joints)
         self.paint_ready()
