@@ -8,13 +8,12 @@ from sensor_msgs.msg import JointState
 from miro_ball.miro.constants import JOINT_NAMES, PLATFORM_TICK_S
 from miro_ball.miro.gaze import look_at
 from miro_ball.miro.interface import check_name, frame_id, robot_name, RobotTopics
-from miro_ball.miro.kc import CAML, CAMR, clamp_joints, FOOT, KinematicChain, WORLD
+from miro_ball.miro.kc import clamp_joints, EYE_FRAMES, FOOT, KinematicChain, WORLD
 from miro_ball.miro.pose_controller import PoseController
 from miro_ball.robot.connection import Connection, node_name
 from miro_ball.robot.readings import Eyes, Readings
 
 FRAMES = {'foot': FOOT, 'odom': WORLD}  # look_at's frames: the robot's own, odometry's
-EYE_FRAMES = {'caml': CAML, 'camr': CAMR, None: None}
 
 
 class Robot:
@@ -140,11 +139,11 @@ class Robot:
         odometry's ('odom'). eye: 'caml', 'camr' or None (whichever turns the head less).
         Returns the Gaze (miro_ball.miro.gaze): ``reachable``, ``error_deg``, ``reason``.
         The head gets there at its own speed (up to half a second)."""
-        if frame not in FRAMES or eye not in EYE_FRAMES:
+        if frame not in FRAMES or (eye is not None and eye not in EYE_FRAMES):
             raise ValueError(f"frame must be 'foot' or 'odom' and eye 'caml', 'camr' or None, "
                              f'got {frame!r}, {eye!r}')
         kc = KinematicChain(self.joints, self.pose)
-        gaze = look_at(kc, (x, y, z), FRAMES[frame], EYE_FRAMES[eye])
+        gaze = look_at(kc, (x, y, z), FRAMES[frame], EYE_FRAMES.get(eye))
         self.set_head(*gaze.joints[1:])
         return gaze
 
