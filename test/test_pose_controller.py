@@ -3,7 +3,7 @@ kinematic loop at MiRo's 50 Hz with a tick of delay (odometry is a tick old)."""
 import math
 
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import example, given, settings, strategies as st
 
 from miro_ball.miro.constants import PLATFORM_TICK_S, WHEEL_MAX_SPEED_M_PER_S
 from miro_ball.miro.kinematics import cmd_vel2wheel_speed
@@ -35,6 +35,9 @@ def drive(controller, pose, seconds):
 
 @settings(max_examples=200, deadline=None)
 @given(start=poses, goal=poses, tolerance=tolerances)
+# Straight behind, farther than it backs: with odometry a tick late, the bearing's sign
+# (+-pi) flipped with each turn's overshoot, and it shook on the spot for ever.
+@example(start=(0.0, -0.0, 0.0), goal=(-1.0, -0.0, 0.0), tolerance=(0.0625, 0.125))
 def test_it_arrives_from_anywhere_within_its_tolerances(start, goal, tolerance):
     controller = PoseController(goal, *tolerance)
     distance = math.dist(start[:2], goal[:2])

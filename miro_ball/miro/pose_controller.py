@@ -21,6 +21,10 @@ from miro_ball.miro.constants import WHEEL_MAX_SPEED_M_PER_S, WHEEL_TRACK_M
 
 # The fastest turn on the spot: both wheels at full speed, opposite ways (4.9 rad/s).
 MAX_TURN_RAD_S = 2.0 * WHEEL_MAX_SPEED_M_PER_S / WHEEL_TRACK_M
+# A goal point within this of straight behind is turned towards the way MiRo already turns:
+# there the bearing's sign flips with the slightest wobble (and with odometry a tick late,
+# a turn's own overshoot flipped it back and forth for ever).
+BEHIND_RAD = 0.3
 
 
 def wrap(angle):
@@ -64,6 +68,7 @@ class PoseController:
             setattr(self, name, float(value))
         self.arrived = False
         self._turning_on_the_spot = False  # within the position tolerance: heading only
+        self._turn_sign = 0.0  # the way the last drive command turned, +1 left, -1 right
 
     def errors(self, pose):
         """(distance to the goal point in m, heading left to turn in rad) from ``pose``."""
@@ -93,6 +98,9 @@ class PoseController:
         direction = 1.0
         if abs(bearing) > math.pi / 2 and distance < self.reverse_within:
             direction, bearing = -1.0, wrap(bearing - math.pi)  # the tail leads
+        elif abs(bearing) > math.pi - BEHIND_RAD and self._turn_sign:
+            bearing = math.copysign(abs(bearing), self._turn_sign)
+        self._turn_sign = math.copysign(1.0, bearing) if bearing else 0.0
         speed = min(self.max_forward, max(self.min_forward, self.forward_gain * distance))
         return self._limited(direction * speed * max(0.0, math.cos(bearing)),
                              self.turn_gain * bearing)
