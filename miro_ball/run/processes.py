@@ -16,6 +16,7 @@ import time
 from dataclasses import dataclass
 
 GROUP_POLL_S = 0.05
+KILL_WAIT_S = 1.0  # at most, for a killed group to be gone
 
 
 @dataclass
@@ -97,10 +98,34 @@ def stop_group(proc, grace_s):
             _signal_group(proc.pid, signal.SIGKILL)
             proc.wait()
     # The group's id can not be taken by another process while any member is alive.
-    while _signal_group(proc.pid, 0) and time.monotonic() < deadline:
+    while _group_alive(proc.pid) and time.monotonic() < deadline:
         time.sleep(GROUP_POLL_S)
-    _signal_group(proc.pid, signal.SIGKILL)
+    # SIGKILL takes effect when the kernel next schedules each member: wait (a little) for
+    # them to be gone, so that nothing of the group still runs once this returns.
+    killed_by = time.monotonic() + KILL_WAIT_S
+    while _signal_group(proc.pid, signal.SIGKILL) and _group_alive(proc.pid) \
+            and time.monotonic() < killed_by:
+        time.sleep(GROUP_POLL_S)
     return stopped
+
+
+def _group_alive(pgid):
+    """Whether a member of the process group still runs. Zombies do not count: whoever
+    adopts a dead shell's children may take its time to reap them (the container's first
+    process here does), and a zombie still answers kill(0)."""
+    try:
+        stats = [path for path in os.listdir('/proc') if path.isdigit()]
+    except OSError:  # no /proc: a zombie is then taken for a live member
+        return _signal_group(pgid, 0)
+    for pid in stats:
+        try:
+            with open(f'/proc/{pid}/stat') as stat:
+                fields = stat.read().rsplit(')', 1)[1].split()
+        except OSError:  # gone meanwhile
+            continue
+        if fields[0] != 'Z' and int(fields[2]) == pgid:
+            return True
+    return False
 
 
 def _signal_group(pgid, signum):
