@@ -11,7 +11,7 @@ from miro_ball.miro.interface import check_name, frame_id, robot_name, RobotTopi
 from miro_ball.miro.kc import clamp_joints, EYE_FRAMES, FOOT, KinematicChain, WORLD
 from miro_ball.miro.pose_controller import PoseController
 from miro_ball.robot.connection import Connection, node_name
-from miro_ball.robot.readings import Eyes, Readings
+from miro_ball.robot.readings import Eyes, READINGS, Readings
 
 FRAMES = {'foot': FOOT, 'odom': WORLD}  # look_at's frames: the robot's own, odometry's
 
@@ -40,9 +40,11 @@ class Robot:
         self._head = self._ros.publisher(JointState, topics.kinematic_targets)
         self._command = None  # (forward, turn) repeated every tick until stop()
         self._ros.node.create_timer(PLATFORM_TICK_S, self._repeat)
+        # Every reading, not just the pose: they come on topics of their own, in any order
+        # (the tutorial's first line of battery found none, once in a full run).
         heard = self._readings.latest
-        if not self._ros.wait_until(lambda: 'pose' in heard and 'joints' in heard
-                                    and self.now > 0, 'the robot', wall_timeout=timeout):
+        if not self._ros.wait_until(lambda: heard.keys() >= READINGS.keys() and self.now > 0,
+                                    'the robot', wall_timeout=timeout):
             domain = self._ros.domain
             self._ros.close()
             raise TimeoutError(
