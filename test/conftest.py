@@ -106,3 +106,12 @@ def make_sim(ros_context, executor):
 def paused_sim(make_sim):
     """The simulator node in-process on the default world, paused."""
     return make_sim()
+
+
+@pytest.fixture(scope='module')
+def marked_floor():
+    """(a SimWorld 'empty' with a red floor mark, the mark's body, its Cameras)"""
+    from floor_mark import marked_world
+
+    with marked_world() as marked:
+        yield marked

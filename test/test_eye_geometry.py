@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, HealthCheck, settings, strategies as st
 
+from floor_mark import FLOOR_TOLERANCE, red_centroid
 from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT, LIFT_RAD_CALIB, PITCH, TILT_RAD, YAW
 from miro_ball.controller.detection import BallDetector
 from miro_ball.miro.camera_model import CameraModel, LENSES
@@ -130,33 +131,6 @@ def test_eye_worker_processes_render_exactly_what_the_simulator_would():
     finally:
         cameras.close()
         world.close()
-
-
-MARKER_HALF = 0.01  # a 2 cm red square flat on the floor
-# What the issue asks of pixel -> floor, points up to 1 m away: m per lens.
-FLOOR_TOLERANCE = {'pinhole': 0.02, 'miro': 0.03}
-
-
-@pytest.fixture(scope='module')
-def marked_floor():
-    """(a SimWorld 'empty' with a red floor marker, its marker body, its Cameras)"""
-    world = SimWorld('empty')
-    kw = dict(physicsClientId=world.client)
-    shape = pb.createVisualShape(pb.GEOM_BOX, halfExtents=(MARKER_HALF, MARKER_HALF, 0.0005),
-                                 rgbaColor=(1, 0, 0, 1), **kw)
-    # Not static (a mass), so the renderer draws it where it is put; no collision shape.
-    marker = pb.createMultiBody(baseMass=0.001, baseVisualShapeIndex=shape, **kw)
-    world.place_ball(-3.0, 3.0)  # out of every view: it would hide the mark
-    cameras = Cameras(world, 'auto')
-    yield world, marker, cameras
-    cameras.close()
-    world.close()
-
-
-def red_centroid(rgb):
-    r, g, b = (rgb[:, :, i].astype(int) for i in range(3))
-    v, u = np.nonzero((r > 100) & (g < 60) & (b < 60))
-    return (u.mean(), v.mean()) if len(u) >= 4 else None
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.filter_too_much,

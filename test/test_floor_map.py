@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, HealthCheck, settings, strategies as st
 
+from floor_mark import FLOOR_TOLERANCE, red_centroid
 from miro_ball.mapping.floor_map import FloorMap, MAX_CELLS_PER_SIDE, UNSEEN_RGB
 from miro_ball.miro.camera_model import CameraModel, LENSES
 from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT, PITCH, TILT_RAD, YAW
 from miro_ball.miro.kc import CAML, CAMR, FOOT, KinematicChain, WORLD
 from miro_sim_bullet.bullet import pybullet as pb
-from test_eye_geometry import FLOOR_TOLERANCE, marked_floor, red_centroid  # noqa: F401 (a fixture)
 
 RED, GREEN, SKY = (200, 30, 30), (30, 160, 30), (0, 0, 0)
 head_poses = st.tuples(*(st.floats(*JOINT_LIMITS_RAD[j]) for j in (LIFT, YAW, PITCH)))

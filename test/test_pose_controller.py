@@ -6,8 +6,8 @@ import pytest
 from hypothesis import example, given, settings, strategies as st
 
 from miro_ball.miro.constants import PLATFORM_TICK_S, WHEEL_MAX_SPEED_M_PER_S
-from miro_ball.miro.kinematics import cmd_vel2wheel_speed
-from miro_ball.miro.pose_controller import PoseController, wrap
+from miro_ball.miro.kinematics import cmd_vel2wheel_speed, wrap
+from miro_ball.miro.pose_controller import PoseController
 
 poses = st.tuples(st.floats(-2, 2), st.floats(-2, 2), st.floats(-math.pi, math.pi))
 tolerances = st.tuples(st.floats(0.005, 0.1), st.floats(math.radians(0.5), math.radians(10)))

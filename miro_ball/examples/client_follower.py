@@ -17,7 +17,7 @@ from std_msgs.msg import UInt32
 
 from miro_ball.examples._client import Client, heading, make_parser, number, run
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
-from miro_ball.miro.pose_controller import wrap
+from miro_ball.miro.kinematics import wrap
 
 TICK = 0.02  # s
 REACHED = 0.03  # m: close enough to a corner

@@ -33,7 +33,7 @@ from miro_ball.examples._client import Client, heading, make_parser, number, run
 from miro_ball.mapping.floor_map import FloorMap, MAX_RANGE_M
 from miro_ball.miro.interface import EYE_QOS, frame_id
 from miro_ball.miro.kc import EYE_FRAMES, KinematicChain
-from miro_ball.miro.kinematics import finite
+from miro_ball.miro.kinematics import finite, wrap
 
 TICK = 0.02  # s: MiRo's 50 Hz platform tick, the rate of the spin command
 PUBLISH_PERIOD_S = 0.5  # simulated s between maps on ~/map
@@ -80,7 +80,7 @@ class Track:
         a, b = self.values[after - 1], self.values[after]
         step = b - a
         for i in self.angles:
-            step[i] = math.atan2(math.sin(step[i]), math.cos(step[i]))
+            step[i] = wrap(step[i])
         return a + step * (t - t0) / (t1 - t0)
 
 

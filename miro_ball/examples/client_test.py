@@ -23,6 +23,7 @@ from std_msgs.msg import Float32MultiArray, UInt32MultiArray
 from miro_ball.examples._client import Client, heading, make_parser, run
 from miro_ball.miro.constants import COSMETIC_CALIB, JOINT_LIMITS_RAD, JOINT_NAMES, \
     KIN_CALIB_RAD, LIFT, PITCH, YAW
+from miro_ball.miro.kinematics import wrap
 
 TICK = 0.02  # s
 COLOURS = (('red', 0xFF0000), ('green', 0x00FF00), ('blue', 0x0000FF), ('white', 0xFFFFFF))
@@ -133,7 +134,7 @@ class Bench(Client):
             away = [math.hypot(x - x0, y - y0) for x, y, _ in poses]
             return f'out {max(away):.2f} m, back to {away[-1]:.2f} m from the start'
         if name == 'spin':
-            turned = [math.degrees(math.atan2(math.sin(h - h0), math.cos(h - h0)))
+            turned = [math.degrees(wrap(h - h0))
                       for _, _, h in poses]
             return f'turned {max(turned):+.0f} deg, back to {turned[-1]:+.0f} deg'
         if name == 'kin':

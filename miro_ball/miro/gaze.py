@@ -28,6 +28,7 @@ import numpy as np
 from miro_ball.miro.constants import JOINT_LIMITS_RAD
 from miro_ball.miro.kc import CAML, CAMR, clamp_joints, EYE_SIDE, FOOT, FRAME_NAMES, HEAD, \
     KinematicChain, NECK, rot_y
+from miro_ball.miro.kinematics import wrap
 
 REACH_TOLERANCE_RAD = math.radians(2.0)  # reachable: the target this close to the axis
 # Nearer than this to the eye, an unreachable target is "too close": MiRo's own feet and
@@ -193,8 +194,7 @@ def _first_guess(chain, tilt, target, eye):
         turn = math.acos(max(-1.0, min(1.0, wanted[2] / reach)))
         for pitch in (turn - phase, -turn - phase):
             seen = rot_y(pitch) @ axis
-            yaw = math.atan2(wanted[1], wanted[0]) - math.atan2(seen[1], seen[0])
-            yaw = math.atan2(math.sin(yaw), math.cos(yaw))
+            yaw = wrap(math.atan2(wanted[1], wanted[0]) - math.atan2(seen[1], seen[0]))
             guesses.append(np.clip((lift, yaw, pitch), _LOW, _HIGH))
     return min(guesses, key=lambda head: _angle(_offsets(chain, tilt, head, target, eye)))
 
@@ -213,9 +213,7 @@ def _why(chain, tilt, head, target, eye):
         for v in (to_target, chain.axis(eye)))
     up = math.degrees(target_elevation - axis_elevation)
     # Across, an angle of bearing counts less the more steeply the target is seen.
-    left = math.degrees(math.atan2(math.sin(target_bearing - axis_bearing),
-                                   math.cos(target_bearing - axis_bearing))
-                        * math.cos(target_elevation))
+    left = math.degrees(wrap(target_bearing - axis_bearing) * math.cos(target_elevation))
     lift, yaw, pitch = head
     vertical_held = (up < 0 and lift >= _HIGH[0] and pitch >= _HIGH[2]) or \
         (up > 0 and lift <= _LOW[0] and pitch <= _LOW[2])

@@ -21,6 +21,11 @@ def clamp_wheel_speeds(left, right, limit=WHEEL_MAX_SPEED_M_PER_S):
     return (max(-limit, min(limit, left)), max(-limit, min(limit, right)))
 
 
+def wrap(angle):
+    """The angle in (-pi, pi]: headings and turns compared the short way round."""
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
 def finite(*values):
     """True when every value is a finite real number."""
     try:

@@ -18,6 +18,7 @@ platform runs at 50 Hz).
 import math
 
 from miro_ball.miro.constants import WHEEL_MAX_SPEED_M_PER_S, WHEEL_TRACK_M
+from miro_ball.miro.kinematics import wrap
 
 # The fastest turn on the spot: both wheels at full speed, opposite ways (4.9 rad/s).
 MAX_TURN_RAD_S = 2.0 * WHEEL_MAX_SPEED_M_PER_S / WHEEL_TRACK_M
@@ -25,11 +26,6 @@ MAX_TURN_RAD_S = 2.0 * WHEEL_MAX_SPEED_M_PER_S / WHEEL_TRACK_M
 # there the bearing's sign flips with the slightest wobble (and with odometry a tick late,
 # a turn's own overshoot flipped it back and forth for ever).
 BEHIND_RAD = 0.3
-
-
-def wrap(angle):
-    """The angle in (-pi, pi]."""
-    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 class PoseController:
