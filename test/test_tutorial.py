@@ -9,10 +9,11 @@ The tutorial marks what the test runs, in the fence's info string:
     ```python run          a script the reader runs: must exit 0 (asserts inside count)
     ```python file=NAME    a file the reader saves as NAME, for later blocks
 
-and an HTML comment on a line of its own, invisible on the rendered page, where the reader
-presses Ctrl+C:
+and HTML comments on lines of their own, invisible on the rendered page, where the reader
+presses Ctrl+C, and where they wait until a shell has printed some text before going on:
 
     <!-- test: ctrl-c shell1 shell2 -->
+    <!-- test: wait shell3 s simulated: -->
 
 Fences with any other info string are shown, not run. Everything runs in a
 temporary folder, on this test process's private ROS domain, with this Python's
@@ -32,13 +33,15 @@ from miro_ball.common.isolation import isolated_env
 TUTORIAL = Path(__file__).resolve().parent.parent / 'docs' / 'tutorial.md'
 FENCE = re.compile(r'^```(?P<info>[^\n]*)\n(?P<body>.*?)^```\s*$', re.M | re.S)
 CTRL_C = re.compile(r'^<!--\s*test:\s*ctrl-c\s+(?P<shells>[\w ]+?)\s*-->\s*$', re.M)
+WAIT = re.compile(r'^<!--\s*test:\s*wait\s+(?P<shell>shell\d+)\s+(?P<text>.+?)\s*-->\s*$', re.M)
 SHELL = re.compile(r'shell\d+\Z')
 RUN_TIMEOUT_S = 120  # guards against a hang only
 STOP_TIMEOUT_S = 15
 
 
 def steps(text):
-    """('run' | 'python' | 'file' | 'background' | 'ctrl-c', argument, body) in page order."""
+    """('run' | 'python' | 'file' | 'background' | 'ctrl-c' | 'wait', argument, body) in page
+    order."""
     found = []
     for match in FENCE.finditer(text):
         words = match['info'].split()
@@ -54,6 +57,8 @@ def steps(text):
             found.append((match.start(), ('file', marks[0][len('file='):], body)))
     for match in CTRL_C.finditer(text):
         found.append((match.start(), ('ctrl-c', match['shells'].split(), '')))
+    for match in WAIT.finditer(text):
+        found.append((match.start(), ('wait', match['shell'], match['text'])))
     return [step for _, step in sorted(found, key=lambda item: item[0])]
 
 
@@ -109,6 +114,17 @@ class Reader:
             assert proc.poll() is None, f'{shell} ({body.strip()}) ended (code ' \
                 f'{proc.returncode}) while: {after}\n{log.read_text(errors="replace")}'
 
+    def wait_for(self, shell, text):
+        """Wait until the shell has printed text (as a reader watches for a line before typing
+        the next command); the shell must keep running meanwhile."""
+        log = self.shells[shell][1]
+        deadline = time.monotonic() + RUN_TIMEOUT_S
+        while text not in log.read_text(errors='replace'):
+            self.check_shells(f'waiting for {text!r} from {shell}')
+            assert time.monotonic() < deadline, f'{shell} did not print {text!r} in ' \
+                f'{RUN_TIMEOUT_S} s:\n{log.read_text(errors="replace")}'
+            time.sleep(0.2)
+
     def ctrl_c(self, shell):
         proc, log, body = self.shells.pop(shell)
         if proc.poll() is None:
@@ -133,7 +149,7 @@ class Reader:
 
 def test_the_page_has_steps_of_every_kind():
     kinds = {kind for kind, _, _ in steps(TUTORIAL.read_text())}
-    assert kinds == {'run', 'python', 'file', 'background', 'ctrl-c'}
+    assert kinds == {'run', 'python', 'file', 'background', 'ctrl-c', 'wait'}
 
 
 def test_the_tutorial_runs_as_written(tmp_path):
@@ -151,6 +167,8 @@ def test_the_tutorial_runs_as_written(tmp_path):
                 (tmp_path / argument).write_text(body)
             elif kind == 'background':
                 reader.start(argument, body)
+            elif kind == 'wait':
+                reader.wait_for(argument, body)
             else:
                 for shell in argument:
                     reader.ctrl_c(shell)
