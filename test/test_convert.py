@@ -89,6 +89,13 @@ def test_pose_requests_are_normalised_and_checked():
     assert orientation == pytest.approx((0.0, 0.0, math.sqrt(0.5), math.sqrt(0.5)))
     for bad in (pose_msg('ball', (math.nan, 0, 0)), pose_msg('ball', (0, 1e9, 0)),
                 pose_msg('ball', (0, 0, 0), (math.inf, 0, 0, 1)),
-                pose_msg('ball', (0, 0, 0), (1e-9, 0, 0, 0))):
+                pose_msg('ball', (0, 0, 0), (1e-9, 0, 0, 0)),
+                pose_msg('ball', (0, 0, 0), (math.nan, 0, 0, 1))):
         with pytest.raises(ValueError):
             convert.pose_request(bad)
+
+
+def test_a_drag_keeps_height_and_orientation():
+    """NaN height and four NaNs of orientation: keep what the object has (None)."""
+    request = convert.pose_request(pose_msg('ball', (0.2, -0.3, math.nan), (math.nan,) * 4))
+    assert request == ('ball', (0.2, -0.3, None), None)

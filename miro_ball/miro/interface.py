@@ -23,6 +23,8 @@ CLOCK = '/clock'
 EYES = ('caml', 'camr')  # index 0 is the left eye, as the MDK's CAM_L
 EYE_SIDE = {'caml': +1, 'camr': -1}  # +1 left, -1 right: the sign of the eye's y offset
 SIM_NODE_NAME = 'miro_sim'
+WORLD_FRAME = 'world'  # the simulator's frame (ground truth, the scene)
+TOUCH_PARTS = ('head', 'body')
 BALL_NAME = 'ball'  # the simulator's name of the ball, for set_pose and its ground truth
 MAX_NAME_LENGTH = 64
 # A ROS name token: what may stand between two slashes of a topic name.
@@ -236,6 +238,22 @@ class SimTopics:
     @property
     def overhead(self):
         return self.topic('overhead/compressed')
+
+    @property
+    def scene(self):
+        """visualization_msgs/MarkerArray: the world to draw (RViz, Foxglove, the GUI)."""
+        return self.topic('scene')
+
+    def links(self, robot):
+        """geometry_msgs/PoseArray: where a robot's link frames are in the world
+        (constants.LINK_FRAMES, in order), to move the robot's markers of the scene."""
+        return self.topic(f'links/{check_name(robot)}')
+
+    def touch(self, robot, part):
+        """std_msgs/UInt16 in: the pads of a robot's head or body a hand touches now."""
+        if part not in TOUCH_PARTS:
+            raise ValueError(f'touch part must be one of {", ".join(TOUCH_PARTS)}, got {part!r}')
+        return self.topic(f'touch/{check_name(robot)}/{part}')
 
     @property
     def reset(self):

@@ -12,7 +12,9 @@ from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       KIN_CALIB_RAD, TILT_RAD, WHEEL_RADIUS_M)
 from miro_ball.miro.kc import camera_in_head, SONAR_IN_HEAD
+from miro_ball.miro.interface import TOUCH_PARTS
 from miro_ball.miro.kinematics import clamp_wheel_speeds, cmd_vel2wheel_speed
+from miro_ball.miro.touch import pads_touched, TOUCH_PADS
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics import model as rb
 from miro_sim_bullet.physics.sensors import (SONAR_DIRECTIONS, Accelerometer, Sensors,
@@ -23,6 +25,9 @@ WHEEL_TORQUE_NM = 0.5  # enough to reach 0.4 m/s in a few cm, weak enough to sta
 HEAD_SPEED_RAD_S = 2.0  # servo-like slew rate of the neck joints
 HEAD_TORQUE_NM = 2.0
 COSMETIC_TORQUE_NM = 0.2
+# A touched pad reads touched this long after the last message that named it: a stroke is a
+# stream of touch messages (the GUI sends 20 a second), and letting go is their end.
+TOUCH_HOLD_S = 0.25
 
 
 class MiroRobot:
@@ -56,6 +61,7 @@ class MiroRobot:
         self.cosmetic = list(COSMETIC_CALIB)
         self.flags = 0
         self.illum = [0] * 6
+        self.touched_at = {part: [-math.inf] * TOUCH_PADS for part in TOUCH_PARTS}
         for accelerometer in self.imu.values():
             accelerometer.reset()
         self._set_joints_to_targets()
@@ -92,6 +98,17 @@ class MiroRobot:
         """Six 0xAARRGGBB LEDs, shown as the colour of the body patches."""
         self.illum = list(argb)
         self.model.show_illum(self.illum)
+
+    def touch(self, part, mask):
+        """A hand on the pads of mask (bits 0..13) of 'head' or 'body', now."""
+        now = self.clock()
+        for pad in pads_touched(mask):
+            self.touched_at[part][pad] = now
+
+    def _touch_reading(self, part):
+        now = self.clock()
+        return sum(1 << pad for pad, when in enumerate(self.touched_at[part])
+                   if now - when < TOUCH_HOLD_S)
 
     @property
     def cliff_reflex_enabled(self):
@@ -211,6 +228,8 @@ class MiroRobot:
             sonar=self._read_sonar(),
             imu_body=self._imu(-1, 'body'),
             imu_head=self._imu(rb.HEAD, 'head'),
+            touch_head=self._touch_reading('head'),
+            touch_body=self._touch_reading('body'),
         )
 
     # -- cameras ----------------------------------------------------------------------------

@@ -33,6 +33,8 @@ class Sensors:
     imu_head: tuple
     battery_voltage: float = BATTERY_VOLTAGE
     light: tuple = (AMBIENT_LIGHT,) * 4
+    touch_head: int = 0  # pad bit masks (miro_ball.miro.touch)
+    touch_body: int = 0
 
 
 def cone_directions(half_angle, rings=(0.5, 1.0), per_ring=6):

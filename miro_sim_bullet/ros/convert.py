@@ -11,10 +11,9 @@ from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Im
 from std_msgs.msg import Float32MultiArray
 
 from miro_ball.miro.constants import JOINT_NAMES
-from miro_ball.miro.interface import frame_id
+from miro_ball.miro.interface import frame_id, WORLD_FRAME
 from miro_sim_bullet.physics import model as rb
 
-WORLD_FRAME = 'world'  # the simulator's own frame: ground truth, no robot's
 MAX_COORDINATE_M = 1000.0  # where set_pose may put things: far beyond any bundled world
 
 
@@ -130,17 +129,23 @@ def pose_request(msg):
     """(name, position, orientation xyzw) asked for by a set_pose message, or ValueError.
 
     The name is header.frame_id. An all-zero orientation (a message with only a
-    position filled in) means upright; any other is normalised.
+    position filled in) means upright; any other is normalised. A NaN height (position.z)
+    keeps the object's height and four NaNs keep its orientation: those come back as None,
+    so a drag in a viewer moves a thing across its floor without knowing how it stands.
     """
     name = msg.header.frame_id
     p, o = msg.pose.position, msg.pose.orientation
-    position = (p.x, p.y, p.z)
+    position = (p.x, p.y, None if math.isnan(p.z) else p.z)
     orientation = np.array([o.x, o.y, o.z, o.w])
-    if not all(math.isfinite(v) and abs(v) <= MAX_COORDINATE_M for v in position):
-        raise ValueError(f'position must be finite and within {MAX_COORDINATE_M:g} m, '
-                         f'got {position}')
+    if not all(v is None or (math.isfinite(v) and abs(v) <= MAX_COORDINATE_M)
+               for v in position):
+        raise ValueError(f'position must be finite and within {MAX_COORDINATE_M:g} m '
+                         f'(z may be NaN: keep the height), got {(p.x, p.y, p.z)}')
+    if np.all(np.isnan(orientation)):
+        return name, position, None
     if not np.all(np.isfinite(orientation)):
-        raise ValueError(f'orientation must be finite, got {tuple(orientation)}')
+        raise ValueError(f'orientation must be finite (or four NaNs: keep it), '
+                         f'got {tuple(orientation)}')
     norm = float(np.linalg.norm(orientation))
     if norm == 0.0:
         return name, position, (0.0, 0.0, 0.0, 1.0)

@@ -36,6 +36,8 @@ from miro_sim_bullet.ros.domain_guard import refuse_shared_domain, SharedDomain
 from miro_sim_bullet.ros.endpoints import Endpoints
 from miro_sim_bullet.ros.params import SimParams
 from miro_sim_bullet.ros.robot_interface import RobotInterface
+from miro_sim_bullet.ros.scene import SCENE_RATE_HZ
+from miro_sim_bullet.ros.scene_interface import SceneInterface
 from miro_sim_bullet.ros.sim_interface import SimInterface
 from miro_sim_bullet.scene.world_file import WorldError, bundled_worlds
 
@@ -79,6 +81,7 @@ class SimNode(Node):
                        for name in self.sim.robots}
         self.sim_interface = SimInterface(ros, self.sim, self.cameras, reset=self.reset,
                                           pause=self.pause, step=self.step, warn=self.warn)
+        self.scene = SceneInterface(ros, self.sim)
         self.get_logger().info(
             f'world {self.sim.description.source}; robots {", ".join(self.robots)}; renderer '
             f'{self.cameras.renderer.name}; cameras {p.frame_width}x{p.frame_height} @ '
@@ -135,6 +138,7 @@ class SimNode(Node):
         if not keep_time:
             self._next_frame = 0
             self._next_overhead = 0.0
+            self._next_scene = 0.0
 
     def _frame_step(self, index):
         return round(index / self.params.camera_rate / self.sim.dt)
@@ -179,6 +183,9 @@ class SimNode(Node):
                     self._next_frame += 1
             if sim.step_index % sim.ticks_per_platform_tick == 0:
                 self._publish_tick()
+            if sim.time >= self._next_scene:
+                self.scene.publish(convert.stamp(sim.time))
+                self._next_scene += 1.0 / SCENE_RATE_HZ
             rate = self.params.overhead_rate
             if rate > 0 and sim.time >= self._next_overhead:
                 self.sim_interface.publish_overhead(convert.stamp(sim.time),

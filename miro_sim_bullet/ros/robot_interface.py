@@ -16,8 +16,10 @@ from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, UI
 
 from miro_ball.common.qos import profile
 from miro_ball.miro.constants import JOINT_NAMES, UPSTREAM_FLAG_SIMULATOR
-from miro_ball.miro.interface import EYE_SIDE, EYES, frame_id, RobotTopics, TOPIC
+from miro_ball.miro.interface import (EYE_SIDE, EYES, frame_id, RobotTopics, SimTopics, TOPIC,
+                                      TOUCH_PARTS)
 from miro_ball.miro.kinematics import finite
+from miro_ball.miro.touch import ALL_PADS
 from miro_sim_bullet.ros import convert
 
 
@@ -52,7 +54,7 @@ class RobotInterface:
         self.pub_imu = {part: pub(Imu, 'imu', part=part) for part in ('body', 'head')}
         self.pub_battery = pub(BatteryState, 'battery')
         self.pub_light = pub(Float32MultiArray, 'light')
-        self.pub_touch = [pub(UInt16, 'touch', part=part) for part in ('head', 'body')]
+        self.pub_touch = {part: pub(UInt16, 'touch', part=part) for part in TOUCH_PARTS}
         self.pub_flags = pub(UInt32, 'sensor_flags')
         self.subs = [ros.subscription(msg_type, getattr(t, key), callback,
                                       profile(TOPIC[key].qos))
@@ -63,6 +65,13 @@ class RobotInterface:
                          (UInt32MultiArray, 'illum', self._on_illum),
                          (UInt16MultiArray, 'tone', self._on_tone),
                          (UInt32, 'control_flags', self._on_flags))]
+        # The hand: the simulator's input for touching this robot (not part of MiRo's own
+        # interface: a real MiRo is touched by people, not by topics).
+        sim = SimTopics()
+        self.subs += [ros.subscription(UInt16, sim.touch(name, part),
+                                       lambda msg, part=part: self._on_touch(part, msg),
+                                       profile(TOPIC['touch'].qos))
+                      for part in TOUCH_PARTS]
 
     @property
     def robot(self):
@@ -117,6 +126,12 @@ class RobotInterface:
         self._warn('tone_play', f'{self.name}: tone {frequency} Hz, volume {volume}, '
                    f'{ticks} ticks (not audible in simulation)')
 
+    def _on_touch(self, part, msg):
+        if msg.data > ALL_PADS:
+            self._warn('touch', f'touch on the {part}: pads {msg.data:#x} beyond the 14 there '
+                       'are: those ignored')
+        self.robot.touch(part, msg.data & ALL_PADS)
+
     def _on_flags(self, msg):
         self.robot.flags = msg.data
 
@@ -138,8 +153,8 @@ class RobotInterface:
                                                    frame_id(self.name, f'imu_{part}')))
         self.pub_battery.publish(convert.battery(s, when, self.name))
         self.pub_light.publish(convert.floats(s.light))
-        for pub in self.pub_touch:
-            pub.publish(UInt16(data=0))
+        self.pub_touch['head'].publish(UInt16(data=s.touch_head))
+        self.pub_touch['body'].publish(UInt16(data=s.touch_body))
         self.pub_flags.publish(UInt32(data=UPSTREAM_FLAG_SIMULATOR))
 
     def wanted_eyes(self):

@@ -1,0 +1,111 @@
+"""What a PyBullet client looks like: every body's visual shapes as primitives.
+
+PyBullet keeps each visual shape as a geometry in a link's frame. This module turns them
+into instances of three unit primitives (box, sphere, cylinder; a capsule is a cylinder
+and two spheres), each with its rotation, offset and scale in its link's frame, and
+reports the link frames in the world as they are now. Our OpenGL renderer draws these
+instances and the simulator's scene topic describes them as markers: one reading of the
+shapes for both, so the view on ROS is the view the eyes have.
+"""
+import numpy as np
+
+from miro_sim_bullet.bullet import pybullet as p
+
+MESHES = ('box', 'sphere', 'cylinder')  # unit cube, unit-radius sphere, unit cylinder along z
+MIN_SCALE = 1e-6  # flat shapes still get finite normals
+
+
+def matrices(quaternions):
+    """(n, 3, 3) rotation matrices of (n, 4) quaternions x, y, z, w."""
+    x, y, z, w = np.asarray(quaternions, float).T
+    return np.stack([
+        1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
+        2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+        2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        axis=-1).reshape(-1, 3, 3)
+
+
+class BodyVisuals:
+    """The primitive instances of one body's visual shapes, in its link frames.
+
+    Arrays per instance: mesh (index into MESHES), link (-1 = base), entry (index into
+    getVisualShapeData, for colours that change), local rotation and offset, scale (box:
+    full extents; sphere: radius; cylinder: radius, radius, length).
+    """
+
+    def __init__(self, client, body):
+        self.client, self.body = client, body
+        kw = {'physicsClientId': client}
+        self.links = p.getNumJoints(body, **kw)
+        info = p.getDynamicsInfo(body, -1, **kw)
+        self.static = info[0] == 0 and self.links == 0
+        # PyBullet reports a base by its centre of mass; visuals hang off the link frame.
+        inertial_rot = matrices([info[4]])[0]
+        self.base_to_link = (inertial_rot.T, -inertial_rot.T @ np.asarray(info[3]))
+        mesh, link, entry, rot, offset, scale = [], [], [], [], [], []
+        for index, shape in enumerate(p.getVisualShapeData(body, **kw)):
+            geometry, dims, position, orientation = shape[2], shape[3], shape[5], shape[6]
+            local_rot = matrices([orientation])[0]
+            for kind, shift, size in _parts(geometry, dims):
+                mesh.append(MESHES.index(kind))
+                link.append(shape[1])
+                entry.append(index)
+                rot.append(local_rot)
+                offset.append(np.asarray(position) + local_rot @ shift)
+                scale.append(np.maximum(size, MIN_SCALE))
+        self.mesh = np.array(mesh, int)
+        self.link = np.array(link, int)
+        self.entry = np.array(entry, int)
+        self.rot = np.array(rot).reshape(-1, 3, 3)
+        self.offset = np.array(offset).reshape(-1, 3)
+        self.scale = np.array(scale).reshape(-1, 3)
+
+    def link_frames(self):
+        """(positions (links + 1, 3), rotations (links + 1, 3, 3)) of the link frames in the
+        world now; row 0 is the base, row k + 1 link k."""
+        kw = {'physicsClientId': self.client}
+        position, orientation = p.getBasePositionAndOrientation(self.body, **kw)
+        com_rot = matrices([orientation])[0]
+        to_link_rot, to_link_offset = self.base_to_link
+        positions = [np.asarray(position) + com_rot @ to_link_offset]
+        rotations = [com_rot @ to_link_rot]
+        if self.links:
+            states = p.getLinkStates(self.body, range(self.links),
+                                     computeForwardKinematics=1, **kw)
+            positions += [s[4] for s in states]
+            rotations += list(matrices([s[5] for s in states]))
+        return np.array(positions), np.array(rotations)
+
+    def colours(self):
+        """(instances, 4) RGBA of every instance now (LEDs change colour)."""
+        rgba = np.array([s[7] for s in p.getVisualShapeData(self.body,
+                                                            physicsClientId=self.client)])
+        return rgba[self.entry]
+
+    def world_poses(self):
+        """(rotations (n, 3, 3), positions (n, 3)) of every instance in the world now."""
+        positions, rotations = self.link_frames()
+        frame_rot, frame_pos = rotations[self.link + 1], positions[self.link + 1]
+        return frame_rot @ self.rot, frame_pos + np.einsum('nij,nj->ni', frame_rot, self.offset)
+
+
+def client_visuals(client):
+    """BodyVisuals of every body in the client, in body-id order."""
+    return [BodyVisuals(client, body) for body in range(p.getNumBodies(physicsClientId=client))]
+
+
+def _parts(geometry, dims):
+    """[(mesh, shift along the shape's frame, scale)] drawing one PyBullet visual shape."""
+    zero = np.zeros(3)
+    if geometry == p.GEOM_BOX:
+        return [('box', zero, np.asarray(dims[:3], float))]
+    if geometry == p.GEOM_SPHERE:
+        return [('sphere', zero, np.full(3, dims[0]))]
+    length, radius = dims[0], dims[1]
+    parts = [('cylinder', zero, np.array([radius, radius, length]))]
+    if geometry == p.GEOM_CAPSULE:
+        parts += [('sphere', np.array([0.0, 0.0, sign * length / 2]), np.full(3, radius))
+                  for sign in (1, -1)]
+    elif geometry != p.GEOM_CYLINDER:
+        return []  # meshes and planes do not occur in our worlds
+    return parts

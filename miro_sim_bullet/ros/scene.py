@@ -1,0 +1,164 @@
+"""The world as markers, for RViz, Foxglove and the GUI's 3D view (/miro_sim/scene).
+
+Two kinds of message go out on the one topic, each from a publisher of its own that keeps
+its newest message for late subscribers (transient local), so a viewer that joins at any
+time gets both:
+
+- the layout: every static shape and picture in frame ``world``, and every robot's shapes
+  in its link frames (``<robot>/<link>``, frame-locked: /miro_sim/links/<robot> says where
+  those frames are, see frames.py). Sent at the start, after a reset and when a robot's
+  colours change (its LEDs);
+- the movers: every movable object (the ball, named boxes) in frame ``world``, sent at up
+  to SCENE_RATE_HZ of simulated time, only when one of them has moved.
+
+A robot costs the scene topic nothing while its LEDs stay as they are: its motion is on
+its links topic. Marker namespaces are the objects' and robots' names; unnamed statics are grouped by
+the world-file table they come from (``wall``, ``ring``, ``table``, ``box``, ``ground``,
+``picture``). A robot's markers carry the link's name in ``text``.
+"""
+import hashlib
+from pathlib import Path
+
+import numpy as np
+from builtin_interfaces.msg import Duration
+from geometry_msgs.msg import Point
+from sensor_msgs.msg import CompressedImage
+from std_msgs.msg import ColorRGBA
+from visualization_msgs.msg import Marker, MarkerArray, UVCoordinate
+
+from miro_ball.miro.constants import LINK_NAMES
+from miro_ball.miro.interface import frame_id, WORLD_FRAME
+from miro_sim_bullet.render.visuals import BodyVisuals, MESHES
+from miro_sim_bullet.ros.frames import quaternion
+
+SCENE_RATE_HZ = 30.0
+MOVED_M = 0.0005  # a mover is sent again once it has moved this far...
+TURNED = 2e-7  # ... or turned (1 - |q.q'|: about 0.05 degrees)
+_TYPES = {'box': Marker.CUBE, 'sphere': Marker.SPHERE, 'cylinder': Marker.CYLINDER}
+# A picture is two triangles over its corners (bottom-left, bottom-right, top-right,
+# top-left); texture coordinates with v up, as OpenGL and three.js take them.
+_PICTURE_CORNERS = (0, 1, 2, 0, 2, 3)
+_PICTURE_UV = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
+
+
+def _shape_marker(mesh, scale, colour, frame, ns, marker_id):
+    """A CUBE, SPHERE or CYLINDER marker of one primitive instance (visuals.MESHES);
+    ROS scales a sphere and a cylinder by their diameters."""
+    kind = MESHES[mesh]
+    marker = Marker(ns=ns, id=marker_id, type=_TYPES[kind], action=Marker.ADD)
+    marker.header.frame_id = frame
+    sx, sy, sz = (float(v) for v in scale)
+    if kind == 'sphere':
+        sx = sy = sz = 2 * sx
+    elif kind == 'cylinder':
+        sx, sy = 2 * sx, 2 * sy
+    marker.scale.x, marker.scale.y, marker.scale.z = sx, sy, sz
+    marker.color = ColorRGBA(r=float(colour[0]), g=float(colour[1]), b=float(colour[2]),
+                             a=float(colour[3]))
+    marker.lifetime = Duration()  # forever
+    return marker
+
+
+def _place(marker, rotation, position):
+    p, o = marker.pose.position, marker.pose.orientation
+    p.x, p.y, p.z = (float(v) for v in position)
+    o.x, o.y, o.z, o.w = quaternion(rotation)
+    return marker
+
+
+def picture_marker(picture, marker_id):
+    """A picture as a textured TRIANGLE_LIST in frame world (its PNG travels inside)."""
+    data = Path(picture.image).read_bytes()
+    key = f'{Path(picture.image).stem}-{hashlib.sha1(data).hexdigest()[:10]}'
+    marker = Marker(ns='picture', id=marker_id, type=Marker.TRIANGLE_LIST, action=Marker.ADD,
+                    texture_resource=f'embedded://{key}.png',
+                    texture=CompressedImage(format='png', data=data), text=picture.source)
+    marker.header.frame_id = WORLD_FRAME
+    marker.pose.orientation.w = 1.0
+    marker.scale.x = marker.scale.y = marker.scale.z = 1.0
+    marker.color = ColorRGBA(r=1.0, g=1.0, b=1.0, a=1.0)
+    marker.points = [Point(x=float(x), y=float(y), z=float(z))
+                     for x, y, z in (picture.corners[k] for k in _PICTURE_CORNERS)]
+    marker.uv_coordinates = [UVCoordinate(u=_PICTURE_UV[k][0], v=_PICTURE_UV[k][1])
+                             for k in _PICTURE_CORNERS]
+    return marker
+
+
+class SceneMarkers:
+    """The markers of one built SimWorld (make a new one after a reset)."""
+
+    def __init__(self, world):
+        self.world = world
+        self.labels = world.body_labels  # body id -> (namespace, kind of body)
+        self.visuals = {body: BodyVisuals(world.client, body) for body in self.labels}
+        self.robot_bodies = {robot.body_id: name for name, robot in world.robots.items()}
+        self.movers = {body: ns for body, (ns, kind) in self.labels.items() if kind == 'mover'}
+        self._sent = {}  # mover body -> (position, quaternion) last sent
+        self._colours = None
+
+    # -- the layout ---------------------------------------------------------------------------
+    def layout(self):
+        """MarkerArray of the statics, the pictures and the robots' links."""
+        markers, counts = [], {}
+        for body, (ns, kind) in self.labels.items():
+            visuals = self.visuals[body]
+            if kind == 'static':
+                rotations, positions = visuals.world_poses()
+                colours = visuals.colours()
+                for k in range(len(visuals.mesh)):
+                    index = counts[ns] = counts.get(ns, -1) + 1
+                    markers.append(_place(_shape_marker(visuals.mesh[k], visuals.scale[k],
+                                                        colours[k], WORLD_FRAME, ns, index),
+                                          rotations[k], positions[k]))
+            elif kind == 'robot':
+                markers += self._robot_markers(ns, visuals)
+        for index, picture in enumerate(getattr(self.world.description, 'pictures', ())):
+            markers.append(picture_marker(picture, index))
+        self._colours = self.robot_colours()
+        return MarkerArray(markers=markers)
+
+    def _robot_markers(self, robot, visuals):
+        """A robot's shapes in its link frames, frame-locked: /tf moves them."""
+        colours = visuals.colours()
+        markers = []
+        for k in range(len(visuals.mesh)):
+            link = LINK_NAMES[visuals.link[k] + 1]
+            marker = _shape_marker(visuals.mesh[k], visuals.scale[k], colours[k],
+                                   frame_id(robot, link), robot, k)
+            marker.frame_locked, marker.text = True, link
+            markers.append(_place(marker, visuals.rot[k], visuals.offset[k]))
+        return markers
+
+    def robot_colours(self):
+        """Every robot's shape colours now (the LEDs change them)."""
+        return tuple(tuple(self.visuals[body].colours().ravel().round(3))
+                     for body in self.robot_bodies)
+
+    def colours_changed(self):
+        return self.robot_colours() != self._colours
+
+    # -- the movers ---------------------------------------------------------------------------
+    def movers_if_moved(self):
+        """MarkerArray of every movable object if any moved since last sent, else None."""
+        poses = {}
+        moved = False
+        for body in self.movers:
+            rotations, positions = self.visuals[body].world_poses()
+            q = np.asarray(quaternion(rotations[0]))
+            poses[body] = (rotations, positions, q)
+            last = self._sent.get(body)
+            if last is None or np.linalg.norm(positions[0] - last[0]) > MOVED_M \
+                    or 1.0 - abs(float(q @ last[1])) > TURNED:
+                moved = True
+        if not moved:
+            return None
+        markers = []
+        for body, (rotations, positions, q) in poses.items():
+            visuals = self.visuals[body]
+            colours = visuals.colours()
+            for k in range(len(visuals.mesh)):
+                markers.append(_place(_shape_marker(visuals.mesh[k], visuals.scale[k],
+                                                    colours[k], WORLD_FRAME, self.movers[body],
+                                                    k), rotations[k], positions[k]))
+            self._sent[body] = (positions[0], q)
+        return MarkerArray(markers=markers)
