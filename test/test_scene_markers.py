@@ -97,7 +97,8 @@ def test_the_link_frames_are_where_the_simulator_has_them():
     robot.set_kinematic_targets((0.0, 0.5, 0.6, -0.1))
     world.run(1.0)
     links = RobotLinks(world, robot.name)
-    frames = dict(zip(LINK_FRAMES, links.frames()))
+    frames = {name: (rotation_of(q), np.array(p)) for name, (p, q) in
+              zip(LINK_FRAMES, links.frames())}
     assert len(frames) == len(LINK_FRAMES) == len(links.frames())
     message = links.message(convert.stamp(world.time))
     assert message.header.frame_id == 'world' and len(message.poses) == len(LINK_FRAMES)

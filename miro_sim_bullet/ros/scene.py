@@ -130,9 +130,8 @@ class SceneMarkers:
         return markers
 
     def robot_colours(self):
-        """Every robot's shape colours now (the LEDs change them)."""
-        return tuple(tuple(self.visuals[body].colours().ravel().round(3))
-                     for body in self.robot_bodies)
+        """What sets the robots' colours now: their LEDs."""
+        return tuple(tuple(robot.illum) for robot in self.world.robots.values())
 
     def colours_changed(self):
         return self.robot_colours() != self._colours
