@@ -6,8 +6,13 @@ the simulator is in-process and paused, stepped here tick by tick, so every
 or released, a page closed), the world is stepped no faster than real time, as a
 simulator runs for a user. One simulator, GUI and browser serve all the tests of
 this file; each test opens its own page.
+
+The world view (three.js on WebGL, SwiftShader here) is checked as a user sees it:
+screenshots of #world-view (saved under pytest's tmp dir; -s prints their paths), and
+mouse gestures where the page says a thing is drawn (miroGui.world.screenOf).
 """
 import http.client
+import math
 import os
 import shutil
 import sys
@@ -18,7 +23,7 @@ from rclpy.parameter import Parameter
 
 from miro_ball.common.isolation import isolated_env
 from miro_ball.gui.process import GuiProcess
-from miro_ball.miro.interface import RobotTopics, default_robot_name
+from miro_ball.miro.interface import BALL_NAME, RobotTopics, SimTopics, default_robot_name
 
 playwright_api = pytest.importorskip('playwright.sync_api')
 CHROMIUM = shutil.which('chromium') or '/usr/bin/chromium'
@@ -26,7 +31,8 @@ if not os.path.exists(CHROMIUM):
     pytest.skip("Debian's chromium is not installed (./dev.sh installs it as root)",
                 allow_module_level=True)
 
-T = RobotTopics(default_robot_name())
+ROBOT = default_robot_name()
+T = RobotTopics(ROBOT)
 BLUE_BALL_JS = """(id) => {
   const c = document.getElementById(id);
   const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
@@ -42,10 +48,13 @@ class Rig:
     def __init__(self, context, executor, sim, url, browser, probe):
         self.context, self.executor, self.sim = context, executor, sim
         self.url, self.browser = url, browser
+        from geometry_msgs.msg import PoseStamped
         from nav_msgs.msg import Odometry
         from sensor_msgs.msg import JointState
-        from std_msgs.msg import Float32MultiArray
+        from std_msgs.msg import Float32MultiArray, UInt16
         self.odom = probe.watch(Odometry, T.odom)
+        self.ball = probe.watch(PoseStamped, SimTopics().object_pose(BALL_NAME))
+        self.touch = {part: probe.watch(UInt16, T.touch(part)) for part in ('head', 'body')}
         self.joints = probe.watch(JointState, T.kinematic_joints)
         self.wheels = probe.watch(Float32MultiArray, T.wheel_speed_cmd)
         self.errors = []
@@ -277,3 +286,162 @@ def test_foreign_origins_are_refused(rig):
     assert handshake(rig.url, origin='http://evil.example') == 403
     assert handshake(rig.url, origin=f'http://evil.example:{port}',
                      host=f'evil.example:{port}') == 403  # DNS rebinding
+
+
+# ---- the world view ---------------------------------------------------------------------------
+def world_ready(page):
+    """The page's world view has the scene and MiRo's link frames."""
+    return page.evaluate(f"""() => !!miroGui.world
+        && miroGui.world.positionOf({BALL_NAME!r}) !== null
+        && miroGui.world.positionOf({ROBOT!r}) !== null""")
+
+
+def world_page(rig):
+    page = rig.open_page()
+    assert rig.until(lambda: world_ready(page)), 'the scene never reached the world view'
+    page.evaluate('miroGui.world.home()')
+    return page
+
+
+def redrawn(rig, page):
+    """Wait until the world view has drawn what it has now."""
+    drawn = page.evaluate('miroGui.world.dirty = true; miroGui.world.drawn')
+    assert rig.until(lambda: page.evaluate('miroGui.world.drawn') > drawn)
+
+
+def world_shot(page, tmp_path, name):
+    path = tmp_path / f'{name}.png'
+    png = page.locator('#world-view').screenshot(path=str(path))
+    print(f'\nscreenshot of the world view: {path}')
+    import cv2
+    import numpy as np
+    return cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)
+
+
+def blue_pixels(bgr):
+    b, g, r = (bgr[..., i].astype(int) for i in range(3))
+    return int(((b > 120) & (g < 60) & (r < 60)).sum())
+
+
+def screen(page, point):
+    at = page.evaluate('(p) => miroGui.world.screenOf(p)', list(point))
+    return at['x'], at['y']
+
+
+def position(page, name):
+    return page.evaluate('(n) => miroGui.world.positionOf(n)', name)
+
+
+def test_the_world_view_shows_the_ball_and_miro_driving(rig, tmp_path):
+    page = world_page(rig)
+    assert page.locator('#world-view').is_visible(), 'the world view is not shown by default'
+    redrawn(rig, page)
+    before = world_shot(page, tmp_path, 'world_view')
+    assert blue_pixels(before) > 30, 'the blue ball is not in the world view'
+    start = position(page, ROBOT)
+    page.keyboard.down('ArrowUp')
+    rig.run(1.0)
+    page.keyboard.up('ArrowUp')
+    assert rig.until(rig.stopped)
+    assert rig.until(lambda: math.dist(position(page, ROBOT)[:2], start[:2]) > 0.1), \
+        'MiRo drove but did not move in the world view'
+    redrawn(rig, page)
+    after = world_shot(page, tmp_path, 'world_view_after_driving')
+    changed = (abs(after.astype(int) - before.astype(int)).sum(axis=2) > 40).mean()
+    assert changed > 0.002, f'driving MiRo changed {changed:.2%} of the world view'
+    page.close()
+    assert not rig.errors
+
+
+def test_dragging_the_ball_moves_it_in_the_simulator_by_the_dragged_amount(rig, tmp_path):
+    page = world_page(rig)
+    assert rig.until(lambda: rig.ball), 'no ground truth of the ball'
+    truth = rig.ball[-1].pose.position
+    start = position(page, BALL_NAME)
+    assert math.dist(start[:2], (truth.x, truth.y)) < 0.01
+    # Towards the arena's edge and away from MiRo, wherever an earlier test left them.
+    away = -0.4 if start[1] > -0.5 else 0.4
+    shift = (-0.1, away)
+    target = (start[0] + shift[0], start[1] + shift[1], start[2])
+    (x0, y0), (x1, y1) = screen(page, start), screen(page, target)
+    page.mouse.move(x0, y0)
+    page.mouse.down()
+    for k in range(1, 11):
+        page.mouse.move(x0 + (x1 - x0) * k / 10, y0 + (y1 - y0) * k / 10)
+        rig.run(0.05)
+    rig.run(0.3)  # held still: it stays under the pointer
+    world_shot(page, tmp_path, 'world_view_dragging_the_ball')
+    page.mouse.up()
+    rig.run(0.3)
+    end = rig.ball[-1].pose.position
+    miss = math.dist((end.x, end.y), (truth.x + shift[0], truth.y + shift[1]))
+    assert miss < 0.05, f'the ball ended {miss:.3f} m from where it was dragged'
+    assert rig.until(lambda: math.dist(position(page, BALL_NAME)[:2], (end.x, end.y)) < 0.01)
+    page.close()
+    assert not rig.errors
+
+
+def stroke(rig, page, points, sensor, sim_seconds=5.0):
+    """Press at the first point and stroke back and forth through the others, as a hand
+    does, until the sensor reads a touch (the GUI's first touch of a part also waits for
+    ROS to find the simulator's topic); the simulated seconds that took, or None."""
+    import itertools
+    heard = len(sensor)
+    path = itertools.cycle(points + points[-2:0:-1])
+    ticks = itertools.count()
+    page.mouse.move(*next(path))
+    page.mouse.down()
+
+    def touched():
+        if next(ticks) % 3 == 0:  # a move every 60 ms
+            page.mouse.move(*next(path))
+        return any(m.data for m in sensor[heard:])
+    took = rig.run(sim_seconds, touched)
+    page.mouse.up()
+    return took
+
+
+def test_stroking_miros_head_in_the_view_and_its_back_on_the_body_map_touches_it(rig, tmp_path):
+    page = world_page(rig)
+    page.select_option('#world_mode', 'stroke')
+
+    def head(fractions):  # a point of the head's shapes, as fractions of their box
+        return page.evaluate('(f) => miroGui.world.linkPoint(%r, "head", f)' % ROBOT, fractions)
+    # Seen from in front of the head and above it, as a hand would come.
+    page.evaluate('([eye, at]) => miroGui.world.setView(eye, at)',
+                  [head([3, 0.5, 5]), head([0.5, 0.5, 0.5])])
+    redrawn(rig, page)
+    world_shot(page, tmp_path, 'world_view_head')
+    points = [screen(page, head([f, 0.5, 1.0])) for f in (0.8, 0.7, 0.6, 0.5, 0.4, 0.3)]
+    under = [page.evaluate('([x, y]) => miroGui.world.hitAt(x, y)', list(p)) for p in points]
+    assert stroke(rig, page, points, rig.touch['head']) is not None, \
+        f"stroking MiRo's head in the world view did not touch its head sensor ({under})"
+    # The body map beside the readouts: a stroke down MiRo's back.
+    box = page.locator('#bodymap').bounding_box()
+    w, h = page.evaluate("[document.getElementById('bodymap').width, "
+                         "document.getElementById('bodymap').height]")
+
+    def on_map(x, y):
+        return box['x'] + x * box['width'] / w, box['y'] + y * box['height'] / h
+    points = [on_map(75, y) for y in (110, 130, 150, 170, 190, 210)]
+    assert stroke(rig, page, points, rig.touch['body']) is not None, \
+        'stroking the body map did not touch the body sensor'
+    assert rig.until(lambda: page.evaluate('miroGui.state.readouts.touch_body') == 0), \
+        'the touch went on after the stroke'
+    page.close()
+    assert not rig.errors
+
+
+def test_speed_menu_sets_the_simulators_real_time_factor_and_tones_are_heard(rig):
+    page = rig.open_page()
+    assert page.locator('#readtable .mark').count() == 2, 'the battery marks at 4.6 and 4.8 V'
+    page.select_option('#rtf_set', '2')
+    assert rig.until(lambda: rig.sim.get_parameter('real_time_factor').value == 2.0)
+    rig.sim.set_parameters([Parameter('real_time_factor', value=1.0)])
+    page.locator('#sound').click()  # a click: browsers let a page make sound after one
+    page.locator('#tone_play').click()
+    assert rig.until(lambda: page.evaluate(
+        'miroGui.tones.some((t) => t.played && t.hz === 440 && t.ticks === 50)')), \
+        'the tone MiRo was asked to play was not played in the page'
+    page.close()
+    assert not rig.errors

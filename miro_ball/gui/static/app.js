@@ -1,19 +1,24 @@
-// The MiRo GUI page: images and readouts in, commands out, over one WebSocket.
-// The server sends the newest frame of each channel and waits for our 'ack' before
-// the next, so frames never pile up here. Driving is a command refreshed every
+// The MiRo GUI page: images, readouts and the world's scene in, commands out, over one
+// WebSocket. The server sends the newest frame of each channel and waits for our 'ack'
+// before the next, so frames never pile up here; it sends only what the page says it shows
+// ('view'), so hidden panels cost nothing. Driving is a command refreshed every
 // DRIVE_REFRESH_MS while a key or button is held; the server stops the robot when the
-// refreshes stop (key up, page hidden or closed, connection lost).
-'use strict';
+// refreshes stop (key up, page hidden or closed, connection lost). The 3D world view is
+// world_view.js, loaded on its own so that a browser without WebGL still gets the rest.
 
 const DRIVE_REFRESH_MS = 100;
 const ANIMATION_MS = 40;  // cosmetic animations: 25 updates a second
 const DEBUG_FRESH_MS = 1000;  // show the controller's annotated frame while this fresh
 const FPS_FRAMES = 15;  // the MDK GUI averages its frame rate over 15 frames
 const LOG_LENGTH = 5000;
+const TOUCH_PERIOD_MS = 50;  // a stroke is a stream: the sensor holds each for 0.25 s
+const HINT_MS = 4000;
+const TONE_GAIN = 0.3;  // at volume 255: loud enough, never harsh
 const $ = (id) => document.getElementById(id);
 
 // What tests and the benchmark read: frames drawn per channel, and when.
-const gui = window.miroGui = { frames: {}, drawn: [], state: null, config: null, connected: false };
+const gui = window.miroGui = { frames: {}, drawn: [], state: null, config: null, connected: false,
+                               world: null, tones: [] };
 
 let ws = null;
 let channels = [];
@@ -32,7 +37,7 @@ function send(message) {
 function connect() {
   ws = new WebSocket(`${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws`);
   ws.binaryType = 'arraybuffer';
-  ws.onopen = () => { gui.connected = true; showConnection(); };
+  ws.onopen = () => { gui.connected = true; worldShown = false; showConnection(); };
   ws.onclose = () => { gui.connected = false; showConnection(); setTimeout(connect, 1000); };
   ws.onmessage = (event) => {
     if (typeof event.data === 'string') onText(JSON.parse(event.data));
@@ -46,8 +51,192 @@ function showConnection() {
 }
 
 function onText(message) {
-  if (message.t === 'config') setUp(message);
+  if (message.t === 'config') { setUp(message); sendView(); }
   else if (message.t === 'state') showState(message);
+  else if (message.t === 'scene') { if (gui.world) gui.world.applyScene(message); }
+  else if (message.t === 'tf') { if (gui.world) gui.world.applyTf(message); }
+  else if (message.t === 'tone') playTone(message);
+}
+
+// ---- what this page shows -------------------------------------------------------------------
+// The server subscribes to a robot's eyes, and to the scene, only while some page shows them.
+let worldReady = false;  // the world view loaded and has WebGL
+let worldShown = false;
+
+function sendView() {
+  const visible = !document.hidden;
+  const wanted = [];
+  if (visible && $('show_eyes').checked) {
+    wanted.push('caml', 'camr');
+    if ($('detections').checked) wanted.push('debug_caml', 'debug_camr');
+  }
+  if (visible && $('show_overhead').checked) wanted.push('overhead');
+  const world = visible && worldReady && $('show_world').checked;
+  if (world && !worldShown) gui.world.clear();  // the whole scene comes again
+  worldShown = world;
+  if (gui.world) gui.world.active = world;
+  $('worldbox').hidden = !$('show_world').checked;
+  $('eyesbox').hidden = $('eyesinfo').hidden = !$('show_eyes').checked;
+  $('overheadbox').hidden = !$('show_overhead').checked;
+  send({ t: 'view', channels: wanted.filter((c) => channels.includes(c)), world });
+}
+
+function hint(text) {
+  $('world_hint').textContent = text;
+  clearTimeout(hint.timer);
+  hint.timer = setTimeout(() => { $('world_hint').textContent = ''; }, HINT_MS);
+}
+
+async function startWorld() {
+  for (const id of ['show_world', 'show_eyes', 'show_overhead', 'detections']) {
+    $(id).addEventListener('change', sendView);
+  }
+  document.addEventListener('visibilitychange', sendView);
+  try {
+    const { WorldView } = await import('./world_view.js');
+    gui.world = new WorldView($('world-view'), $('world-labels'), {
+      place: (name, x, y) => send({ t: 'place', name, x: round3(x), y: round3(y) }),
+      touch: touchAt, untouch, hint });
+  } catch (err) {
+    $('world_note').textContent = `This browser cannot draw the world view (${err.message}): `
+      + 'the overhead image shows the world instead.';
+    $('world_note').hidden = false;
+    $('worldstage').hidden = $('worldtools').hidden = true;
+    $('show_overhead').checked = true;
+    sendView();
+    return;
+  }
+  const world = gui.world;
+  world.onRobots = (names) => {
+    const follow = $('world_follow');
+    const chosen = follow.value;
+    follow.replaceChildren(new Option('nobody', ''), ...names.map((n) => new Option(n, n)));
+    follow.value = names.includes(chosen) ? chosen : '';
+  };
+  $('world_mode').addEventListener('change', () => { world.mode = $('world_mode').value; });
+  $('world_follow').addEventListener('change', () => world.setFollow($('world_follow').value));
+  $('world_fov').addEventListener('change', () => world.setShowFov($('world_fov').checked));
+  $('world_home').addEventListener('click', () => world.home());
+  worldReady = true;
+  sendView();
+}
+
+function round3(x) {
+  return Math.round(x * 1000) / 1000;
+}
+
+// ---- touch: strokes from the world view or the body map ---------------------------------------
+const stroke = { part: null, u: 0, v: 0, timer: null };
+
+function touchAt(part, u, v) {
+  Object.assign(stroke, { part, u: round3(u), v: round3(v) });
+  if (stroke.timer === null) {
+    sendTouch();
+    stroke.timer = setInterval(sendTouch, TOUCH_PERIOD_MS);
+  }
+}
+
+function sendTouch() {
+  if (stroke.part) send({ t: 'touch', part: stroke.part, u: stroke.u, v: stroke.v });
+}
+
+function untouch() {
+  stroke.part = null;
+  clearInterval(stroke.timer);
+  stroke.timer = null;
+}
+
+// MiRo from above, facing up: each part's pads in columns across (left to right) and rows
+// along (front at the top), as miro/touch.py numbers them (bit = across * along + along).
+const BODY_MAP = { head: [45, 8, 60, 72], body: [30, 92, 90, 130] };  // x, y, w, h
+let touchGrid = { rows: 2, columns: 7 };
+
+function drawBodyMap() {
+  const canvas = $('bodymap');
+  const ctx = canvas.getContext('2d');
+  const r = (gui.state && gui.state.readouts) || {};
+  ctx.clearRect(0, 0, canvas.width, canvas.height);
+  const { rows, columns } = touchGrid;
+  for (const [part, [x, y, w, h]] of Object.entries(BODY_MAP)) {
+    const mask = r[`touch_${part}`] || 0;
+    const pw = w / rows;
+    const ph = h / columns;
+    for (let across = 0; across < rows; across++) {
+      for (let along = 0; along < columns; along++) {
+        const lit = (mask >> (across * columns + along)) & 1;
+        ctx.fillStyle = lit ? '#ef6c00' : '#e3e3e3';
+        ctx.fillRect(x + across * pw + 1, y + along * ph + 1, pw - 2, ph - 2);
+      }
+    }
+    ctx.strokeStyle = '#2d3b45';
+    ctx.strokeRect(x + 0.5, y + 0.5, w - 1, h - 1);
+    ctx.fillStyle = '#2d3b45';
+    ctx.font = '11px system-ui, sans-serif';
+    ctx.fillText(part, x + w + 3 > canvas.width - 24 ? 2 : x + w + 3, y + 12);
+  }
+}
+
+function setUpBodyMap() {
+  const canvas = $('bodymap');
+  const at = (e) => {
+    const rect = canvas.getBoundingClientRect();
+    const px = ((e.clientX - rect.left) * canvas.width) / rect.width;
+    const py = ((e.clientY - rect.top) * canvas.height) / rect.height;
+    for (const [part, [x, y, w, h]] of Object.entries(BODY_MAP)) {
+      if (px >= x && px <= x + w && py >= y && py <= y + h) {
+        return [part, (py - y) / h, (px - x) / w];
+      }
+    }
+    return null;
+  };
+  canvas.addEventListener('pointerdown', (e) => {
+    const where = at(e);
+    if (!where) return;
+    canvas.setPointerCapture(e.pointerId);
+    touchAt(...where);
+  });
+  canvas.addEventListener('pointermove', (e) => {
+    if (!canvas.hasPointerCapture(e.pointerId)) return;
+    const where = at(e);
+    if (where) touchAt(...where);
+    else untouch();
+  });
+  for (const end of ['pointerup', 'pointercancel', 'lostpointercapture']) {
+    canvas.addEventListener(end, untouch);
+  }
+  drawBodyMap();
+}
+
+// ---- sound: MiRo's tones, when the user has allowed them --------------------------------------
+let audio = null;
+let soundOn = false;
+
+function setUpSound() {
+  $('sound').addEventListener('click', () => {
+    soundOn = !soundOn;
+    if (soundOn && !audio) audio = new AudioContext();  // made in a click, as browsers ask
+    if (audio && soundOn) audio.resume();
+    $('sound').textContent = soundOn ? 'sound on' : 'sound off';
+    $('sound').classList.toggle('on', soundOn);
+  });
+}
+
+function playTone(message) {
+  const { hz, volume, ticks } = message;
+  if (![hz, volume, ticks].every(Number.isFinite) || !gui.config) return;
+  gui.tones.push({ hz, volume, ticks, played: soundOn });
+  if (gui.tones.length > 100) gui.tones.shift();
+  if (!soundOn || !audio || hz <= 0 || volume <= 0 || ticks <= 0) return;
+  const start = audio.currentTime;
+  const seconds = Math.min(ticks, 255) * gui.config.tick_s;
+  const osc = audio.createOscillator();
+  const gain = audio.createGain();
+  osc.frequency.value = Math.min(Math.max(hz, 20), 20000);
+  gain.gain.setValueAtTime(TONE_GAIN * Math.min(volume, 255) / 255, start);
+  gain.gain.linearRampToValueAtTime(0, start + seconds);  // no click at the end
+  osc.connect(gain).connect(audio.destination);
+  osc.start(start);
+  osc.stop(start + seconds + 0.02);
 }
 
 // ---- images --------------------------------------------------------------------------------
@@ -74,14 +263,14 @@ function draw(name, stamp, bitmap) {
     return;  // this eye is shown with the controller's detections drawn
   }
   const canvas = $(target);
+  if (!canvas) return;
   if (canvas.width !== bitmap.width || canvas.height !== bitmap.height) {
     canvas.width = bitmap.width;
     canvas.height = bitmap.height;
   }
   const ctx = canvas.getContext('2d');
   ctx.drawImage(bitmap, 0, 0);
-  if (target === 'overhead') $('overheadbox').hidden = false;
-  else crossHairs(ctx, bitmap.width, bitmap.height, target === 'caml' ? 0.75 : 0.25);
+  if (target !== 'overhead') crossHairs(ctx, bitmap.width, bitmap.height, target === 'caml' ? 0.75 : 0.25);
   gui.frames[name] = (gui.frames[name] || 0) + 1;
   gui.drawn.push({ ch: name, stamp, at: performance.timeOrigin + now });
   if (gui.drawn.length > LOG_LENGTH) gui.drawn.splice(0, gui.drawn.length - LOG_LENGTH);
@@ -167,8 +356,13 @@ function showReadouts(readouts) {
 }
 
 function showState(state) {
+  const r = state.readouts || {};
+  const touched = gui.state && gui.state.readouts
+    && (gui.state.readouts.touch_head !== r.touch_head || gui.state.readouts.touch_body !== r.touch_body);
   gui.state = state;
-  showReadouts(state.readouts || {});
+  showReadouts(r);
+  if (touched) drawBodyMap();
+  if (gui.world) gui.world.setState(state);
   const picker = $('robot');
   const names = state.robots.includes(state.robot) ? state.robots : [state.robot, ...state.robots];
   if (picker.options.length !== names.length || names.some((n, i) => picker.options[i].value !== n)) {
@@ -184,6 +378,7 @@ function showState(state) {
   $('simtime').textContent = sim.time === null ? '-' : sim.time.toFixed(2);
   $('rtf').textContent = sim.rtf === null ? '-' : sim.rtf.toFixed(2);
   $('pause').textContent = sim.paused ? 'resume' : 'pause';
+  showRtfSet(state.rtf_set !== undefined ? state.rtf_set : sim.rtf_set);
   $('status').textContent = state.status;
   $('fps').textContent = `${fps('caml')} / ${fps('camr')}`;
 }
@@ -320,10 +515,39 @@ function ledPreset(colours, brightness) {
   sendLeds();
 }
 
+// The simulator's real_time_factor as last set or read, in the speed menu.
+function showRtfSet(value) {
+  const menu = $('rtf_set');
+  if (typeof value !== 'number' || !Number.isFinite(value) || document.activeElement === menu) return;
+  const text = String(value);
+  if (![...menu.options].some((o) => Number(o.value) === value)) {
+    menu.add(new Option(`${text}x`, text));
+  }
+  menu.value = [...menu.options].find((o) => Number(o.value) === value).value;
+}
+
+function batteryMarks(marks) {
+  const [, , lo, hi] = READOUTS[0];
+  const bar = readoutCells[0][1].parentElement;
+  for (const volts of marks || []) {
+    if (!Number.isFinite(volts)) continue;
+    const mark = document.createElement('div');
+    mark.className = 'mark';
+    mark.title = `${volts} V`;
+    mark.style.left = `${(100 * (volts - lo)) / (hi - lo)}%`;
+    bar.appendChild(mark);
+  }
+}
+
 function setUp(config) {
   gui.config = config;
   channels = config.channels;
   if ($('headsliders').childElementCount) return;  // a reconnection: the controls are there
+  batteryMarks(config.battery_marks);
+  if (config.touch && config.touch.rows > 0 && config.touch.columns > 0) {
+    touchGrid = { rows: config.touch.rows, columns: config.touch.columns };
+    drawBodyMap();
+  }
   for (const [id, max] of [['linear', config.max_linear], ['angular', config.max_angular]]) {
     $(id).max = max;
     $(id).value = max / 2;
@@ -377,6 +601,10 @@ function setUpSimulator() {
   $('step').addEventListener('click', () => send({ t: 'sim', action: 'step' }));
   $('reset').addEventListener('click', () => send({ t: 'sim', action: 'reset' }));
   $('robot').addEventListener('change', () => send({ t: 'robot', name: $('robot').value }));
+  $('rtf_set').addEventListener('change', () => {
+    send({ t: 'rtf', value: Number($('rtf_set').value) });
+    $('rtf_set').blur();  // shown as the simulator says from now on
+  });
 }
 
 function showMeasured() {
@@ -391,5 +619,8 @@ function showMeasured() {
 buildReadouts();
 setUpDriving();
 setUpSimulator();
+setUpBodyMap();
+setUpSound();
 setInterval(showMeasured, 100);
 connect();
+startWorld();
