@@ -1,42 +1,77 @@
-"""The GUI's ROS node in-process, without a browser: what it publishes, and its deadman."""
+"""The GUI's ROS node in-process, without a browser: what it publishes and subscribes to,
+for which page, and its deadman."""
 import json
+import math
 import time
 
 import pytest
-from geometry_msgs.msg import TwistStamped
-from sensor_msgs.msg import JointState
-from std_msgs.msg import Float32MultiArray, UInt16MultiArray, UInt32, UInt32MultiArray
+from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
+from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import ParameterType, ParameterValue, SetParametersResult
+from rcl_interfaces.srv import GetParameters, SetParameters
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import CameraInfo, JointState
+from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, UInt32MultiArray
+from visualization_msgs.msg import Marker, MarkerArray
 
 from miro_ball.gui import protocol as p
 from miro_ball.gui.bridge import DEADMAN_S, GuiBridge, NODE_NAME
-from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
-from miro_ball.miro.interface import RobotTopics, default_robot_name
+from miro_ball.miro.camera_model import CameraModel
+from miro_ball.miro.constants import (DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, LINK_FRAMES,
+                                      PLATFORM_TICK_S)
+from miro_ball.miro.interface import (BALL_NAME, EYES, RobotTopics, SimTopics,
+                                      default_robot_name)
+from miro_ball.miro.touch import pads_at
 from rostools import Probe, spin_until
 
 T = RobotTopics(default_robot_name())
+SIM = SimTopics()
 # What ROS itself publishes for every node.
 ROS_OWN = {'/rosout', '/parameter_events'}
+# The simulator renders an eye for a subscriber to any of its topics.
+EYE_TOPICS = {eye: (T.eye_compressed(eye), T.eye_raw(eye), T.camera_info(eye)) for eye in EYES}
+
+
+class Events(list):
+    """What the bridge had the web server send to pages: (owners, message)."""
+
+    def __call__(self, owners, text):
+        self.append((list(owners), json.loads(text)))
 
 
 @pytest.fixture
-def bridge(ros_context, executor):
-    node = GuiBridge(T.name, context=ros_context)
+def events():
+    return Events()
+
+
+@pytest.fixture
+def bridge(ros_context, executor, events):
+    node = GuiBridge(T.name, context=ros_context, on_event=events)
     executor.add_node(node)
     yield node
     executor.remove_node(node)
     node.destroy_node()
 
 
-def test_every_control_reaches_miros_topics_and_nothing_else_is_published(
+def opened(bridge, executor, owner=1):
+    bridge.open(owner)
+    assert spin_until(executor, lambda: owner in bridge.pages and bridge.watches)
+    return bridge
+
+
+def test_every_control_reaches_its_topic_and_nothing_else_is_published(
         bridge, ros_context, executor):
+    opened(bridge, executor)
     probe = Probe(ros_context, executor)
     got = {topic: probe.watch(kind, topic) for kind, topic in (
         (TwistStamped, T.cmd_vel), (JointState, T.kinematic_targets),
         (Float32MultiArray, T.cosmetic_joints), (UInt32MultiArray, T.illum),
-        (UInt16MultiArray, T.tone), (UInt32, T.control_flags))}
+        (UInt16MultiArray, T.tone), (UInt32, T.control_flags),
+        (PoseStamped, SIM.set_pose), (UInt16, SIM.touch(T.name, 'head')))}
     commands = [p.Head((0.0, 0.5, 0.1, 0.0)), p.Cosmetic((0.0, 1.0, 0.5, 0.5, 0.2, 0.2)),
                 p.Illum((1, 2, 3, 4, 5, 6)), p.Tone((440, 100, 50)),
-                p.Flags(DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX), p.Drive(0.1, 0.0)]
+                p.Flags(DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX), p.Drive(0.1, 0.0),
+                p.Place(BALL_NAME, 0.5, -0.25), p.Touch('head', 0.1, 0.0)]
     for command in commands:  # publishers are made on first use: let them match first
         bridge.submit(command, owner=1)
     assert spin_until(executor, lambda: all(got.values()))
@@ -47,16 +82,27 @@ def test_every_control_reaches_miros_topics_and_nothing_else_is_published(
     assert got[T.control_flags][-1].data == DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
     assert list(got[T.tone][-1].data) == [440, 100, 50]
     assert got[T.cmd_vel][-1].twist.linear.x == pytest.approx(0.1)
-    # Only the robot part, in the robot's namespace, publishes on MiRo's topics.
+    # A drag keeps the object's height and orientation: NaN and all zeros say so.
+    place = got[SIM.set_pose][-1]
+    assert place.header.frame_id == BALL_NAME
+    assert (place.pose.position.x, place.pose.position.y) == (0.5, -0.25)
+    assert math.isnan(place.pose.position.z)
+    o = place.pose.orientation
+    assert (o.x, o.y, o.z, o.w) == (0.0, 0.0, 0.0, 0.0)
+    assert got[SIM.touch(T.name, 'head')][-1].data == pads_at(0.1, 0.0)
+    # The robot part, in the robot's namespace, publishes on MiRo's topics; the bridge
+    # only on the simulator's inputs.
     published = {name for name, _ in bridge.get_publisher_names_and_types_by_node(
         NODE_NAME, '/' + T.name)}
-    assert published - ROS_OWN == set(got)
+    assert published - ROS_OWN == {t for t in got if t.startswith(f'/{T.name}/')}
     assert {name for name, _ in bridge.get_publisher_names_and_types_by_node(
-        NODE_NAME, '/')} <= ROS_OWN
+        NODE_NAME, '/')} - ROS_OWN == {SIM.set_pose, SIM.touch(T.name, 'head')}
 
 
 def test_a_drive_that_is_not_renewed_stops_and_another_page_cannot_stop_it(
         bridge, ros_context, executor):
+    opened(bridge, executor, 1)
+    opened(bridge, executor, 2)
     probe = Probe(ros_context, executor)
     twists = probe.watch(TwistStamped, T.cmd_vel)
     sent = time.monotonic()
@@ -73,30 +119,172 @@ def test_a_drive_that_is_not_renewed_stops_and_another_page_cannot_stop_it(
         'went on publishing after the stop'
 
 
-def test_the_state_is_json_with_the_robot_and_no_simulator(bridge):
-    state = json.loads(bridge.state())
-    assert state['t'] == 'state' and state['robot'] == T.name
-    assert state['sim']['present'] is False and state['readouts'] == {}
+def test_a_flood_of_drive_commands_reaches_miro_at_50_hz_the_newest_winning(
+        bridge, ros_context, executor):
+    opened(bridge, executor)
+    probe = Probe(ros_context, executor)
+    twists = probe.watch(TwistStamped, T.cmd_vel)
+    bridge.submit(p.Drive(0.01, 0.0), owner=1)  # the publisher is made on first use
+    assert spin_until(executor, lambda: twists)
+    twists.clear()
+    start = time.monotonic()
+    sent = 0
+    while time.monotonic() - start < 1.0:  # thousands a second, as the attack sent
+        for _ in range(20):
+            sent += 1
+            bridge.submit(p.Drive(0.2, sent * 1e-4), owner=1)
+        executor.spin_once(timeout_sec=0)
+    flood_s = time.monotonic() - start
+    last = sent * 1e-4
+    stopped = spin_until(executor, lambda: twists and twists[-1].twist.linear.x == 0.0,
+                         timeout_s=5.0)
+    stop_after = time.monotonic() - start - flood_s
+    assert stopped and sent > 2000
+    driving = [t for t in twists if t.twist.linear.x > 0]
+    assert len(driving) <= (flood_s + stop_after) / PLATFORM_TICK_S + 2
+    assert len(driving) >= 10  # and it went on driving meanwhile
+    assert driving[-1].twist.angular.z == pytest.approx(last)  # the newest command
+    assert stop_after < DEADMAN_S + 0.15  # the deadman unchanged by the flood
 
 
-def test_robots_are_found_and_picked_by_what_publishes(ros_context, executor):
-    from nav_msgs.msg import Odometry
+def eye_subscribers(node):
+    """{eye: 0 if no topic of it has a subscriber, else the most any has}."""
+    return {eye: max(node.count_subscribers(topic) for topic in topics)
+            for eye, topics in EYE_TOPICS.items()}
 
+
+def test_eyes_are_subscribed_only_while_a_page_shows_them(bridge, executor):
+    def settles(expected):
+        return spin_until(executor, lambda: eye_subscribers(bridge) == expected)
+
+    # No page: the simulator renders nothing for the GUI; nor is any sensor read. (The
+    # bridge's own subscriptions are in its graph at once: nothing to wait for.)
+    assert eye_subscribers(bridge) == {'caml': 0, 'camr': 0}
+    assert bridge.count_subscribers(T.odom) == 0 and not bridge.watches
+    opened(bridge, executor, 1)  # a page shows both eyes until it says otherwise
+    assert settles({'caml': 1, 'camr': 1})
+    assert spin_until(executor, lambda: bridge.count_subscribers(T.odom) == 1)
+    bridge.submit(p.View(frozenset(), True), owner=1)  # the world only
+    assert settles({'caml': 0, 'camr': 0})
+    opened(bridge, executor, 2)
+    bridge.submit(p.View(frozenset({'camr'}), False), owner=2)
+    assert settles({'caml': 0, 'camr': 1})
+    bridge.release(2)
+    assert settles({'caml': 0, 'camr': 0})
+    bridge.release(1)
+    assert spin_until(executor, lambda: bridge.count_subscribers(T.odom) == 0)
+    assert eye_subscribers(bridge) == {'caml': 0, 'camr': 0}
+
+
+def test_each_page_watches_and_drives_its_own_robot(ros_context, executor, events):
     probe = Probe(ros_context, executor)
     for name in ('robot_b', 'robot_a'):
         probe.publisher(Odometry, RobotTopics(name).odom)
+    a, b = RobotTopics('robot_a'), RobotTopics('robot_b')
+    twists = {name: probe.watch(TwistStamped, t.cmd_vel) for name, t in (('a', a), ('b', b))}
     # Asked for a robot that is not running: its topics have our subscribers only.
-    node = GuiBridge(None, context=ros_context, default_robot='absent')
+    node = GuiBridge(None, context=ros_context, default_robot='absent', on_event=events)
     executor.add_node(node)
     try:
         assert spin_until(executor, lambda: node.robots == ['robot_a', 'robot_b'])
-        assert spin_until(executor, lambda: node.watch.robot == 'robot_a')
+        opened(node, executor, 1)
+        opened(node, executor, 2)
+        state = lambda owner: json.loads(node.state(owner))  # noqa: E731
+        assert spin_until(executor, lambda: state(1)['robot'] == state(2)['robot'] == 'robot_a')
         node.submit(p.SelectRobot('robot_b'), owner=1)
-        assert spin_until(executor, lambda: node.watch.robot == 'robot_b')
-        node.submit(p.SelectRobot('ghost'), owner=1)  # not running: refused
-        node.submit(p.Stop(), owner=1)
-        assert spin_until(executor, lambda: not node._commands)
-        assert node.watch.robot == 'robot_b'
+        assert spin_until(executor, lambda: state(1)['robot'] == 'robot_b')
+        assert state(2)['robot'] == 'robot_a'
+        node.submit(p.SelectRobot('ghost'), owner=2)  # not running: refused
+        node.submit(p.Drive(0.1, 0.0), owner=1)
+        node.submit(p.Drive(0.2, 0.0), owner=2)
+        assert spin_until(executor, lambda: twists['a'] and twists['b'])
+        assert twists['b'][0].twist.linear.x == pytest.approx(0.1)
+        assert twists['a'][0].twist.linear.x == pytest.approx(0.2)
+        assert state(2)['robot'] == 'robot_a'
+        # Each robot's eyes for the page that watches it.
+        assert spin_until(executor, lambda: node.count_subscribers(b.eye_compressed('caml')) == 1
+                          and node.count_subscribers(a.eye_compressed('caml')) == 1)
+        node.release(2)
+        assert spin_until(executor, lambda: node.count_subscribers(a.eye_compressed('caml')) == 0)
+        # A tone robot_b is asked for is heard in the page that watches it, only.
+        tones = probe.publisher(UInt16MultiArray, b.tone)
+        assert spin_until(executor, lambda: tones.get_subscription_count() == 1)
+        tones.publish(UInt16MultiArray(data=[440, 90, 7]))
+        assert spin_until(executor, lambda: events)
+        assert events == [([1], {'t': 'tone', 'hz': 440, 'volume': 90, 'ticks': 7})]
     finally:
         executor.remove_node(node)
         node.destroy_node()
+
+
+def test_the_state_says_the_eyes_field_of_view_and_no_simulator(bridge, ros_context, executor):
+    opened(bridge, executor)
+    state = json.loads(bridge.state(1))
+    assert state['t'] == 'state' and state['robot'] == T.name
+    assert state['sim']['present'] is False and state['readouts'] == {}
+    assert state['eye_fov_deg'] is None and state['rtf_set'] is None
+    probe = Probe(ros_context, executor)
+    info = CameraInfo(**CameraModel(640, 360, lens='miro').camera_info_fields())
+    # Read while the eye is shown (a page shows both eyes until it says otherwise).
+    publisher = probe.publisher(CameraInfo, T.camera_info(EYES[0]))
+    assert spin_until(executor, lambda: publisher.get_subscription_count())
+    publisher.publish(info)
+    assert spin_until(executor, lambda: json.loads(bridge.state(1))['eye_fov_deg'])
+    assert json.loads(bridge.state(1))['eye_fov_deg'] == pytest.approx([121.2, 63.6], abs=0.1)
+
+
+def test_the_real_time_factor_is_set_on_the_simulator_and_read_back(
+        bridge, ros_context, executor):
+    opened(bridge, executor)
+    sim = Probe(ros_context, executor, name='fake_sim')
+    asked = []
+
+    def set_parameters(request, response):
+        asked.append(request.parameters[0])
+        response.results = [SetParametersResult(successful=True)]
+        return response
+
+    def get_parameters(request, response):
+        response.values = [ParameterValue(type=ParameterType.PARAMETER_DOUBLE,
+                                          double_value=1.0)]
+        return response
+
+    sim.node.create_service(SetParameters, SIM.topic('set_parameters'), set_parameters)
+    sim.node.create_service(GetParameters, SIM.topic('get_parameters'), get_parameters)
+    assert spin_until(executor, lambda: json.loads(bridge.state(1))['rtf_set'] == 1.0)
+    assert spin_until(executor, lambda: bridge.sim_clients['set_parameters'].service_is_ready())
+    bridge.submit(p.SetRtf(0.0), owner=1)
+    assert spin_until(executor, lambda: json.loads(bridge.state(1))['rtf_set'] == 0.0)
+    assert asked[0].name == 'real_time_factor'
+    assert asked[0].value.type == ParameterType.PARAMETER_DOUBLE
+
+
+def test_the_scene_is_followed_only_while_a_page_shows_the_world(
+        bridge, ros_context, executor):
+    probe = Probe(ros_context, executor)
+    probe.publisher(Odometry, T.odom)  # the robot runs
+    latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    scene = probe.node.create_publisher(MarkerArray, SIM.scene, latched)
+    ball = Marker(ns=BALL_NAME, id=0, type=Marker.SPHERE, action=Marker.ADD)
+    ball.header.frame_id = 'world'
+    ball.pose.orientation.w = 1.0
+    scene.publish(MarkerArray(markers=[ball]))  # before anyone listens: kept for them
+    links = probe.publisher(PoseArray, SIM.links(T.name))
+    assert spin_until(executor, lambda: bridge.robots == [T.name])
+    opened(bridge, executor)
+    assert bridge.count_subscribers(SIM.scene) == 0 and bridge.count_subscribers(
+        SIM.links(T.name)) == 0
+    bridge.submit(p.View(frozenset(EYES), True), owner=1)
+    assert spin_until(executor, lambda: json.loads(bridge.scene_message(None)[0])['markers'])
+    assert json.loads(bridge.scene_message(None)[0])['markers'][0]['id'] == f'{BALL_NAME}/0'
+    assert spin_until(executor, lambda: links.get_subscription_count() == 1)
+    poses = PoseArray()
+    poses.header.frame_id = 'world'
+    poses.poses = [ball.pose] * len(LINK_FRAMES)
+    links.publish(poses)
+    assert spin_until(executor, lambda: bridge.tf_message(None)[0])
+    assert f'{T.name}/head' in json.loads(bridge.tf_message(None)[0])['frames']
+    bridge.submit(p.View(frozenset(EYES), False), owner=1)
+    assert spin_until(executor, lambda: bridge.count_subscribers(SIM.scene) == 0
+                      and bridge.count_subscribers(SIM.links(T.name)) == 0)

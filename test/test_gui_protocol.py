@@ -1,16 +1,24 @@
-"""The GUI's message checks and readout units, without ROS or a browser."""
+"""The GUI's message checks, readout units and web server, without ROS or a browser."""
+import asyncio
+import contextlib
 import json
 import math
 import random
+import time
+import types
 
+import aiohttp
 import pytest
 
 from miro_ball.gui import protocol as p
 from miro_ball.gui import readouts as r
-from miro_ball.gui.server import is_loopback, origin_allowed
+from miro_ball.gui import server as web_server
+from miro_ball.gui.scene import SceneState
+from miro_ball.gui.server import GuiServer, is_loopback, listen, origin_allowed, serve, url
+from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import (DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       TILT_RAD, WHEEL_MAX_SPEED_M_PER_S)
-from miro_ball.miro.interface import RobotTopics, SimTopics, robots_in
+from miro_ball.miro.interface import BALL_NAME, RobotTopics, SimTopics, robots_in
 from miro_ball.miro.kinematics import cmd_vel2wheel_speed
 
 
@@ -58,6 +66,19 @@ def test_the_other_controls():
     assert parse({'t': 'stop'})[0] == p.Stop()
 
 
+def test_the_world_views_messages():
+    assert parse({'t': 'view', 'channels': ['caml', 'overhead'], 'world': True})[0] == \
+        p.View(frozenset({'caml', 'overhead'}), True)
+    assert parse({'t': 'view', 'channels': [], 'world': False})[0] == p.View(frozenset(), False)
+    assert parse({'t': 'place', 'name': BALL_NAME, 'x': 1, 'y': -0.5})[0] == \
+        p.Place(BALL_NAME, 1.0, -0.5)
+    assert parse({'t': 'place', 'name': BALL_NAME, 'x': 1e9, 'y': 0})[0].x == p.MAX_PLACE_M
+    assert parse({'t': 'touch', 'part': 'head', 'u': 0.25, 'v': 1.5}) == \
+        (p.Touch('head', 0.25, 1.0), ['v'])
+    assert parse({'t': 'rtf', 'value': 0})[0] == p.SetRtf(0.0)
+    assert parse({'t': 'rtf', 'value': 5000})[0] == p.SetRtf(p.MAX_RTF)
+
+
 @pytest.mark.parametrize('text', [
     'not json', '[]', '"drive"', 'null', '{}', '{"t": "launch_missiles"}',
     '{"t": "drive", "linear": "fast", "angular": 0}',
@@ -76,7 +97,23 @@ def test_the_other_controls():
     '{"t": "robot", "name": "../etc"}',
     '{"t": "ack", "ch": 99}',
     '[' * 100000,
-    'x' * (p.MAX_TEXT_CHARS + 1),
+    'x' * (p.MAX_TEXT_BYTES + 1),
+    # Found by a held-out attack: each dropped the page's connection with a traceback.
+    '{"t": []}', '{"t": {}}', '{"t": 5}', '{"t": null}',
+    '{"t": "drive", "linear": ' + '9' * 400 + ', "angular": 0}',
+    '{"t": "illum", "leds": [' + '1' * 400 + ', 0, 0, 0, 0, 0]}',
+    '{"t": "ack", "ch": -' + '9' * 400 + '}',
+    '{"t": "drive", "linear": ' + '9' * 5000 + ', "angular": 0}',  # beyond int()'s digits
+    '{"t": "robot", "name": "' + '\u00e9' * 3000 + '"}',  # 3,000 characters, 6 KB
+    '{"t": "view", "channels": ["caml", "eyes"], "world": true}',
+    '{"t": "view", "channels": "caml", "world": true}',
+    '{"t": "view", "channels": [["caml"]], "world": true}',
+    '{"t": "view", "channels": [], "world": 1}',
+    '{"t": "place", "name": "ball", "x": 0}',
+    '{"t": "place", "name": "../ball", "x": 0, "y": 0}',
+    '{"t": "touch", "part": "tail", "u": 0, "v": 0}',
+    '{"t": "touch", "part": ["head"], "u": 0, "v": 0}',
+    '{"t": "rtf", "value": NaN}',
 ])
 def test_malformed_messages_are_rejected_with_a_one_line_reason(text):
     with pytest.raises(p.Rejected) as err:
@@ -87,10 +124,11 @@ def test_malformed_messages_are_rejected_with_a_one_line_reason(text):
 def test_any_garbage_is_rejected_or_gives_values_within_miros_ranges():
     rng = random.Random(8)
     atoms = [0, 1, -1, 0.5, 1e308, -1e308, 1e-320, 'x', None, True, [], {}, [1] * 6,
-             2 ** 64, -(2 ** 64)]
-    for _ in range(3000):
-        kind = rng.choice(list(p.KINDS) + ['bogus'])
-        keys = list(p.KINDS.get(kind, ((), None))[0]) + ['t', 'junk']
+             2 ** 64, -(2 ** 64), 10 ** 400, -(10 ** 400), 'head', 'caml', ['caml'], BALL_NAME]
+    for _ in range(5000):
+        kind = rng.choice(list(p.KINDS) + ['bogus', [], {}, 3, None])
+        keys = list(p.KINDS.get(kind, ((), None))[0]) if isinstance(kind, str) else []
+        keys += ['t', 'junk']
         message = {key: rng.choice(atoms) for key in rng.sample(keys, rng.randint(0, len(keys)))}
         message['t'] = kind
         try:
@@ -117,6 +155,21 @@ def test_the_page_gets_miros_ranges_from_the_constants():
     config = p.page_config()
     assert config['head']['lift'] == [8.0, 60.0] and config['max_linear'] == 0.4
     assert json.loads(json.dumps(config))['channels'][0] == 'caml'
+    assert config['touch'] == {'rows': 2, 'columns': 7}
+    assert config['battery_marks'] == [4.6, 4.8]  # the MDK GUI's low and high
+
+
+def test_a_tone_goes_to_the_page_as_the_mdk_says_it():
+    assert json.loads(p.tone_message([440, 100, 50])) == \
+        {'t': 'tone', 'hz': 440, 'volume': 100, 'ticks': 50}
+
+
+@pytest.mark.parametrize('lens, expected', [('pinhole', (120.0, 88.5)), ('miro', (121.2, 63.6))])
+def test_the_eyes_field_of_view_is_read_from_camera_info(lens, expected):
+    camera = CameraModel(640, 360, lens=lens)
+    info = types.SimpleNamespace(**camera.camera_info_fields())
+    assert r.eye_fov_deg(CameraModel.from_camera_info(info)) == \
+        pytest.approx(expected, abs=0.1)
 
 
 def test_readouts_in_the_mdk_guis_units():
@@ -159,3 +212,170 @@ def test_robots_are_found_by_their_odometry_topic():
              SimTopics().object_pose('ball'), '/clock', '/x/y/sensors/odom', '/9x/sensors/odom',
              '/sensors/odom', 'miro/sensors/odom']
     assert robots_in(graph) == ['a1', 'miro02']
+
+
+# -- the web server, on a real socket, with a stand-in for the bridge ---------------------------
+class FakeBridge:
+    """What the web server asks of the bridge, recorded."""
+
+    def __init__(self):
+        self.commands = []
+        self.scene = SceneState()
+
+    def open(self, owner):
+        self.commands.append(('open', owner))
+
+    def submit(self, command, owner):
+        self.commands.append((command, owner))
+
+    def release(self, owner):
+        self.commands.append(('release', owner))
+
+    def frames(self, owner):
+        return {}
+
+    def state(self, owner):
+        return json.dumps({'t': 'state', 'robot': None})
+
+    def scene_message(self, since):
+        return self.scene.scene_message(since), self.scene.seq
+
+    def tf_message(self, since):
+        return self.scene.tf_message(since), self.scene.seq
+
+    def texture(self, key):
+        return self.scene.textures.get(key)
+
+    def got(self, kind):
+        return [command for command, _ in self.commands if isinstance(command, kind)]
+
+
+@contextlib.asynccontextmanager
+async def web_gui(bridge):
+    """(server, its URL, the warnings it gave) while it serves on a free port."""
+    warnings = []
+    server = GuiServer(bridge, log=lambda line: None, warn=warnings.append)
+    sock = listen('127.0.0.1', 0)
+    stop = types.SimpleNamespace(requested=False)
+    serving = asyncio.create_task(serve(server, sock, stop))
+    try:
+        yield server, url(sock), warnings
+    finally:
+        stop.requested = True
+        await serving
+
+
+async def until(predicate, timeout_s=5.0):
+    """Let the server work until predicate() holds (the limit only guards against a hang)."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        assert time.monotonic() < deadline, 'timed out'
+        await asyncio.sleep(0.005)
+
+
+async def next_of_kind(ws, kind, timeout_s=5.0):
+    deadline = time.monotonic() + timeout_s
+    while True:
+        msg = await ws.receive(timeout=max(0.01, deadline - time.monotonic()))
+        if msg.type == aiohttp.WSMsgType.TEXT and json.loads(msg.data).get('t') == kind:
+            return json.loads(msg.data)
+        assert msg.type in (aiohttp.WSMsgType.TEXT, aiohttp.WSMsgType.BINARY), msg
+
+
+def test_bad_messages_are_ignored_and_the_page_stays_connected():
+    async def run():
+        bridge = FakeBridge()
+        async with web_gui(bridge) as (server, address, warnings), \
+                aiohttp.ClientSession() as session, \
+                session.ws_connect(address + 'ws') as ws:
+            assert (await next_of_kind(ws, 'config'))['t'] == 'config'
+            for text in ('{"t": []}', '{"t": "drive", "linear": ' + '9' * 400 + ', "angular": 0}',
+                         '{"t": "robot", "name": "' + '\U0001F600' * 3000 + '"}'):
+                await ws.send_str(text)
+            await ws.send_str('{"t": "stop"}')
+            await until(lambda: bridge.got(p.Stop))
+            assert not ws.closed and bridge.commands[0] == ('open', 1)
+            assert len(bridge.commands) == 2  # nothing of the bad ones reached the bridge
+            assert len(warnings) == 1 and 'ignored' in warnings[0]  # throttled: one line
+    asyncio.run(run())
+
+
+def test_bad_http_requests_cost_one_warning_and_no_traceback(capfd, caplog):
+    bad = (b'GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nno colon in this header\r\n\r\n',
+           b'GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX: ' + b'a' * 20000 + b'\r\n\r\n',
+           b'GET /\x00 HTTP/1.1\r\n\r\n', b'GET / HTTP/9.9\r\n\r\n')
+
+    async def bad_request(address, i):
+        host, port = address.split('//')[1].strip('/').split(':')
+        reader, writer = await asyncio.open_connection(host, int(port))
+        writer.write(bad[i % len(bad)])
+        await writer.drain()
+        answer = await reader.read()
+        writer.close()
+        return answer
+
+    async def run():
+        async with web_gui(FakeBridge()) as (server, address, warnings):
+            answers = [await bad_request(address, i) for i in range(100)]
+            return answers, warnings
+
+    with caplog.at_level('DEBUG'):
+        answers, warnings = asyncio.run(run())
+    assert all(answer.split(b' ')[1] == b'400' for answer in answers)
+    assert len(warnings) == 1 and 'Traceback' not in warnings[0] and '\n' not in warnings[0]
+    out, err = capfd.readouterr()
+    assert 'Traceback' not in out + err and 'Error handling request' not in out + err
+    assert not [rec for rec in caplog.records if rec.levelname in ('WARNING', 'ERROR')]
+
+
+def test_a_drag_reaches_the_simulator_at_most_30_times_a_second_the_newest_last():
+    async def run():
+        bridge = FakeBridge()
+        async with web_gui(bridge) as (server, address, warnings), \
+                aiohttp.ClientSession() as session, \
+                session.ws_connect(address + 'ws') as ws:
+            start = time.monotonic()
+            for i in range(200):  # as fast as a mouse could never move
+                await ws.send_str(json.dumps({'t': 'place', 'name': BALL_NAME, 'x': i * 0.01,
+                                              'y': 0.0}))
+            await until(lambda: bridge.got(p.Place) and bridge.got(p.Place)[-1].x == 1.99)
+            return bridge.got(p.Place), time.monotonic() - start
+
+    places, elapsed = asyncio.run(run())
+    assert len(places) <= 2 + elapsed * web_server.PLACE_RATE_HZ
+    assert places[0].x == 0.0 and places[-1] == p.Place(BALL_NAME, 1.99, 0.0)
+
+
+def test_a_page_that_shows_the_world_gets_it_whole_then_what_moved_and_its_pictures():
+    from test_gui_scene import Warnings, links, marker, picture  # the scene's own builders
+
+    async def run():
+        bridge = FakeBridge()
+        warn = Warnings()
+        bridge.scene.apply_markers([marker('ball'), marker('wall', 1), picture('logo')], warn)
+        bridge.scene.apply_links('miro02', links(), warn)
+        async with web_gui(bridge) as (server, address, warnings), \
+                aiohttp.ClientSession() as session, \
+                session.ws_connect(address + 'ws') as ws:
+            await ws.send_str(json.dumps({'t': 'view', 'channels': [], 'world': True}))
+            whole = await next_of_kind(ws, 'scene')
+            frames = await next_of_kind(ws, 'tf')
+            bridge.scene.apply_markers([marker('ball', xyz=(0.0, 0.0, 0.05))], warn)
+            moved = await next_of_kind(ws, 'scene')
+            async with session.get(address + 'texture/logo.png') as response:
+                png = (response.status, response.content_type, await response.read())
+            missing = []
+            for path in ('texture/nothing.png', 'texture/..%2Fserver.py', 'texture/logo'):
+                async with session.get(address + path) as response:
+                    missing.append(response.status)
+            server.event([1], p.tone_message([440, 100, 5]))
+            tone = await next_of_kind(ws, 'tone')
+            return whole, frames, moved, png, missing, tone
+
+    whole, frames, moved, png, missing, tone = asyncio.run(run())
+    assert {m['id'] for m in whole['markers']} == {'ball/0', 'wall/1', 'picture/3'}
+    assert len(frames['frames']) == len(links().poses)
+    assert [m['id'] for m in moved['markers']] == ['ball/0'] and moved['removed'] == []
+    assert png[:2] == (200, 'image/png') and png[2].startswith(b'\x89PNG')
+    assert missing == [404, 404, 404]
+    assert tone == {'t': 'tone', 'hz': 440, 'volume': 100, 'ticks': 5}

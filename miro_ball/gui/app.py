@@ -20,18 +20,21 @@ PROG = 'miro_gui'
 def parse_args(argv):
     parser = argparse.ArgumentParser(
         prog=PROG,
-        description="See and drive MiRo in a web browser: both eyes, every sensor in the MDK "
-                    "GUI's units, driving (arrow keys / WASD), head, tail, ears, eyelids, LEDs, "
-                    "tone, the cliff reflex, and the simulator's pause / step / reset. It "
-                    "publishes only MiRo's control topics and prints the URL to open.")
+        description="See and drive MiRo in a web browser: its world in 3D (drag objects, "
+                    "stroke MiRo), both eyes, every sensor in the MDK GUI's units, driving "
+                    "(arrow keys / WASD), head, tail, ears, eyelids, LEDs, tone, the cliff "
+                    "reflex, and the simulator's pause / step / reset / speed. It publishes "
+                    "only MiRo's control topics and the simulator's inputs, and prints the URL "
+                    "to open.")
     parser.add_argument('--host', default=DEFAULT_HOST,
                         help=f'address to listen on ({DEFAULT_HOST}); anything but loopback '
                              'lets other machines drive the robot')
     parser.add_argument('--port', type=int, default=DEFAULT_PORT,
                         help=f'port ({DEFAULT_PORT}); 0 = any free port')
     parser.add_argument('--robot', metavar='NAME',
-                        help='the MiRo to show (default: $MIRO_ROBOT_NAME if running, else the '
-                             'first found; the page has a picker when several run)')
+                        help='the MiRo every page shows (default: a page starts with '
+                             '$MIRO_ROBOT_NAME if running, else the first found, and has a picker '
+                             'when several run; each page picks its own)')
     args = parser.parse_args(argv)
     if not 0 <= args.port <= 65535:
         parser.error(f'--port must be in 0..65535, got {args.port}')
@@ -66,6 +69,7 @@ def main(argv=None):
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     server = None
     bridge = GuiBridge(args.robot, on_frame=lambda channel: server.frame_arrived(channel),
+                       on_event=lambda owners, text: server.event(owners, text),
                        default_robot=default)
     log = bridge.get_logger()
     server = GuiServer(bridge, loopback_only=is_loopback(args.host), log=log.info,

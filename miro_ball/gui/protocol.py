@@ -5,9 +5,9 @@ it into a command with every value checked and clamped to what MiRo accepts (the
 simulator's own clamps), or raises Rejected saying why in one line. Nothing here
 knows about ROS or the web server, so it is tested on its own.
 
-Server -> page: JSON text for the readouts, and images as binary messages: a
-FRAME_HEADER (channel number, stamp in seconds) followed by the JPEG bytes as the
-robot sent them (the browser decodes them; the server never does).
+Server -> page: JSON text for the readouts, the scene and the tones, and images as
+binary messages: a FRAME_HEADER (channel number, stamp in seconds) followed by the
+JPEG bytes as the robot sent them (the browser decodes them; the server never does).
 """
 import json
 import math
@@ -17,15 +17,16 @@ from dataclasses import dataclass
 from miro_ball.miro.constants import (COSMETIC_CALIB, DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX,
                                       JOINT_LIMITS_RAD, LIFT, LIFT_RAD_CALIB, PITCH,
                                       PLATFORM_TICK_S, TILT_RAD, WHEEL_MAX_SPEED_M_PER_S, YAW)
-from miro_ball.miro.interface import check_name
+from miro_ball.miro.interface import TOUCH_PARTS, check_name
 from miro_ball.miro.kinematics import (clamp_wheel_speeds, cmd_vel2wheel_speed,
                                        wheel_speed2cmd_vel)
+from miro_ball.miro.touch import TOUCH_COLUMNS, TOUCH_ROWS
 
 # Image channels, in the order of their numbers on the wire.
 CHANNELS = ('caml', 'camr', 'overhead', 'debug_caml', 'debug_camr')
 FRAME_HEADER = struct.Struct('<Bd')  # channel, stamp (s); then the JPEG
 MAX_FRAME_BYTES = 4 << 20  # a 1280x720 eye at quality 100 is well under 1 MB
-MAX_TEXT_CHARS = 4096  # the page's longest command is a few hundred characters
+MAX_TEXT_BYTES = 4096  # UTF-8; the page's longest command is a few hundred characters
 
 # The MDK GUI's slider ranges where MiRo itself has no tighter limit.
 MAX_TURN_RAD_S = 5.0
@@ -34,6 +35,9 @@ TONE_VOLUME = (1, 255)
 TONE_TICKS = (1, 255)
 ARGB_MAX = 0xFFFFFFFF
 SIM_ACTIONS = ('pause', 'resume', 'step', 'reset')
+MAX_RTF = 1000.0  # the simulator's own range of real_time_factor
+MAX_PLACE_M = 100.0  # farther than any world reaches: the simulator says if it is off its floor
+BATTERY_MARKS_V = (4.6, 4.8)  # the MDK GUI's battery bar: low, high
 
 
 class Rejected(ValueError):
@@ -91,16 +95,50 @@ class Ack:
     channel: int  # the page has drawn the last frame of this channel
 
 
+@dataclass(frozen=True)
+class View:
+    channels: frozenset  # names of the image channels the page shows now
+    world: bool  # the page shows the world view (the scene and the frames)
+
+
+@dataclass(frozen=True)
+class Place:
+    name: str  # an object or robot of the simulator
+    x: float  # m, world frame; height and orientation stay as they are
+    y: float
+
+
+@dataclass(frozen=True)
+class Touch:
+    part: str  # 'head' or 'body'
+    u: float  # 0 front .. 1 back
+    v: float  # 0 left .. 1 right
+
+
+@dataclass(frozen=True)
+class SetRtf:
+    value: float  # the simulator's real_time_factor; 0 = as fast as possible
+
+
 def _reject_constant(name):
     raise Rejected(f'{name} is not a number')
+
+
+def _show(value):
+    """A value from the page in a warning: its type and the start of it, on one line."""
+    return f'{type(value).__name__} {repr(value)[:40]}'
 
 
 def _number(msg, key, lo, hi, clamped):
     value = msg.get(key)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise Rejected(f'{key} must be a number, got {value!r:.40}')
-    if not math.isfinite(value):
-        raise Rejected(f'{key} must be finite')
+        raise Rejected(f'{key} must be a number, got {_show(value)}')
+    try:
+        finite = math.isfinite(value)  # an integer of 400 digits is no float: OverflowError
+    except OverflowError:
+        finite = False
+    if not finite:
+        raise Rejected(f'{key} must be a finite number')
     if not lo <= value <= hi:
         clamped.append(key)
         value = min(max(value, lo), hi)
@@ -174,6 +212,34 @@ def _ack(msg, clamped):
     return Ack(channel)
 
 
+def _view(msg, clamped):
+    channels = msg.get('channels')
+    if not isinstance(channels, list) or len(channels) > 2 * len(CHANNELS) or \
+            not all(isinstance(c, str) and c in CHANNELS for c in channels):
+        raise Rejected(f'channels must be a list of names from {", ".join(CHANNELS)}')
+    world = msg.get('world')
+    if not isinstance(world, bool):
+        raise Rejected('world must be true or false')
+    return View(frozenset(channels), world)
+
+
+def _place(msg, clamped):
+    try:
+        name = check_name(msg.get('name'), 'object name')
+    except ValueError as err:
+        raise Rejected(str(err)) from None
+    return Place(name, float(_number(msg, 'x', -MAX_PLACE_M, MAX_PLACE_M, clamped)),
+                 float(_number(msg, 'y', -MAX_PLACE_M, MAX_PLACE_M, clamped)))
+
+
+def _touch(msg, clamped):
+    part = msg.get('part')
+    if not isinstance(part, str) or part not in TOUCH_PARTS:
+        raise Rejected(f'part must be one of {", ".join(TOUCH_PARTS)}')
+    return Touch(part, float(_number(msg, 'u', 0.0, 1.0, clamped)),
+                 float(_number(msg, 'v', 0.0, 1.0, clamped)))
+
+
 # kind: (the keys it takes besides "t", builder)
 KINDS = {
     'drive': (('linear', 'angular'), _drive),
@@ -189,6 +255,11 @@ KINDS = {
     'sim': (('action',), _sim),
     'robot': (('name',), _robot),
     'ack': (('ch',), _ack),
+    'view': (('channels', 'world'), _view),
+    'place': (('name', 'x', 'y'), _place),
+    'touch': (('part', 'u', 'v'), _touch),
+    'rtf': (('value',), lambda msg, clamped: SetRtf(
+        float(_number(msg, 'value', 0.0, MAX_RTF, clamped)))),
 }
 
 
@@ -196,17 +267,20 @@ def parse(text):
     """(command, names of the values that were clamped) of one text message, or Rejected."""
     if not isinstance(text, str):
         raise Rejected('not a text message')
-    if len(text) > MAX_TEXT_CHARS:
-        raise Rejected(f'message of {len(text)} characters (at most {MAX_TEXT_CHARS})')
+    # A character is 1 to 4 bytes: count the bytes (a lone surrogate counts as 3).
+    size = len(text) if len(text) > MAX_TEXT_BYTES else \
+        len(text.encode('utf-8', 'surrogatepass'))
+    if size > MAX_TEXT_BYTES:
+        raise Rejected(f'message of more than {MAX_TEXT_BYTES} bytes')
     try:
         msg = json.loads(text, parse_constant=_reject_constant)
-    except (ValueError, RecursionError):
+    except (ValueError, RecursionError):  # digits beyond int's limit are a ValueError too
         raise Rejected('not JSON') from None
     if not isinstance(msg, dict):
         raise Rejected('not a JSON object')
     kind = msg.get('t')
-    if kind not in KINDS:
-        raise Rejected(f'unknown message kind {kind!r:.40}')
+    if not isinstance(kind, str) or kind not in KINDS:  # a list is not even hashable
+        raise Rejected(f'unknown message kind {_show(kind)}')
     keys, build = KINDS[kind]
     extra = set(msg) - set(keys) - {'t'}
     if extra:
@@ -226,9 +300,17 @@ def page_config():
             'head_calib': {'lift': math.degrees(LIFT_RAD_CALIB), 'yaw': 0.0, 'pitch': 0.0},
             'cosmetic_calib': COSMETIC_CALIB,
             'tone': {'hz': TONE_HZ, 'volume': TONE_VOLUME, 'ticks': TONE_TICKS},
-            'tick_s': PLATFORM_TICK_S}
+            'tick_s': PLATFORM_TICK_S,
+            'touch': {'rows': TOUCH_ROWS, 'columns': TOUCH_COLUMNS},
+            'battery_marks': list(BATTERY_MARKS_V)}
 
 
 def frame_message(channel, stamp, jpeg):
     """The binary WebSocket message of one image."""
     return FRAME_HEADER.pack(channel, stamp) + jpeg
+
+
+def tone_message(values):
+    """The page plays what its robot was asked to play: [hz, volume, ticks] of control/tone."""
+    hz, volume, ticks = values
+    return json.dumps({'t': 'tone', 'hz': hz, 'volume': volume, 'ticks': ticks})

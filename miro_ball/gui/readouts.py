@@ -67,3 +67,14 @@ def jsonable(value):
     if isinstance(value, str) or value is None or isinstance(value, bool):
         return value
     return finite_or_none(value)
+
+
+def eye_fov_deg(camera):
+    """[horizontal, vertical] field of view (deg) of a camera_model.CameraModel, edge to edge
+    through the image's centre lines (the lens included), for drawing what an eye sees."""
+    w, h = camera.width, camera.height
+    cu, cv = (w - 1) / 2.0, (h - 1) / 2.0
+    x, y, z = camera.pixel_to_ray([-0.5, w - 0.5, cu, cu], [cv, cv, -0.5, h - 0.5]).T
+    across = math.atan2(y[0], x[0]) - math.atan2(y[1], x[1])  # y is left
+    up = math.atan2(z[2], x[2]) - math.atan2(z[3], x[3])  # z is up
+    return [round(math.degrees(across), 3), round(math.degrees(up), 3)]

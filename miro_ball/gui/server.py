@@ -1,16 +1,22 @@
 """The GUI's web side (aiohttp): the page's files, and one WebSocket per page.
 
-Each page gets the newest frame of each image channel, one at a time: the next
-frame of a channel goes out only when the page says it has drawn the last one
-(or after ACK_TIMEOUT_S), so a slow page gets fewer frames, never older ones,
-and nothing queues up. Readouts go out at the bridge's rate. The page's commands
-come in on the same socket, in the other direction, so they never wait behind
-images; each is checked (protocol.py) and handed to the bridge.
+Each page gets the newest frame of each image channel of its robot, one at a time:
+the next frame of a channel goes out only when the page says it has drawn the last
+one (or after ACK_TIMEOUT_S), so a slow page gets fewer frames, never older ones,
+and nothing queues up. Readouts go out at the bridge's rate; while the page shows
+the world view, the scene's and the link frames' changes at most WORLD_RATE_HZ (the
+whole of them when it turns the view on); the pictures' PNGs are fetched at
+/texture/<key>.png. The page's commands come in on the same socket, in the other
+direction, so they never wait behind images; each is checked (protocol.py) and
+handed to the bridge; a drag's places at most PLACE_RATE_HZ, the newest winning.
 """
 import asyncio
+import collections
 import ipaddress
 import itertools
 import json
+import logging
+import re
 import socket
 import time
 from pathlib import Path
@@ -24,6 +30,10 @@ from miro_ball.gui import protocol
 STATIC = Path(__file__).parent / 'static'
 ACK_TIMEOUT_S = 1.0  # a frame the page never acknowledged does not block its channel
 STATE_PERIOD_S = 0.05
+WORLD_RATE_HZ = 30.0  # scene and frame changes to a page
+PLACE_RATE_HZ = 30.0  # a dragged object's places to the simulator, per page
+OUTBOX_LENGTH = 50  # events (tones) waiting for a slow page; the oldest go first
+TEXTURE_PATH = re.compile(r'([A-Za-z0-9_][A-Za-z0-9_.-]{0,99})\.png\Z')
 MAX_MESSAGE_BYTES = 1 << 20  # beyond this aiohttp closes that socket; below, parse() refuses
 LOOPBACK_NAMES = ('localhost',)
 HEADERS = {
@@ -73,6 +83,34 @@ class Page:
         self.sent = {}  # channel: seq of the last frame sent
         self.in_flight = {}  # channel: when the unacknowledged frame went out
         self.state_sent = 0.0
+        self.outbox = collections.deque(maxlen=OUTBOX_LENGTH)  # JSON texts
+        self.world = False  # it shows the world view
+        self.scene_seq = self.tf_seq = None  # what of the world it has (None: nothing)
+        self.world_sent = 0.0
+        self.place = None  # the newest place of a drag not yet forwarded
+        self.place_sent = 0.0
+        self.place_timer = None
+
+
+class _HttpLog(logging.Handler):
+    """aiohttp's word on a request it could not handle (a bad request line, a header too
+    long...): one throttled line without the traceback; the client got its error answer."""
+
+    def __init__(self, warn):
+        super().__init__(logging.INFO)  # its debug lines stay out
+        self.warn = warn
+
+    def emit(self, record):
+        exc = record.exc_info[1] if record.exc_info else None
+        why = f': {type(exc).__name__} {str(exc).strip()[:100]!r}' if exc else ''
+        self.warn('http', f'{record.getMessage()[:100]}{why}')
+
+
+def http_logger(warn):
+    """The logger the web server's connections report their errors to (see _HttpLog)."""
+    logger = logging.Logger('miro_gui.http')  # not in logging's tree: nothing propagates
+    logger.addHandler(_HttpLog(warn))
+    return logger
 
 
 class GuiServer:
@@ -86,8 +124,10 @@ class GuiServer:
         self.pages = {}
         self.numbers = itertools.count(1)
         self.loop = None
+        self.http_logger = http_logger(self.warn)
         self.app = web.Application(middlewares=[self._guard])
         self.app.add_routes([web.get('/', self._index), web.get('/ws', self._websocket),
+                             web.get('/texture/{name}', self._texture),
                              web.static('/static', STATIC)])
         self.app.on_startup.append(self._started)
         self.app.on_shutdown.append(self._closing)
@@ -110,6 +150,18 @@ class GuiServer:
         for page in self.pages.values():
             page.wake.set()
 
+    def event(self, owners, text):
+        """Called from the ROS thread: a JSON message for these pages (a tone)."""
+        if self.loop is not None:
+            self.loop.call_soon_threadsafe(self._deliver, owners, text)
+
+    def _deliver(self, owners, text):
+        for owner in owners:
+            page = self.pages.get(owner)
+            if page is not None:
+                page.outbox.append(text)
+                page.wake.set()
+
     async def _tick(self):
         while True:
             await asyncio.sleep(STATE_PERIOD_S)
@@ -128,6 +180,13 @@ class GuiServer:
     async def _index(self, request):
         return web.FileResponse(STATIC / 'index.html')
 
+    async def _texture(self, request):
+        match = TEXTURE_PATH.match(request.match_info['name'])
+        data = self.bridge.texture(match.group(1)) if match else None
+        if data is None:
+            raise web.HTTPNotFound(text='no such picture in the scene')
+        return web.Response(body=data, content_type='image/png')
+
     async def _websocket(self, request):
         origin = request.headers.get('Origin')
         if not origin_allowed(origin, request.host, self.loopback_only):
@@ -138,6 +197,7 @@ class GuiServer:
         await ws.prepare(request)
         page = Page(ws, next(self.numbers))
         self.pages[page.number] = page
+        self.bridge.open(page.number)
         self.log(f'page {page.number} connected from {request.remote} '
                  f'({len(self.pages)} open)')
         await ws.send_str(json.dumps(protocol.page_config()))
@@ -146,6 +206,8 @@ class GuiServer:
             await self._receive(page)
         finally:
             sender.cancel()
+            if page.place_timer is not None:
+                page.place_timer.cancel()
             del self.pages[page.number]
             self.bridge.release(page.number)
             self.log(f'page {page.number} closed ({len(self.pages)} open)')
@@ -161,14 +223,48 @@ class GuiServer:
             except protocol.Rejected as err:
                 self.warn(f'bad:{page.number}', f'page {page.number}: message ignored: {err}')
                 continue
+            except Exception as err:  # noqa: BLE001 -- a gap in the checks must not end the page
+                self.warn(f'bad:{page.number}', f'page {page.number}: message ignored: '
+                          f'{type(err).__name__} (please report)')
+                continue
             if clamped:
                 self.warn(f'clamp:{page.number}', f'page {page.number}: '
                           f'{", ".join(sorted(set(clamped)))} out of range: clamped')
-            if isinstance(command, protocol.Ack):
-                page.in_flight.pop(command.channel, None)
-                page.wake.set()
-            else:
-                self.bridge.submit(command, page.number)
+            self._take(page, command)
+
+    def _take(self, page, command):
+        if isinstance(command, protocol.Ack):
+            page.in_flight.pop(command.channel, None)
+            page.wake.set()
+            return
+        if isinstance(command, protocol.Place):
+            page.place = command
+            self._forward_place(page)
+            return
+        if isinstance(command, protocol.View):
+            if command.world and not page.world:
+                page.scene_seq = page.tf_seq = None  # the whole world first
+            page.world = command.world
+            page.wake.set()
+        self.bridge.submit(command, page.number)
+
+    def _forward_place(self, page):
+        """A drag sends places as fast as the mouse moves: forward the newest, at most
+        PLACE_RATE_HZ."""
+        if page.place is None or page.number not in self.pages:
+            return
+        wait = page.place_sent + 1.0 / PLACE_RATE_HZ - time.monotonic()
+        if wait > 0:
+            if page.place_timer is None:
+                page.place_timer = self.loop.call_later(wait, self._place_due, page)
+            return
+        page.place_sent = time.monotonic()
+        self.bridge.submit(page.place, page.number)
+        page.place = None
+
+    def _place_due(self, page):
+        page.place_timer = None
+        self._forward_place(page)
 
     async def _send(self, page):
         ws = page.ws
@@ -177,7 +273,7 @@ class GuiServer:
                 await page.wake.wait()
                 page.wake.clear()
                 now = time.monotonic()
-                for channel, frame in self.bridge.frames().items():
+                for channel, frame in self.bridge.frames(page.number).items():
                     sent_at = page.in_flight.get(channel)
                     if page.sent.get(channel) == frame.seq or (
                             sent_at is not None and now - sent_at < ACK_TIMEOUT_S):
@@ -185,11 +281,27 @@ class GuiServer:
                     page.sent[channel] = frame.seq
                     page.in_flight[channel] = now
                     await ws.send_bytes(protocol.frame_message(channel, frame.stamp, frame.jpeg))
+                while page.outbox:
+                    await ws.send_str(page.outbox.popleft())
+                if page.world and now - page.world_sent >= 0.9 / WORLD_RATE_HZ:
+                    await self._send_world(page, now)
                 if now - page.state_sent >= STATE_PERIOD_S * 0.9:
                     page.state_sent = now
-                    await ws.send_str(self.bridge.state())
+                    await ws.send_str(self.bridge.state(page.number))
         except (ConnectionError, RuntimeError):
             pass  # the page went away; _receive ends too
+
+    async def _send_world(self, page, now):
+        """The scene's and the frames' changes since the page last heard."""
+        scene, seq = self.bridge.scene_message(page.scene_seq)
+        if scene is not None:
+            await page.ws.send_str(scene)
+        page.scene_seq = seq
+        frames, seq = self.bridge.tf_message(page.tf_seq)
+        if frames is not None:
+            await page.ws.send_str(frames)
+        page.tf_seq = seq
+        page.world_sent = now
 
 
 def listen(host, port):
@@ -207,7 +319,8 @@ def url(sock):
 
 async def serve(server, sock, stop):
     """Serve on the socket until stop.requested."""
-    runner = web.AppRunner(server.app, handle_signals=False, access_log=None)
+    runner = web.AppRunner(server.app, handle_signals=False, access_log=None,
+                           logger=server.http_logger)
     await runner.setup()
     try:
         await web.SockSite(runner, sock).start()

@@ -1,0 +1,260 @@
+"""The world as the page draws it: the simulator's scene markers and frames, as JSON.
+
+The simulator publishes its world as visualization_msgs Markers (/miro_sim/scene), as
+RViz reads them, and where each robot's link frames are in the world as one PoseArray
+per robot (/miro_sim/links/<robot>, in the order of constants.LINK_FRAMES). The page gets
+the same in a form three.js takes at once: a marker becomes
+{"id": "<ns>/<id>", "ns", "frame", "kind", "p", "q", "scale", "colour", ...} and a
+frame {"<robot>/<link>": {"parent": "world", "p", "q"}}. SceneState keeps the newest of
+each with a sequence number, so each page is sent only what changed since it last heard,
+and a page that turns its world view on gets everything. Pictures' PNGs are kept here by key and
+served by the web server at TEXTURE_URL; the markers carry the URL, not the bytes.
+
+Nothing here needs ROS: messages are read by their fields, so tests build them freely.
+"""
+import json
+import math
+import re
+
+from miro_ball.miro.constants import LINK_FRAMES
+from miro_ball.miro.interface import WORLD_FRAME, frame_id
+
+# visualization_msgs/Marker's numbers (the message's own constants; checked in the test).
+CUBE, SPHERE, CYLINDER, CUBE_LIST, TRIANGLE_LIST = 1, 2, 3, 6, 11
+ADD, DELETE, DELETEALL = 0, 2, 3
+KIND = {CUBE: 'box', SPHERE: 'sphere', CYLINDER: 'cylinder', CUBE_LIST: 'cube_list',
+        TRIANGLE_LIST: 'picture'}
+
+TEXTURE_PREFIX = 'embedded://'
+TEXTURE_KEY = re.compile(r'[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}\Z')  # safe in a URL path
+TEXTURE_URL = '/texture/{key}.png'
+MAX_TEXTURE_BYTES = 8 << 20
+MAX_TEXTURES = 256
+MAX_POINTS = 20000  # a LED strip is a few points, a picture 6
+MAX_MARKERS = 10000
+MAX_FRAMES = 5000
+MAX_NAME = 256  # characters of a namespace or frame name
+MAX_REMOVED = 10000  # deletions remembered for pages that are behind
+# Rounding: a tenth of a millimetre and about 0.001 degree are beyond what a page can show,
+# and a number of six digits is a third of the bytes of Python's seventeen.
+DIGITS_POSITION, DIGITS_ROTATION, DIGITS_COLOUR = 4, 5, 3
+
+
+class SceneRejected(ValueError):
+    """A marker or transform the page cannot draw; the text says why, in one line."""
+
+
+def _finite(values, digits, what):
+    out = []
+    for value in values:
+        value = float(value)
+        if not math.isfinite(value):
+            raise SceneRejected(f'{what} is not finite')
+        out.append(round(value, digits))
+    return out
+
+
+def _name(value, what):
+    if not isinstance(value, str) or len(value) > MAX_NAME:
+        raise SceneRejected(f'{what} is not a name of at most {MAX_NAME} characters')
+    return value
+
+
+def _frame(value, what):
+    return _name(value, what).lstrip('/')  # tf2 names have no leading slash
+
+
+def _xyz(v, digits=DIGITS_POSITION, what='a point'):
+    return _finite((v.x, v.y, v.z), digits, what)
+
+
+def _quaternion(q):
+    x, y, z, w = _finite((q.x, q.y, q.z, q.w), 9, 'an orientation')
+    norm = math.sqrt(x * x + y * y + z * z + w * w)
+    if norm < 1e-9:  # RViz reads all zeros as "no rotation"
+        return [0.0, 0.0, 0.0, 1.0]
+    return [round(c / norm, DIGITS_ROTATION) for c in (x, y, z, w)]
+
+
+def _rgba(c):
+    return [min(max(v, 0.0), 1.0) for v in _finite((c.r, c.g, c.b, c.a), DIGITS_COLOUR,
+                                                     'a colour')]
+
+
+def marker_id(marker):
+    return f'{marker.ns}/{marker.id}'
+
+
+def texture_key(resource):
+    """The key of an 'embedded://<key>.png' texture, or SceneRejected."""
+    if not resource.startswith(TEXTURE_PREFIX) or not resource.endswith('.png'):
+        raise SceneRejected(f'texture {resource[:60]!r} is not {TEXTURE_PREFIX}<key>.png')
+    key = resource[len(TEXTURE_PREFIX):-len('.png')]
+    if not TEXTURE_KEY.match(key):
+        raise SceneRejected(f'texture key {key[:60]!r}: letters, digits, _ . - only')
+    return key
+
+
+def marker_json(marker):
+    """(the page's dict of one ADD marker, (texture key, PNG bytes) or None), or
+    SceneRejected."""
+    kind = KIND.get(marker.type)
+    if kind is None:
+        raise SceneRejected(f'marker type {marker.type} is not drawn (only '
+                            f'{", ".join(KIND.values())})')
+    pose = marker.pose
+    out = {'id': marker_id(marker), 'ns': _name(marker.ns, 'ns'),
+           'frame': _frame(marker.header.frame_id, 'frame_id'), 'kind': kind,
+           'p': _xyz(pose.position), 'q': _quaternion(pose.orientation),
+           'scale': _xyz(marker.scale, what='a scale'), 'colour': _rgba(marker.color)}
+    texture = None
+    if kind in ('cube_list', 'picture'):
+        if len(marker.points) > MAX_POINTS:
+            raise SceneRejected(f'{len(marker.points)} points (at most {MAX_POINTS})')
+        out['points'] = [_xyz(point) for point in marker.points]
+        if marker.colors:
+            if len(marker.colors) != len(marker.points):
+                raise SceneRejected(f'{len(marker.colors)} colours for '
+                                    f'{len(marker.points)} points')
+            out['colours'] = [_rgba(c) for c in marker.colors]
+    if kind == 'picture':
+        if len(marker.points) % 3:
+            raise SceneRejected(f'a triangle list of {len(marker.points)} points')
+        if marker.texture_resource:
+            if len(marker.uv_coordinates) != len(marker.points):
+                raise SceneRejected(f'{len(marker.uv_coordinates)} texture coordinates for '
+                                    f'{len(marker.points)} points')
+            out['uv'] = [_finite((c.u, c.v), 5, 'a texture coordinate')
+                         for c in marker.uv_coordinates]
+            key = texture_key(marker.texture_resource)
+            out['texture'] = TEXTURE_URL.format(key=key)
+            data = bytes(marker.texture.data)
+            if data:  # a marker may refer to a texture an earlier one carried
+                if 'png' not in marker.texture.format.lower() or \
+                        not data.startswith(b'\x89PNG\r\n\x1a\n'):
+                    raise SceneRejected(f'texture {key!r} is not a PNG')
+                if len(data) > MAX_TEXTURE_BYTES:
+                    raise SceneRejected(f'texture {key!r} of {len(data)} bytes')
+                texture = (key, data)
+    if marker.text:
+        out['link'] = _name(marker.text, 'text')
+    return out, texture
+
+
+def link_frames(robot, pose_array, names=LINK_FRAMES):
+    """[(frame "<robot>/<name>", {"parent", "p", "q"})] of the simulator's PoseArray of one
+    robot's link frames (in the order of ``names``), or SceneRejected."""
+    parent = _frame(pose_array.header.frame_id, 'frame_id') or WORLD_FRAME
+    poses = pose_array.poses
+    if len(poses) != len(names):
+        raise SceneRejected(f'{len(poses)} link poses of {robot}, not {len(names)}')
+    return [(frame_id(robot, name), {'parent': parent, 'p': _xyz(pose.position),
+                                     'q': _quaternion(pose.orientation)})
+            for name, pose in zip(names, poses)]
+
+
+class SceneState:
+    """The newest of every marker and transform, each with the sequence number of its last
+    change, so a page is sent what changed since the number it last got."""
+
+    def __init__(self):
+        self.seq = 0
+        self.markers = {}  # id: (seq, JSON text)
+        self.removed = {}  # id: seq of its removal
+        self.frames = {}  # child: (seq, JSON text of {"parent", "p", "q"})
+        self.textures = {}  # key: PNG bytes
+
+    def _next(self):
+        self.seq += 1
+        return self.seq
+
+    def apply_markers(self, markers, warn):
+        """Take a MarkerArray's markers; warn(key, text) about each one not drawn.
+        Returns how many changed."""
+        changed = 0
+        for marker in markers:
+            try:
+                changed += self._apply_marker(marker)
+            except SceneRejected as err:
+                warn(f'marker:{marker_id(marker)[:80]}',
+                     f'scene marker {marker_id(marker)[:80]!r} not drawn: {err}')
+            except (TypeError, ValueError, AttributeError) as err:  # garbage from the graph
+                warn('marker', f'a malformed scene marker ignored: {err}')
+        return changed
+
+    def _apply_marker(self, marker):
+        if marker.action == DELETEALL:
+            doomed = [i for i in self.markers if not marker.ns or i.startswith(marker.ns + '/')]
+            for i in doomed:
+                self._remove(i)
+            return len(doomed)
+        if marker.action == DELETE:
+            return self._remove(marker_id(marker))
+        if marker.action != ADD:  # ADD and MODIFY are one number
+            raise SceneRejected(f'action {marker.action} unknown')
+        out, texture = marker_json(marker)
+        if texture is not None:
+            key, data = texture
+            if key not in self.textures and len(self.textures) >= MAX_TEXTURES:
+                raise SceneRejected(f'more than {MAX_TEXTURES} textures')
+            self.textures[key] = data
+        text = json.dumps(out, separators=(',', ':'))
+        old = self.markers.get(out['id'])
+        if old is not None and old[1] == text:
+            return 0  # re-published unchanged: nothing to send
+        if old is None and len(self.markers) >= MAX_MARKERS:
+            raise SceneRejected(f'more than {MAX_MARKERS} markers')
+        self.markers[out['id']] = (self._next(), text)
+        self.removed.pop(out['id'], None)
+        return 1
+
+    def _remove(self, marker_id_):
+        if self.markers.pop(marker_id_, None) is None:
+            return 0
+        self.removed[marker_id_] = self._next()
+        if len(self.removed) > MAX_REMOVED:  # the oldest: a page that far behind is gone
+            del self.removed[next(iter(self.removed))]
+        return 1
+
+    def apply_links(self, robot, pose_array, warn):
+        """Take the PoseArray of one robot's link frames; returns how many frames changed."""
+        try:
+            frames = link_frames(robot, pose_array)
+        except SceneRejected as err:
+            warn(f'links:{robot}', f'the link frames of {robot} not shown: {err}')
+            return 0
+        except (TypeError, ValueError, AttributeError) as err:  # garbage from the graph
+            warn(f'links:{robot}', f'malformed link frames of {robot} ignored: {err}')
+            return 0
+        changed = 0
+        for child, out in frames:
+            text = json.dumps(out, separators=(',', ':'))
+            old = self.frames.get(child)
+            if old is not None and old[1] == text:
+                continue
+            if old is None and len(self.frames) >= MAX_FRAMES:
+                warn('frames', f'more than {MAX_FRAMES} frames: {child[:40]!r} not shown')
+                continue
+            self.frames[child] = (self._next(), text)
+            changed += 1
+        return changed
+
+    def scene_message(self, since):
+        """JSON text of {"t": "scene"} with the markers changed and removed after seq
+        ``since``, or None when nothing changed; since None: the whole scene."""
+        full = since is None
+        markers = [text for seq, text in self.markers.values() if full or seq > since]
+        removed = [] if full else [i for i, seq in self.removed.items() if seq > since]
+        if not (full or markers or removed):
+            return None
+        return ('{"t":"scene","markers":[' + ','.join(markers) + '],"removed":'
+                + json.dumps(removed) + '}')
+
+    def tf_message(self, since):
+        """JSON text of {"t": "tf"} with the frames changed after seq ``since`` (None: all),
+        or None when there are none."""
+        frames = [json.dumps(child) + ':' + text for child, (seq, text) in self.frames.items()
+                  if since is None or seq > since]
+        if not frames:
+            return None
+        return '{"t":"tf","frames":{' + ','.join(frames) + '}}'
