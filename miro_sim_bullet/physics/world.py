@@ -12,7 +12,8 @@ from miro_ball.miro.interface import default_robot_name
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.robot import MiroRobot
 from miro_sim_bullet.physics.sensors import GRAVITY
-from miro_sim_bullet.scene.world_file import BALL_NAME, MAX_ROBOTS, Shape, World, load_world
+from miro_sim_bullet.scene.world_file import (BALL_NAME, MAX_ROBOTS, PICTURE_UV, Shape, World,
+                                              load_world)
 
 # Collision groups. Bit 0 stays in every mask because Bullet's ray tests carry group 1.
 # Static bodies skip each other (a wall panel touching the floor is work for nothing);
@@ -30,6 +31,11 @@ ALL_GROUPS = (1 << (MAX_ROBOTS + 3)) - 1
 
 def robot_group(index):
     return 1 << (index + 3)
+
+
+def _table(shape):
+    """The world-file table an unnamed shape comes from: 'wall' for 'wall[2]'."""
+    return getattr(shape, 'source', shape.kind).split('[')[0] or shape.kind
 
 
 class SimWorld:
@@ -61,22 +67,29 @@ class SimWorld:
         pb.setGravity(0, 0, -GRAVITY, **kw)
         self.step_index = 0
         world = self.description
+        # body id -> (name or group, 'static' | 'mover' | 'robot'): what the scene calls it.
+        self.body_labels = {}
         if world.ground_height is not None:
-            self._shape(Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
-                              size=(*world.ground_size, 0.1), colour=world.ground_colour))
+            ground = self._shape(Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
+                                       size=(*world.ground_size, 0.1), colour=world.ground_colour))
+            self.body_labels[ground] = ('ground', 'static')
         self.objects = {}  # name -> body id of everything movable but the robots
         for shape in world.shapes:
             body = self._shape(shape)
             if shape.mass > 0:
                 self.objects[shape.name] = body
+                self.body_labels[body] = (shape.name, 'mover')
+            else:
+                self.body_labels[body] = (shape.name or _table(shape), 'static')
         self.ball_id = None
         if world.ball is not None:
             ball = world.ball
             self.ball_id = self._shape(Shape(
                 kind='sphere', position=(*ball.position, ball.floor + ball.radius),
                 radius=ball.radius, colour=ball.colour, mass=ball.mass, friction=ball.friction,
-                restitution=ball.restitution))
+                restitution=ball.restitution, name=BALL_NAME, source='ball'))
             self.objects[BALL_NAME] = self.ball_id
+            self.body_labels[self.ball_id] = (BALL_NAME, 'mover')
         movable = set(self.objects.values())
         for body in range(pb.getNumBodies(**kw)):
             if body in movable:
@@ -91,6 +104,8 @@ class SimWorld:
                               ray_mask=ALL_GROUPS & ~robot_group(index))
             robot.model.set_collision_filter(robot_group(index), ALL_GROUPS)
             self.robots[name] = robot
+            self.body_labels[robot.body_id] = (name, 'robot')
+        self._pictures()  # last, so that the other bodies keep their ids
         self.generation += 1
 
     def _shape(self, shape):
@@ -111,6 +126,30 @@ class SimWorld:
         pb.changeDynamics(body, -1, lateralFriction=shape.friction,
                           restitution=shape.restitution, **kw)
         return body
+
+    def _pictures(self):
+        """A visual-only static body per picture, a textured quad, for PyBullet's
+        TinyRenderer. Our GL renderer draws World.pictures itself; it skips these meshes."""
+        kw = self._kw()
+        textures = {}  # one texture per image file
+        for picture in self.description.pictures:
+            if picture.image not in textures:
+                textures[picture.image] = pb.loadTexture(picture.image, **kw)
+            corners = [list(c) for c in picture.corners]
+            edge_a = [b - a for a, b in zip(corners[0], corners[1])]
+            edge_b = [b - a for a, b in zip(corners[0], corners[3])]
+            normal = [edge_a[1] * edge_b[2] - edge_a[2] * edge_b[1],
+                      edge_a[2] * edge_b[0] - edge_a[0] * edge_b[2],
+                      edge_a[0] * edge_b[1] - edge_a[1] * edge_b[0]]
+            length = math.sqrt(sum(n * n for n in normal)) or 1.0
+            visual = pb.createVisualShape(
+                pb.GEOM_MESH, vertices=corners, indices=[0, 1, 2, 0, 2, 3],
+                # TinyRenderer's texture v runs up from the image's bottom row (OBJ's way).
+                uvs=[(u, 1.0 - v) for u, v in PICTURE_UV],
+                normals=[[n / length for n in normal]] * 4, **kw)
+            body = pb.createMultiBody(0, -1, visual, (0, 0, 0), **kw)
+            pb.changeVisualShape(body, -1, textureUniqueId=textures[picture.image],
+                                 rgbaColor=(1, 1, 1, 1), **kw)
 
     def reset(self):
         """Back to the world's initial state (rebuilt from scratch: deterministic)."""
@@ -136,14 +175,24 @@ class SimWorld:
 
     def set_object_pose(self, name, position, orientation=(0.0, 0.0, 0.0, 1.0)):
         """Move a movable object (its centre) or a robot (the point on the floor under its
-        axle; only the heading of orientation counts) and stop it. KeyError if unknown."""
+        axle; only the heading of orientation counts) and stop it. KeyError if unknown. A
+        height of None keeps the object's (a robot's: its own floor), an orientation of
+        None keeps its orientation (a robot's: its heading)."""
+        x, y, z = position
         if name in self.robots:
-            x, y, z, w = orientation
-            yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-            self.robots[name].place(position[0], position[1], yaw, floor=position[2])
+            robot = self.robots[name]
+            if orientation is None:
+                yaw = robot.pose()[2]
+            else:
+                qx, qy, qz, qw = orientation
+                yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+            robot.place(x, y, yaw, floor=z)
             return
         body = self.objects[name]
-        pb.resetBasePositionAndOrientation(body, position, orientation, **self._kw())
+        now_position, now_orientation = pb.getBasePositionAndOrientation(body, **self._kw())
+        pb.resetBasePositionAndOrientation(
+            body, (x, y, now_position[2] if z is None else z),
+            now_orientation if orientation is None else orientation, **self._kw())
         pb.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0), **self._kw())
 
     def object_poses(self):

@@ -15,7 +15,8 @@ class Cameras:
 
     def __init__(self, world, kind='auto', log=print, eye_workers=False):
         self.world = world
-        self.renderer = Renderer(world.client, kind=kind, log=log)
+        self.renderer = Renderer(world.client, kind=kind, log=log,
+                                 pictures=world.description.pictures)
         self._generation = world.generation  # the bodies the renderer has read
         self.eye_workers = None
         self._plans = {}  # CameraModel -> its render plan (the lens maps take ~20 ms)

@@ -103,8 +103,8 @@ class _GlBackend:
 
     kind = 'egl'
 
-    def __init__(self, client_id):
-        self.gl = GlBackend(client_id)
+    def __init__(self, client_id, pictures=()):
+        self.gl = GlBackend(client_id, pictures)
         self.name = 'egl'
         self.device = self.gl.device
 
@@ -135,13 +135,15 @@ class Renderer:
     :meth:`scene_changed` whenever bodies were added or the client was reset. ``log``
     receives one line describing the choice (with egl, the GL device that renders).
     ``kind`` and ``name`` tell what is in use ('tiny' or 'egl'); ``device`` is the
-    GL_RENDERER string (None with TinyRenderer).
+    GL_RENDERER string (None with TinyRenderer). ``pictures`` (World.pictures) are drawn
+    by egl; TinyRenderer draws the textured bodies SimWorld made of them.
     """
 
-    def __init__(self, client_id, kind='auto', log=print):
+    def __init__(self, client_id, kind='auto', log=print, pictures=()):
         if kind not in ('auto', 'egl', 'tiny'):
             raise ValueError(f"kind must be 'auto', 'egl' or 'tiny', not {kind!r}")
         self.client_id = client_id
+        self.pictures = tuple(pictures)
         self._backend, note = self._choose(kind)
         self.kind = self.name = self._backend.kind
         self.device = getattr(self._backend, 'device', None)
@@ -156,7 +158,7 @@ class Renderer:
         ok, reason = probe_egl()
         if ok:
             try:
-                backend = _GlBackend(self.client_id)
+                backend = _GlBackend(self.client_id, self.pictures)
                 return backend, f'rendering on {backend.device}'
             except GlUnavailable as exc:
                 reason = str(exc)

@@ -23,7 +23,17 @@ memory or time:
   radii and lengths are > 0;
 - at most 16 robots;
 - a [[ring]] or [[wall]] has at most 1000 panels, and the world at most 2000
-  shapes once rings, walls and tables are expanded.
+  shapes once rings, walls and tables are expanded;
+- a picture is a PNG of at most 8 MB and 2048 pixels a side that decodes (checked
+  here, before a renderer sees it), and a world's different pictures have at most
+  16 million pixels in all.
+
+Pictures: a [[wall]] or [[ring]] puts a PNG on its panels' faces, a static [[box]] on
+one of its faces (``picture`` and ``picture_*`` keys). They become World.pictures:
+flat quads 1 mm in front of the surface, for the renderers to draw. A picture is a
+file name from the bundled pictures (worlds/pictures/, bundled_pictures()) or a path
+(relative to the world file's folder); a bare name that is no bundled picture is looked
+for next to the world file.
 """
 import importlib.resources
 import math
@@ -32,7 +42,10 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from miro_ball.miro.interface import BALL_NAME, check_name
+from miro_sim_bullet.scene.png import PngError, png_size
 
 DEFAULT_COLOUR = (0.7, 0.7, 0.7)
 MAX_FILE_BYTES = 1_000_000
@@ -41,6 +54,15 @@ MAX_ROBOTS = 16
 MAX_PANELS = 1000
 MAX_SHAPES = 2000
 PANEL_SIZE = (0.01, 0.65, 0.30)  # the MDK's wall panel: thickness, width, height (m)
+MAX_PICTURE_BYTES = 8_000_000
+MAX_PICTURE_SIDE = 2048
+MAX_PICTURE_PIXELS = 16_000_000  # all of a world's different pictures together
+PICTURE_LIFT = 0.001  # a picture floats 1 mm in front of its surface: no depth fight
+BOX_FACES = ('+x', '-x', '+y', '-y', '+z')
+# A panel's faces are its box's +x and -x: a [[ring]] turns +x outwards, a [[wall]] to the
+# left of the row (looking from 'from' to 'to').
+PANEL_SIDES = {'ring': {'inside': '-x', 'outside': '+x'},
+               'wall': {'left': '+x', 'right': '-x'}}
 
 # Values quoted in error messages are shortened, so a message stays short
 # even when the value at fault is a huge string or a deeply nested list.
@@ -70,6 +92,21 @@ class Shape:
     friction: float = 0.8
     restitution: float = 0.0
     name: str | None = None  # always set when mass > 0
+    source: str = ''  # the world-file table it comes from: 'box[1]', 'ring[0]', 'ground'
+
+
+@dataclass(frozen=True)
+class Picture:
+    """A PNG on a flat quad. corners: four (x, y, z) world points, bottom-left,
+    bottom-right, top-right, top-left as seen from the front (counter-clockwise there),
+    which take the image's corners: in image coordinates (u right, v down, 0..1) the
+    corners' (u, v) are (0, 1), (1, 1), (1, 0), (0, 0)."""
+    source: str  # the world-file table: 'wall[2]', 'ring[0]', 'box[1]'
+    image: str  # absolute path of the PNG
+    corners: tuple
+
+
+PICTURE_UV = ((0.0, 1.0), (1.0, 1.0), (1.0, 0.0), (0.0, 0.0))  # of Picture.corners
 
 
 @dataclass(frozen=True)
@@ -101,6 +138,7 @@ class World:
     ground_colour: tuple = DEFAULT_COLOUR
     ground_size: tuple = (100.0, 100.0)
     shapes: tuple = field(default_factory=tuple)
+    pictures: tuple = field(default_factory=tuple)  # of Picture
 
 
 def bundled_worlds():
@@ -110,7 +148,7 @@ def bundled_worlds():
 
 def load_world(name_or_path):
     """A bundled world by name ('miro', 'empty', ...) or a user's .toml file."""
-    raw, source = _read(str(name_or_path))
+    raw, source, folder = _read(str(name_or_path))
     if len(raw) > MAX_FILE_BYTES:
         raise WorldError(f'{source}: larger than {MAX_FILE_BYTES} bytes')
     try:
@@ -123,7 +161,21 @@ def load_world(name_or_path):
         raise WorldError(f'{source}: not valid TOML: {err}') from None
     except RecursionError:
         raise WorldError(f'{source}: nested too deeply') from None
-    return _Parser(source).world(data, Path(source).stem)
+    return _Parser(source, folder).world(data, Path(source).stem)
+
+
+def bundled_pictures():
+    """File names of the pictures installed with the package (worlds/pictures/)."""
+    return sorted(p.name for p in (_bundled() / 'pictures').iterdir()
+                  if p.name.endswith('.png'))
+
+
+def _picture_choices():
+    """The bundled pictures in a few words: the tags as one entry."""
+    names = bundled_pictures()
+    tags = [n[len('apriltag36h11_'):-4] for n in names if n.startswith('apriltag36h11_')]
+    rest = [n for n in names if not n.startswith('apriltag36h11_')]
+    return ', '.join(rest + ([f'apriltag36h11_N.png (N = {", ".join(tags)})'] if tags else []))
 
 
 def _bundled():
@@ -135,29 +187,33 @@ def _choices():
 
 
 def _read(name):
-    """The file's first MAX_FILE_BYTES + 1 bytes (enough to tell it is too big) and its name."""
+    """The file's first MAX_FILE_BYTES + 1 bytes (enough to tell it is too big), its name
+    and its folder (None for a bundled world)."""
     if not name:
         raise WorldError(f'empty world name: {_choices()}')
     path = Path(name)
     if path.suffix == '.toml' or path.parent != Path('.'):
         try:
             with path.open('rb') as file:
-                return file.read(MAX_FILE_BYTES + 1), str(path)
+                return file.read(MAX_FILE_BYTES + 1), str(path), path.parent
         except OSError as err:
             raise WorldError(f'{path}: cannot read world file: {err.strerror or err}') from None
     resource = _bundled() / f'{name}.toml'
     if not resource.is_file():
         raise WorldError(f'unknown world {_show(name)}: {_choices()}')
-    return resource.read_bytes(), f'{name}.toml'
+    return resource.read_bytes(), f'{name}.toml', None
 
 
 class _Parser:
     """Checks one file's tables and turns them into dataclasses."""
 
-    def __init__(self, source):
+    def __init__(self, source, folder=None):
         self.source = source
+        self.folder = folder  # of a user's world file: where its pictures' paths start
         self.names = {BALL_NAME}  # taken so far; the ball's name is always taken
         self.shapes = []
+        self.pictures = []
+        self.images = {}  # absolute path -> (width, height) of each picture read
 
     def fail(self, where, problem):
         raise WorldError(f'{self.source}: {where}: {problem}')
@@ -264,6 +320,7 @@ class _Parser:
             ground_size=(100.0, 100.0) if ground is None else self.size(
                 'ground.size', ground.get('size', [100.0, 100.0]), 2),
             shapes=tuple(self.shapes),
+            pictures=tuple(self.pictures),
         )
 
     def robots(self, value):
@@ -309,15 +366,16 @@ class _Parser:
         )
 
     def shape(self, where, kind, index, table):
-        dims = {'box': {'size'}, 'cylinder': {'radius', 'length'}, 'sphere': {'radius'}}[kind]
+        dims = {'box': {'size', 'picture', 'picture_face', 'picture_size'},
+                'cylinder': {'radius', 'length'}, 'sphere': {'radius'}}[kind]
         self.keys(where, table, {'name', 'position', 'yaw', 'colour', 'mass', 'friction',
                                  'restitution'} | dims)
-        for key in dims:
+        for key in dims - {'picture', 'picture_face', 'picture_size'}:
             self.require(where, table, key)
         mass = self.number(f'{where}.mass', table.get('mass', 0.0), minimum=0.0)
         # A movable shape needs a name for its ground truth; a static one only if given.
         name = table.get('name', f'{kind}{index}' if mass > 0 else None)
-        return Shape(
+        shape = Shape(
             kind=kind,
             position=self.vector(f'{where}.position', table.get('position', [0, 0, 0]), 3),
             yaw=self.number(f'{where}.yaw', table.get('yaw', 0.0)),
@@ -326,28 +384,144 @@ class _Parser:
             length=self.number(f'{where}.length', table.get('length', 1.0), positive=True),
             mass=mass,
             name=None if name is None else self.name(f'{where}.name', name, 'object name'),
+            source=where,
             **self.surface(where, table),
         )
+        if kind == 'box':
+            self.box_picture(where, table, shape)
+        return shape
+
+    # -- pictures -------------------------------------------------------------------------
+    def box_picture(self, where, table, shape):
+        if 'picture' not in table:
+            for key in ('picture_face', 'picture_size'):
+                if key in table:
+                    self.fail(f'{where}.{key}', "needs 'picture'")
+            return
+        if shape.mass > 0:
+            self.fail(f'{where}.picture', 'only a static box (mass 0) can carry a picture')
+        face = table.get('picture_face', '+x')
+        if face not in BOX_FACES:
+            self.fail(f'{where}.picture_face', f'must be one of {", ".join(BOX_FACES)}, '
+                                               f'got {_show(face)}')
+        image = self.picture_file(f'{where}.picture', table['picture'])
+        self.place_picture(where, table, shape, face, image)
+
+    def panel_pictures(self, where, kind, table, count):
+        """The picture file (or None) of each of a ring's or wall's panels, and the face."""
+        if 'picture' not in table:
+            for key in ('picture_side', 'picture_size'):
+                if key in table:
+                    self.fail(f'{where}.{key}', "needs 'picture'")
+            return [None] * count, None
+        sides = PANEL_SIDES[kind]
+        side = table.get('picture_side', next(iter(sides)))
+        if side not in sides:
+            self.fail(f'{where}.picture_side', f'must be {" or ".join(sides)}, '
+                                               f'got {_show(side)}')
+        value = table['picture']
+        if isinstance(value, list):
+            if len(value) != count:
+                self.fail(f'{where}.picture', f'a list must name a picture (or "") for each '
+                                              f'of the {count} panels, got {len(value)}')
+            return [self.picture_file(f'{where}.picture[{k}]', v) if v != '' else None
+                    for k, v in enumerate(value)], sides[side]
+        return [self.picture_file(f'{where}.picture', value)] * count, sides[side]
+
+    def picture_file(self, where, value):
+        """Absolute path of a checked PNG named by the world file."""
+        if not isinstance(value, str) or not value or '\0' in value:
+            self.fail(where, f'must be the file name of a PNG, got {_show(value)}')
+        path = self.find_picture(where, value)
+        if path in self.images:
+            return path
+        try:
+            with open(path, 'rb') as file:
+                data = file.read(MAX_PICTURE_BYTES + 1)
+        except OSError as err:
+            self.fail(where, f'cannot read {_show(value)}: {err.strerror or err}')
+        if len(data) > MAX_PICTURE_BYTES:
+            self.fail(where, f'{_show(value)} is larger than {MAX_PICTURE_BYTES} bytes')
+        try:
+            width, height = png_size(data, MAX_PICTURE_SIDE)
+        except PngError as err:
+            self.fail(where, f'{_show(value)}: {err}')
+        if sum(w * h for w, h in self.images.values()) + width * height > MAX_PICTURE_PIXELS:
+            self.fail(where, f"the world's pictures have more than {MAX_PICTURE_PIXELS} "
+                             'pixels in all')
+        self.images[path] = (width, height)
+        return path
+
+    def find_picture(self, where, value):
+        """A bare name is a bundled picture, else (in a user's world) a file next to the
+        world file; a path is taken from the world file's folder, or as it is."""
+        path = Path(value)
+        try:
+            bundled = _bundled() / 'pictures' / value
+            if path.name == value and bundled.is_file():
+                path = Path(str(bundled))
+            elif self.folder is not None and not path.is_absolute():
+                path = self.folder / path
+            if path.is_file():
+                return str(path.resolve())
+        except (OSError, ValueError):  # a name too long for the file system, say
+            pass
+        self.fail(where, f'no picture {_show(value)}: bundled pictures are '
+                         f'{_picture_choices()}, or give a path to a PNG')
+
+    def place_picture(self, where, table, box, face, image):
+        """Add the Picture of ``image`` on ``face`` of ``box``, centred, its size given
+        (picture_size) or the largest the face holds at the image's aspect ratio."""
+        axis, sign = 'xyz'.index(face[1]), 1.0 if face[0] == '+' else -1.0
+        normal = np.zeros(3)
+        normal[axis] = sign
+        up = np.array([1.0, 0.0, 0.0]) if axis == 2 else np.array([0.0, 0.0, 1.0])
+        right = np.cross(up, normal)  # as seen from outside, looking at the face
+        half = np.asarray(box.size) / 2
+        face_w, face_h = 2 * abs(right @ half), 2 * abs(up @ half)
+        if 'picture_size' in table:
+            width, height = self.size(f'{where}.picture_size', table['picture_size'], 2)
+            if width > face_w + 1e-9 or height > face_h + 1e-9:
+                self.fail(f'{where}.picture_size', f'[{width:g}, {height:g}] does not fit '
+                                                   f'on the face, {face_w:g} x {face_h:g} m')
+        else:
+            pixels_w, pixels_h = self.images[image]
+            scale = min(face_w / pixels_w, face_h / pixels_h)
+            width, height = pixels_w * scale, pixels_h * scale
+        cos, sin = math.cos(box.yaw), math.sin(box.yaw)
+        turn = np.array([[cos, -sin, 0.0], [sin, cos, 0.0], [0.0, 0.0, 1.0]])
+        centre = np.asarray(box.position) + turn @ (normal * (half[axis] + PICTURE_LIFT))
+        right, up = turn @ right * width / 2, turn @ up * height / 2
+        corners = (centre - right - up, centre + right - up, centre + right + up,
+                   centre - right + up)
+        self.pictures.append(Picture(source=where, image=image, corners=tuple(
+            tuple(float(c) for c in corner) for corner in corners)))
 
     def ring(self, where, table):
         self.keys(where, table, {'count', 'radius', 'size', 'centre', 'yaw', 'colour',
-                                 'friction', 'restitution'})
+                                 'friction', 'restitution', 'picture', 'picture_side',
+                                 'picture_size'})
         count = self.count(f'{where}.count', table.get('count', 12))
         radius = self.number(f'{where}.radius', table.get('radius', 1.0), positive=True)
         size = self.size(f'{where}.size', table.get('size', list(PANEL_SIZE)), 3)
         cx, cy = self.vector(f'{where}.centre', table.get('centre', [0, 0]), 2)
         first = self.number(f'{where}.yaw', table.get('yaw', 0.0))
         surface = self.surface(where, table)
+        pictures, face = self.panel_pictures(where, 'ring', table, count)
         for k in range(count):
             angle = first + 2 * math.pi * k / count
-            self.add(where, Shape(kind='box', size=size, yaw=angle,
-                                  position=(cx + radius * math.cos(angle),
-                                            cy + radius * math.sin(angle), size[2] / 2),
-                                  **surface))
+            panel = Shape(kind='box', size=size, yaw=angle, source=where,
+                          position=(cx + radius * math.cos(angle),
+                                    cy + radius * math.sin(angle), size[2] / 2),
+                          **surface)
+            self.add(where, panel)
+            if pictures[k]:
+                self.place_picture(where, table, panel, face, pictures[k])
 
     def wall(self, where, table):
         self.keys(where, table, {'from', 'to', 'count', 'size', 'floor', 'colour',
-                                 'friction', 'restitution'})
+                                 'friction', 'restitution', 'picture', 'picture_side',
+                                 'picture_size'})
         count = self.count(f'{where}.count', self.require(where, table, 'count'))
         start = self.vector(f'{where}.from', self.require(where, table, 'from'), 2)
         end = start if count == 1 and 'to' not in table else \
@@ -361,12 +535,16 @@ class _Parser:
         # quarter turn from the row lays each panel's width along the row (a
         # lone panel without 'to' has atan2(0, 0) = 0: its width runs along x).
         yaw = math.atan2(end[1] - start[1], end[0] - start[0]) + math.pi / 2
+        pictures, face = self.panel_pictures(where, 'wall', table, count)
         for k in range(count):
             t = k / (count - 1) if count > 1 else 0.0
-            self.add(where, Shape(kind='box', size=size, yaw=yaw,
-                                  position=(start[0] + t * (end[0] - start[0]),
-                                            start[1] + t * (end[1] - start[1]), z),
-                                  **surface))
+            panel = Shape(kind='box', size=size, yaw=yaw, source=where,
+                          position=(start[0] + t * (end[0] - start[0]),
+                                    start[1] + t * (end[1] - start[1]), z),
+                          **surface)
+            self.add(where, panel)
+            if pictures[k]:
+                self.place_picture(where, table, panel, face, pictures[k])
 
     def table(self, where, table):
         self.keys(where, table, {'position', 'yaw', 'top', 'height', 'legs', 'leg_radius',
@@ -381,13 +559,13 @@ class _Parser:
         leg_radius = self.number(f'{where}.leg_radius', table.get('leg_radius', 0.02),
                                  positive=True)
         surface = self.surface(where, table)
-        self.add(where, Shape(kind='box', size=top, yaw=yaw,
+        self.add(where, Shape(kind='box', size=top, yaw=yaw, source=where,
                               position=(x, y, height - top[2] / 2), **surface))
         leg_length = height - top[2]  # from the ground to the underside of the top
         cos, sin = math.cos(yaw), math.sin(yaw)
         for lx, ly in ((legs[0], legs[1]), (legs[0], -legs[1]), (-legs[0], legs[1]),
                        (-legs[0], -legs[1])):
             self.add(where, Shape(kind='cylinder', radius=leg_radius, length=leg_length,
-                                  position=(x + cos * lx - sin * ly, y + sin * lx + cos * ly,
+                                  source=where, position=(x + cos * lx - sin * ly, y + sin * lx + cos * ly,
                                             leg_length / 2),
                                   **surface))
