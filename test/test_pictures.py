@@ -53,14 +53,19 @@ def normal(corners):
 # ------------------------------------------------------------------ the bundled pictures
 
 def test_bundled_pictures_are_what_make_pictures_draws():
-    """The committed PNGs can be made again: python -m miro_ball.bench.make_pictures."""
+    """The committed PNGs can be made again: python -m miro_ball.bench.make_pictures. The
+    tags exactly; the drawings but for anti-aliased edges (OpenCV versions differ there)."""
     drawn = make_pictures.pictures()
     assert sorted(drawn) == bundled_pictures()
     folder = world_file._bundled() / 'pictures'
     for name, image in drawn.items():
         stored = cv2.imdecode(np.frombuffer((folder / name).read_bytes(), np.uint8),
                               cv2.IMREAD_UNCHANGED)
-        assert np.array_equal(stored, image), name
+        assert stored.shape == image.shape, name
+        if name.startswith('apriltag'):
+            assert np.array_equal(stored, image), name
+        else:
+            assert np.abs(stored.astype(int) - image).mean() < 1.0, name
 
 
 @pytest.mark.parametrize('name', bundled_pictures())
