@@ -17,7 +17,7 @@ TIERS = {
               'test_gui_protocol', 'test_interface', 'test_isolation', 'test_jpeg',
               'test_layering', 'test_param_bounds', 'test_processes', 'test_rendering',
               'test_report', 'test_shm', 'test_sim_physics', 'test_world_file',
-              'test_world_fuzz', 'test_kc', 'test_camera_model', 'test_lens', 'test_gaze',
+              'test_world_fuzz', 'test_kc', 'test_camera_model', 'test_gaze',
               'test_pose_controller', 'test_floor_map', 'test_scene_markers', 'test_touch',
               'test_pictures', 'test_gui_scene')),
     'ros': ('nodes in-process on executors of their own, a process or two beside them',
