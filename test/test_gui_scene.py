@@ -120,6 +120,22 @@ def test_a_page_gets_the_whole_scene_then_only_what_moved_or_went():
     assert warn == []
 
 
+def test_a_layout_sent_again_after_a_deleteall_sends_only_what_differs():
+    state, warn = s.SceneState(), Warnings()
+    layout = [marker('wall', 1, Marker.CUBE), marker('wall', 2, Marker.CUBE),
+              marker('leds', 0, Marker.CUBE)]
+    state.apply_markers([marker(action=Marker.DELETEALL, ns='')] + layout, warn)
+    seen = state.seq
+    state.apply_markers([marker(action=Marker.DELETEALL, ns='')] + layout, warn)
+    assert state.scene_message(seen) is None  # the same layout: nothing to send
+    lit = marker('leds', 0, Marker.CUBE)
+    lit.color.r = 1.0
+    state.apply_markers([marker(action=Marker.DELETEALL, ns=''), layout[0], lit], warn)
+    change = json.loads(state.scene_message(seen))
+    assert [m['id'] for m in change['markers']] == ['leds/0']
+    assert change['removed'] == ['wall/2']  # not in the layout any more
+
+
 @pytest.mark.parametrize('spoil, why', [
     (lambda m: setattr(m.pose.position, 'x', math.nan), 'not finite'),
     (lambda m: setattr(m, 'type', Marker.ARROW), 'not drawn'),

@@ -170,24 +170,28 @@ class SceneState:
 
     def apply_markers(self, markers, warn):
         """Take a MarkerArray's markers; warn(key, text) about each one not drawn.
-        Returns how many changed."""
+        Returns how many changed. A DELETEALL followed by the same markers again (a
+        publisher re-sending its whole layout) changes only what differs."""
         changed = 0
+        doomed = set()  # deleted by a DELETEALL unless added again in this array
         for marker in markers:
             try:
+                if marker.action == DELETEALL:
+                    doomed.update(i for i in self.markers
+                                  if not marker.ns or i.startswith(marker.ns + '/'))
+                    continue
+                doomed.discard(marker_id(marker))
                 changed += self._apply_marker(marker)
             except SceneRejected as err:
                 warn(f'marker:{marker_id(marker)[:80]}',
                      f'scene marker {marker_id(marker)[:80]!r} not drawn: {err}')
             except (TypeError, ValueError, AttributeError) as err:  # garbage from the graph
                 warn('marker', f'a malformed scene marker ignored: {err}')
+        for i in doomed:
+            changed += self._remove(i)
         return changed
 
     def _apply_marker(self, marker):
-        if marker.action == DELETEALL:
-            doomed = [i for i in self.markers if not marker.ns or i.startswith(marker.ns + '/')]
-            for i in doomed:
-                self._remove(i)
-            return len(doomed)
         if marker.action == DELETE:
             return self._remove(marker_id(marker))
         if marker.action != ADD:  # ADD and MODIFY are one number
