@@ -65,7 +65,9 @@ DEFAULT_VIEW = (frozenset(EYES), False)
 RTF_PARAMETER = 'real_time_factor'
 # The scene is sent once and kept (transient local), as RViz expects; the link frames are
 # a stream (the newest only matters).
-SCENE_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+# The simulator keeps two messages on the scene for a late subscriber (the layout and the
+# movers, from a publisher each): a depth of 1 would keep only the one that came last.
+SCENE_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
 LINKS_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
 
