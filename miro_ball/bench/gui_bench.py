@@ -46,13 +46,38 @@ def cpu_seconds(pid):
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
-class Simulator:
+class _Spinning:
+    """A node on a context of its own, spun by a thread of this process until close()."""
+
+    def _start(self):
+        from rclpy.executors import SingleThreadedExecutor
+
+        if not hasattr(self, 'executor'):
+            self.executor = SingleThreadedExecutor(context=self.context)
+            self.executor.add_node(self.node)
+        self.running = True
+        self.thread = threading.Thread(target=self._spin, daemon=True)
+        self.thread.start()
+
+    def _spin(self):
+        while self.running:
+            self.executor.spin_once(timeout_sec=0.1)
+
+    def close(self):
+        import rclpy
+
+        self.running = False
+        self.thread.join()
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
+class Simulator(_Spinning):
     """The simulator in a thread of this process, noting when each eye frame went out."""
 
     def __init__(self, domain, renderer, world=None):
         import rclpy
         from rclpy.context import Context
-        from rclpy.executors import SingleThreadedExecutor
         from rclpy.parameter import Parameter
 
         from miro_sim_bullet.ros.node import SimNode
@@ -68,11 +93,7 @@ class Simulator:
             interface.publish_eye = self._noting(interface.publish_eye)
         self.scene_s = 0.0  # wall time spent publishing the scene
         self.node.scene.publish = self._timing(self.node.scene.publish)
-        self.executor = SingleThreadedExecutor(context=self.context)
-        self.executor.add_node(self.node)
-        self.running = True
-        self.thread = threading.Thread(target=self._spin, daemon=True)
-        self.thread.start()
+        self._start()
 
     def _noting(self, publish_eye):
         def publish(eye, rgb, when, *rest):
@@ -86,18 +107,6 @@ class Simulator:
             publish(*args)
             self.scene_s += time.perf_counter() - start
         return timed
-
-    def _spin(self):
-        while self.running:
-            self.executor.spin_once(timeout_sec=0.1)
-
-    def close(self):
-        import rclpy
-
-        self.running = False
-        self.thread.join()
-        self.node.destroy_node()
-        rclpy.try_shutdown(context=self.context)
 
 
 def percentile(values, q):
@@ -154,7 +163,7 @@ def measure(args):
     return lines
 
 
-class SceneMeter:
+class SceneMeter(_Spinning):
     """A node of its own (as RViz would be) counting the serialised bytes of the scene and
     of each robot's links, and driving every robot in circles so that they move."""
 
@@ -162,7 +171,6 @@ class SceneMeter:
         import rclpy
         from geometry_msgs.msg import PoseArray, TwistStamped
         from rclpy.context import Context
-        from rclpy.executors import SingleThreadedExecutor
         from visualization_msgs.msg import MarkerArray
 
         from miro_ball.common.qos import profile
@@ -188,14 +196,7 @@ class SceneMeter:
                 msg.twist.linear.x, msg.twist.angular.z = 0.2, 0.8
                 publisher.publish(msg)
         self.node.create_timer(0.02, drive)
-        self.executor = SingleThreadedExecutor(context=self.context)
-        self.executor.add_node(self.node)
         self._start()
-
-    def _start(self):
-        self.running = True
-        self.thread = threading.Thread(target=self._spin, daemon=True)
-        self.thread.start()
 
     def stop_counting(self):
         """Unsubscribe (between spins), leaving the GUI the scene's only subscriber, as it
@@ -211,18 +212,6 @@ class SceneMeter:
         def count(data):
             self.bytes[key] += len(data)
         return count
-
-    def _spin(self):
-        while self.running:
-            self.executor.spin_once(timeout_sec=0.1)
-
-    def close(self):
-        import rclpy
-
-        self.running = False
-        self.thread.join()
-        self.node.destroy_node()
-        rclpy.try_shutdown(context=self.context)
 
 
 async def _scene_page(url, sim, meter, seconds, warmup):

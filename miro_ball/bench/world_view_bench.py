@@ -12,10 +12,10 @@ import argparse
 import os
 import statistics
 import sys
-import threading
 import time
 
 from miro_ball.common.isolation import isolated_env, limit_discovery, private_domain
+from miro_ball.bench.gui_bench import Simulator
 from miro_ball.gui.process import GuiProcess
 
 CHROMIUM = '/usr/bin/chromium'
@@ -35,40 +35,6 @@ COUNTS_JS = """() => ({drawn: miroGui.world.drawn, caml: miroGui.frames.caml || 
                        ms: miroGui.world.drawMs.slice()})"""
 
 
-class Simulator:
-    """The simulator of a world in a thread of this process, at real time."""
-
-    def __init__(self, domain, world, renderer):
-        import rclpy
-        from rclpy.context import Context
-        from rclpy.executors import SingleThreadedExecutor
-        from rclpy.parameter import Parameter
-
-        from miro_sim_bullet.ros.node import SimNode
-
-        self.context = Context()
-        rclpy.init(context=self.context, domain_id=domain)
-        self.node = SimNode(context=self.context, parameter_overrides=[
-            Parameter('world', value=world), Parameter('renderer', value=renderer)])
-        self.executor = SingleThreadedExecutor(context=self.context)
-        self.executor.add_node(self.node)
-        self.running = True
-        self.thread = threading.Thread(target=self._spin, daemon=True)
-        self.thread.start()
-
-    def _spin(self):
-        while self.running:
-            self.executor.spin_once(timeout_sec=0.1)
-
-    def close(self):
-        import rclpy
-
-        self.running = False
-        self.thread.join()
-        self.node.destroy_node()
-        rclpy.try_shutdown(context=self.context)
-
-
 def measure_world_view(seconds=10.0, warmup=3.0, renderer='auto', world=WORLD):
     """{'fps', 'on_demand_fps', 'draw_ms_median', 'eye_fps', 'robots', 'webgl'} of the world
     view with a page open; raises RuntimeError when the page never got ready."""
@@ -76,7 +42,7 @@ def measure_world_view(seconds=10.0, warmup=3.0, renderer='auto', world=WORLD):
 
     domain = private_domain(salt=71)
     limit_discovery()
-    sim = Simulator(domain, world, renderer)
+    sim = Simulator(domain, renderer, world=world)
     robots = len(sim.node.robots)
     try:
         gui = GuiProcess(isolated_env(domain))
