@@ -1,8 +1,10 @@
 """client_map against the simulator in simulated time: MiRo turns on the spot, and its
 map shows the ball and the arena's wall where the simulator's ground truth has them,
 through either lens; what it publishes and writes is that map."""
+import importlib.resources
 import math
 import os
+import re
 import subprocess
 import sys
 
@@ -31,6 +33,16 @@ def blue(rgb):
 
 def floor_coloured(rgb):
     return rgb.min(axis=-1) > 200  # the white floor disc, lit
+
+
+def bare_arena(folder):
+    """The arena's world file without its pictures: their white backgrounds are the white
+    floor's colour, and this test tells floor from wall by colour."""
+    text = (importlib.resources.files('miro_sim_bullet.worlds') / 'miro.toml').read_text()
+    text = re.sub(r'^picture(_side)? = (\[.*?\]|".*?")\n', '', text, flags=re.M | re.S)
+    path = folder / 'bare_arena.toml'
+    path.write_text(text)
+    return str(path)
 
 
 def wall_depth(world, x, y):
@@ -74,7 +86,8 @@ def spin_and_map(sim_node, executor, context, args):
 @pytest.mark.parametrize('lens', LENSES)
 def test_map_shows_the_ball_and_the_arena_wall_where_they_are(lens, make_sim, executor,
                                                               ros_context, tmp_path):
-    sim_node = make_sim(lens=lens)
+    sim_node = make_sim(lens=lens, world=bare_arena(tmp_path))
+    assert not sim_node.sim.description.pictures
     out = tmp_path / 'map.png'
     client, maps = spin_and_map(sim_node, executor, ros_context, ['--out', str(out)])
     robot = sim_node.sim.robots[T.name]
