@@ -42,7 +42,6 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 
 from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_sim_bullet.scene.png import PngError, png_size
@@ -73,6 +72,20 @@ _SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxstring, _SHORT.maxother, _SHORT.maxlo
 
 def _show(value):
     return _SHORT.repr(value)
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _dot(a, b):
+    return sum(x * y for x, y in zip(a, b))
+
+
+def _turn(yaw, v):
+    """v turned by yaw about z (plain Python: world files load without numpy)."""
+    cos, sin = math.cos(yaw), math.sin(yaw)
+    return (cos * v[0] - sin * v[1], sin * v[0] + cos * v[1], v[2])
 
 
 class WorldError(ValueError):
@@ -473,12 +486,11 @@ class _Parser:
         """Add the Picture of ``image`` on ``face`` of ``box``, centred, its size given
         (picture_size) or the largest the face holds at the image's aspect ratio."""
         axis, sign = 'xyz'.index(face[1]), 1.0 if face[0] == '+' else -1.0
-        normal = np.zeros(3)
-        normal[axis] = sign
-        up = np.array([1.0, 0.0, 0.0]) if axis == 2 else np.array([0.0, 0.0, 1.0])
-        right = np.cross(up, normal)  # as seen from outside, looking at the face
-        half = np.asarray(box.size) / 2
-        face_w, face_h = 2 * abs(right @ half), 2 * abs(up @ half)
+        normal = tuple(sign if k == axis else 0.0 for k in range(3))
+        up = (1.0, 0.0, 0.0) if axis == 2 else (0.0, 0.0, 1.0)
+        right = _cross(up, normal)  # as seen from outside, looking at the face
+        half = tuple(v / 2 for v in box.size)
+        face_w, face_h = 2 * abs(_dot(right, half)), 2 * abs(_dot(up, half))
         if 'picture_size' in table:
             width, height = self.size(f'{where}.picture_size', table['picture_size'], 2)
             if width > face_w + 1e-9 or height > face_h + 1e-9:
@@ -488,14 +500,13 @@ class _Parser:
             pixels_w, pixels_h = self.images[image]
             scale = min(face_w / pixels_w, face_h / pixels_h)
             width, height = pixels_w * scale, pixels_h * scale
-        cos, sin = math.cos(box.yaw), math.sin(box.yaw)
-        turn = np.array([[cos, -sin, 0.0], [sin, cos, 0.0], [0.0, 0.0, 1.0]])
-        centre = np.asarray(box.position) + turn @ (normal * (half[axis] + PICTURE_LIFT))
-        right, up = turn @ right * width / 2, turn @ up * height / 2
-        corners = (centre - right - up, centre + right - up, centre + right + up,
-                   centre - right + up)
-        self.pictures.append(Picture(source=where, image=image, corners=tuple(
-            tuple(float(c) for c in corner) for corner in corners)))
+        lift = half[axis] + PICTURE_LIFT
+        centre = tuple(p + lift * n for p, n in zip(box.position, _turn(box.yaw, normal)))
+        right = tuple(v * width / 2 for v in _turn(box.yaw, right))
+        up = tuple(v * height / 2 for v in _turn(box.yaw, up))
+        corners = tuple(tuple(float(c + a * r + b * u) for c, r, u in zip(centre, right, up))
+                        for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)))
+        self.pictures.append(Picture(source=where, image=image, corners=corners))
 
     def ring(self, where, table):
         self.keys(where, table, {'count', 'radius', 'size', 'centre', 'yaw', 'colour',
