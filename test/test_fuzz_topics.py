@@ -27,7 +27,9 @@ def fuzz(node, probe, executor, between=lambda: None):
             delivered[topic] += 1
             return handled(msg)
         sub.callback = counting
-        pub = probe.node.create_publisher(sub.msg_type, topic, 10)
+        # The subscription's own QoS: a transient-local one (the scene) ignores a volatile
+        # publisher.
+        pub = probe.node.create_publisher(sub.msg_type, topic, sub.qos_profile)
         assert spin_until(executor, lambda: pub.get_subscription_count() > 0), topic
         sent = 0
         for msg in hostile(sub.msg_type):
@@ -78,15 +80,24 @@ def test_the_controller_survives_every_topic(ros_context, executor):
 def test_the_gui_survives_every_topic(ros_context, executor):
     from miro_ball.gui.bridge import GuiBridge
 
-    bridge = GuiBridge(default_robot_name(), context=ros_context)
+    from miro_ball.gui.protocol import View
+    from miro_ball.miro.interface import EYES
+
+    name = default_robot_name()
+    bridge = GuiBridge(name, context=ros_context)
     executor.add_node(bridge)
     try:
+        # A page showing everything: the eyes and the world, so every subscription is made.
+        bridge.open(1)
+        bridge.submit(View(frozenset(EYES), True), owner=1)
+        assert spin_until(executor, lambda: name in bridge.watches and bridge._scene_subs)
         probe = Probe(ros_context, executor, 'fuzzer')
         # The bridge's own topics, then those of its robot part (in the robot's namespace).
-        delivered = {**fuzz(bridge, probe, executor), **fuzz(bridge.watch, probe, executor)}
+        delivered = {**fuzz(bridge, probe, executor),
+                     **fuzz(bridge.watches[name], probe, executor)}
         assert RobotTopics(default_robot_name()).odom in delivered
         assert min(delivered.values()) > 2
-        json.loads(bridge.state())  # the page's readouts still make valid JSON
+        json.loads(bridge.state(1))  # the page's readouts still make valid JSON
     finally:
         executor.remove_node(bridge)
         bridge.destroy_node()
