@@ -35,7 +35,7 @@ def robot_group(index):
 
 def _table(shape):
     """The world-file table an unnamed shape comes from: 'wall' for 'wall[2]'."""
-    return getattr(shape, 'source', shape.kind).split('[')[0] or shape.kind
+    return shape.source.split('[')[0] or shape.kind
 
 
 class SimWorld:
