@@ -8,6 +8,7 @@ from geometry_msgs.msg import PoseStamped
 
 from miro_ball.miro.camera_model import CameraModel, Intrinsics
 from miro_sim_bullet.physics.sensors import Sensors
+from miro_sim_bullet.render.eye_images import encode, EyeWants
 from miro_sim_bullet.ros import convert
 
 SENSORS = Sensors(time=1.5, kinematic_positions=(-0.1, 0.6, 0.2, -0.1),
@@ -65,12 +66,22 @@ def test_camera_info_carries_the_lens_back(lens):
     assert CameraModel.from_camera_info(info) == camera
 
 
-def test_jpeg_keeps_the_ball_blue():
-    rgb = np.zeros((36, 64, 3), np.uint8)
-    rgb[:, :, 2] = 255  # pure blue in RGB
-    msg = convert.jpeg(rgb, convert.stamp(0.0), 'miro/caml_optical', 90)
+@pytest.mark.parametrize('channels', [3, 4])
+def test_eye_images_keep_the_ball_blue_from_rgb_or_rgba(channels):
+    image = np.zeros((36, 64, channels), np.uint8)
+    image[:, :, 2] = 255  # pure blue in RGB(A)
+    if channels == 4:
+        image[:, :, 3] = 255
+    jpeg, raw = encode(image, EyeWants(jpeg=True, raw=True), 90)
+    msg = convert.compressed_image(jpeg, convert.stamp(0.0), 'miro/caml_optical')
+    assert msg.format.endswith('jpeg compressed bgr8')
     b, g, r = cv2.imdecode(np.frombuffer(bytes(msg.data), np.uint8), cv2.IMREAD_COLOR)[10, 10]
     assert b > 240 and g < 15 and r < 15
+    msg = convert.raw_image(raw, 64, 36, convert.stamp(0.0), 'miro/caml_optical')
+    pixels = np.frombuffer(bytes(msg.data), np.uint8).reshape(36, 64, 3)
+    assert msg.encoding == 'rgb8' and msg.step == 3 * 64
+    assert np.array_equal(pixels, image[:, :, :3])
+    assert encode(image, EyeWants(jpeg=False, raw=False), 90) == (None, None)
 
 
 def pose_msg(name, position, orientation=(0.0, 0.0, 0.0, 0.0)):

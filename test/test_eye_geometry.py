@@ -14,7 +14,7 @@ from miro_ball.miro.kc import CAML, CAMR, FOOT, KinematicChain, WORLD
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
-from miro_sim_bullet.render.renderer import probe_egl, view_matrix_from_pose
+from miro_sim_bullet.render.renderer import probe_egl
 from miro_sim_bullet.scene.world_file import load_world
 
 RENDERERS = ['tiny', pytest.param('egl', marks=pytest.mark.skipif(
@@ -110,27 +110,6 @@ def test_ball_is_blue_after_jpeg_and_nothing_else_is(small_ball):
         assert inner.sum() > 30, xy
         assert seen[inner].mean() > 0.98, xy
         assert not seen[outside].any(), xy
-
-
-def test_eye_worker_processes_render_exactly_what_the_simulator_would():
-    world = SimWorld('miro')
-    cameras = Cameras(world, 'tiny', eye_workers=True)
-    try:
-        assert cameras.eye_workers is not None
-        world.robot.set_kinematic_targets([0.0, math.radians(50), math.radians(20), 0.0])
-        world.robot.set_cmd_vel(0.2, 0.5)
-        world.run(1.0)  # robot, head and (maybe) ball have moved since the workers' copy
-        camera = CameraModel(320, 240)
-        requests = [(world.robot, +1), (world.robot, -1)]
-        from_workers = cameras.render_eyes(requests, camera)
-        in_process = [cameras.renderer.render(
-            view_matrix_from_pose(*world.robot.eye_pose(side)), camera.intrinsics)
-            for side in (+1, -1)]
-        for a, b in zip(from_workers, in_process):
-            assert np.array_equal(a, b)
-    finally:
-        cameras.close()
-        world.close()
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.filter_too_much,

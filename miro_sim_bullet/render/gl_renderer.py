@@ -11,9 +11,11 @@ framebuffer, stacked vertically, and come back in one read-back.
 Images follow the pinhole model of :func:`renderer.opengl_projection`. The projection is
 flipped vertically so that the first row read back is the top row of the image: no copy.
 """
+import collections
 import functools
 import math
 import os
+import time
 
 import cv2
 import numpy as np
@@ -240,6 +242,7 @@ class GlBackend:
         self.max_height = self.ctx.info['GL_MAX_RENDERBUFFER_SIZE']
         self.max_height = min(self.max_height, self.ctx.info['GL_MAX_VIEWPORT_DIMS'][1])
         self._framebuffers = {}
+        self.seconds = collections.Counter()  # wall time per stage of drawing, summed
         self._read_scene()
 
     def scene_changed(self):
@@ -322,15 +325,20 @@ class GlBackend:
             self._framebuffers[key] = (fbo, colour, depth)
         return self._framebuffers[key][0]
 
-    def render_views(self, view_projections, width, height):
-        """RGB images (height, width, 3) uint8, one per column-major 4x4 view-projection
-        matrix (already flipped vertically), drawn in as few passes as fit."""
+    def render_views(self, view_projections, width, height, components=3):
+        """RGB images (height, width, 3) uint8 (RGBA with components=4), one per
+        column-major 4x4 view-projection matrix (already flipped vertically), drawn in as
+        few passes as fit."""
         with self.ctx:  # current in this thread for the call: any thread may render
-            return self._render_views(view_projections, width, height)
+            return self._render_views(view_projections, width, height, components)
 
-    def _render_views(self, view_projections, width, height):
+    def _render_views(self, view_projections, width, height, components):
         import moderngl
+        clock = time.perf_counter
+        started = clock()
         self._upload_instances()
+        uploaded = clock()
+        self.seconds['upload'] += uploaded - started
         per_pass = max(1, self.max_height // height)
         images = []
         ctx = self.ctx
@@ -351,8 +359,15 @@ class GlBackend:
                     for texture, _, vao in self.by_texture:
                         texture.use(0)
                         vao.render()
-            pixels = np.empty((len(batch) * height, width, 3), np.uint8)
-            fbo.read_into(pixels, components=3, alignment=1)
+            # RGBA is the framebuffer's own format: llvmpipe copies it out 4x faster than
+            # it converts to RGB (0.2 against 0.8 ms a 640x360 stereo pair).
+            pixels = np.empty((len(batch) * height, width, components), np.uint8)
+            drawn = clock()
+            fbo.read_into(pixels, components=components, alignment=1)
+            # llvmpipe rasterises when the pixels are asked for: 'read back' includes it.
+            self.seconds['draw calls'] += drawn - uploaded
+            uploaded = clock()
+            self.seconds['read back'] += uploaded - drawn
             images += [pixels[k * height:(k + 1) * height] for k in range(len(batch))]
         return images
 

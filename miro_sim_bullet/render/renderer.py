@@ -77,19 +77,19 @@ class _TinyBackend:
         self.client_id = client_id
         self.name = 'tiny'
 
-    def render_views(self, views, intrinsics):
+    def render_views(self, views, intrinsics, rgba=False):
         projection = _projection(intrinsics, self.pixel_shift)
-        return [self._shot(view, intrinsics.width, intrinsics.height, projection)
+        return [self._shot(view, intrinsics.width, intrinsics.height, projection, rgba)
                 for view in views]
 
-    def _shot(self, view, width, height, projection):
+    def _shot(self, view, width, height, projection, rgba):
         pixels = p.getCameraImage(
             width, height, viewMatrix=view, projectionMatrix=projection, shadow=0,
             lightDirection=_TINY_LIGHT_DIRECTION, flags=_FLAGS, renderer=p.ER_TINY_RENDERER,
             physicsClientId=self.client_id)[2]
         # A no-op on numpy-enabled pybullet; converts the flat list otherwise.
-        rgba = np.asarray(pixels, dtype=np.uint8).reshape(height, width, 4)
-        return cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB)
+        image = np.asarray(pixels, dtype=np.uint8).reshape(height, width, 4)
+        return image if rgba else cv2.cvtColor(image, cv2.COLOR_RGBA2RGB)
 
     def scene_changed(self):
         pass  # TinyRenderer reads the client's bodies on every call
@@ -108,10 +108,11 @@ class _GlBackend:
         self.name = 'egl'
         self.device = self.gl.device
 
-    def render_views(self, views, intrinsics):
+    def render_views(self, views, intrinsics, rgba=False):
         projection = _projection(intrinsics, (0.0, 0.0))
         return self.gl.render_views([view_projection(view, projection) for view in views],
-                                    intrinsics.width, intrinsics.height)
+                                    intrinsics.width, intrinsics.height,
+                                    components=4 if rgba else 3)
 
     def scene_changed(self):
         self.gl.scene_changed()
@@ -147,6 +148,8 @@ class Renderer:
         self._backend, note = self._choose(kind)
         self.kind = self.name = self._backend.kind
         self.device = getattr(self._backend, 'device', None)
+        # Wall seconds per stage of drawing (upload, draw calls, read back), egl only.
+        self.seconds = getattr(getattr(self._backend, 'gl', None), 'seconds', {})
         log(f'camera renderer: {self.name} ({note})')
         if not p.isNumpyEnabled():
             log('pybullet was built without numpy: images cost ~30 ms more each at 640x360')
@@ -175,11 +178,12 @@ class Renderer:
         ``view_matrix`` (column-major world-to-camera matrix as from computeViewMatrix)."""
         return self._backend.render_views([view_matrix], intrinsics)[0]
 
-    def render_many(self, view_matrices, intrinsics):
-        """One RGB image per view matrix, all of this instant (egl draws them together)."""
+    def render_many(self, view_matrices, intrinsics, rgba=False):
+        """One RGB image (RGBA with ``rgba``) per view matrix, all of this instant (egl
+        draws them together)."""
         if not view_matrices:
             return []
-        return self._backend.render_views(list(view_matrices), intrinsics)
+        return self._backend.render_views(list(view_matrices), intrinsics, rgba)
 
     def close(self):
         """Release the GL context. Idempotent."""

@@ -1,7 +1,6 @@
 """Simulator state to ROS messages and back: plain functions, no node needed."""
 import math
 
-import cv2
 import numpy as np
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import PointStamped, Pose2D, PoseStamped
@@ -13,6 +12,7 @@ from std_msgs.msg import Float32MultiArray
 from miro_ball.miro.constants import JOINT_NAMES
 from miro_ball.miro.interface import frame_id, WORLD_FRAME
 from miro_sim_bullet.physics import model as rb
+from miro_sim_bullet.render.eye_images import JPEG_FORMAT
 
 MAX_COORDINATE_M = 1000.0  # where set_pose may put things: far beyond any bundled world
 
@@ -88,18 +88,17 @@ def camera_info(camera, when, frame_id):
     return msg
 
 
-def jpeg(rgb, when, frame_id, quality):
-    ok, data = cv2.imencode('.jpg', cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR),
-                            [cv2.IMWRITE_JPEG_QUALITY, quality])
-    msg = CompressedImage(format='rgb8; jpeg compressed bgr8', data=data.tobytes())
+def compressed_image(jpeg, when, frame_id):
+    """A CompressedImage of JPEG bytes (render.eye_images.jpeg_bytes)."""
+    msg = CompressedImage(format=JPEG_FORMAT, data=jpeg)
     msg.header.stamp, msg.header.frame_id = when, frame_id
     return msg
 
 
-def raw_image(rgb, when, frame_id):
-    h, w = rgb.shape[:2]
-    msg = Image(height=h, width=w, encoding='rgb8', is_bigendian=0, step=3 * w,
-                data=rgb.tobytes())
+def raw_image(rgb, width, height, when, frame_id):
+    """An 'rgb8' Image of raw RGB bytes, rows top first."""
+    msg = Image(height=height, width=width, encoding='rgb8', is_bigendian=0, step=3 * width,
+                data=rgb)
     msg.header.stamp, msg.header.frame_id = when, frame_id
     return msg
 

@@ -7,10 +7,20 @@ pause, step). The node itself publishes /clock from physics time and decides whe
 everything is published. Either a steady wall-clock timer advances the world
 (real_time_factor 1.0 = real time, 0 = as fast as possible), or, when paused, the
 ~/step service or in-process code calls advance().
+
+When the timer advances the world, the eyes of a camera instant are drawn and encoded in
+a helper process (render.eye_pipeline) while physics steps on, and published as soon as
+they are done: at the latest before the next camera instant is drawn, so at most one
+camera period of simulated time after their own /clock. Stepped (advance(), ~/step) or
+paused, every image is out before advance() returns, in the order a blocking renderer
+gives: an instant's images, then its /clock.
 """
 import argparse
+import collections
 import sys
 import time
+
+import cv2
 
 import rclpy
 from rclpy.clock import Clock, ClockType
@@ -30,6 +40,7 @@ from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import CLOCK, CLOCK_QOS, robot_name, SIM_NODE_NAME
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
+from miro_sim_bullet.render.eye_pipeline import EyePipeline
 from miro_sim_bullet.render.renderer import RendererUnavailable
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.domain_guard import refuse_shared_domain, SharedDomain
@@ -70,12 +81,15 @@ class SimNode(Node):
             refuse_shared_domain(self, p.peer_check_s)
             self._clock_watch = ClockWatch(self, own=1)
         self.sim = SimWorld(p.world, physics_dt=p.physics_dt, robot_name=unnamed_robot)
-        self.cameras = Cameras(self.sim, p.renderer, log=self.get_logger().info,
-                               eye_workers=p.eye_workers)
+        self.cameras = Cameras(self.sim, p.renderer, log=self.get_logger().info)
+        self.eyes = EyePipeline(self.cameras, p.eye_workers, log=self.get_logger().info,
+                                warn=self.get_logger().warning)
         self.camera = CameraModel(p.frame_width, p.frame_height, p.lens, p.hfov_deg)
         self.paused = p.paused
         self.frames_published = 0
-        self.render_seconds = []  # wall time of each camera instant (all eyes)
+        self.render_seconds = []  # wall time of each camera instant (all eyes, drawn and encoded)
+        # Wall seconds per stage of the loop in this thread (the benchmark's profile).
+        self.stage_seconds = collections.Counter()
         ros = Endpoints.of(self)
         self.robots = {name: RobotInterface(name, ros, self._robot_lookup(name), self.warn)
                        for name in self.sim.robots}
@@ -107,6 +121,8 @@ class SimNode(Node):
             self.timer = self._make_timer()
         self.paused = params.paused
         self._restart_schedule(keep_time=True)
+        if params.paused:
+            self._publish_eyes(wait=True)  # nothing drawn is held back while paused
         if old.paused and not params.paused:
             # The overhead view shows the instant the run resumes (an episode's first video
             # frame is its start, whatever steps placed robot and ball before).
@@ -115,6 +131,7 @@ class SimNode(Node):
     # -- what the simulator's services do to time ---------------------------------------------
     def reset(self):
         """The world back to its initial state, time and schedule from zero."""
+        self._publish_eyes(wait=True)  # the instants before the reset come first
         self.sim.reset()
         self._restart_schedule()
         self.get_logger().info('world reset')
@@ -145,10 +162,13 @@ class SimNode(Node):
 
     def _on_timer(self):
         if self.paused:
+            if self.eyes.pending:  # paused by in-process code, not by the parameter
+                self._publish_eyes(wait=True)
             return
+        self.eyes.start_workers()
         rtf = self.params.real_time_factor
         if rtf == 0:
-            self.advance(self.sim.ticks_per_platform_tick)  # one tick: no bursts of frames
+            self._advance(self.sim.ticks_per_platform_tick, overlap=True)  # no bursts
         else:
             wall0, sim0 = self._anchor
             behind = sim0 + (time.monotonic() - wall0) * rtf - self.sim.time
@@ -156,7 +176,8 @@ class SimNode(Node):
                 self._anchor = (time.monotonic(), self.sim.time)
                 behind = 0.1
             if behind > 0:
-                self.advance(max(1, int(behind / self.sim.dt)))
+                self._advance(max(1, int(behind / self.sim.dt)), overlap=True)
+        self._publish_eyes(wait=False)
         self._report_progress()
 
     def _report_progress(self):
@@ -171,26 +192,45 @@ class SimNode(Node):
 
     def advance(self, steps):
         """Step physics, publishing /clock, sensors and ground truth each platform tick and
-        the cameras at camera_rate, all stamped with simulated time."""
+        the cameras at camera_rate, all stamped with simulated time; every image drawn is
+        published before this returns."""
+        self._advance(steps, overlap=False)
+        self._publish_eyes(wait=True)
+
+    def _advance(self, steps, overlap):
+        """advance(); with ``overlap``, the eyes are drawn while physics steps on and some
+        may still be on their way when this returns."""
         sim = self.sim
+        spent = self.stage_seconds
+        clock = time.perf_counter
         for _ in range(steps):
+            started = clock()
             sim.step()
-            # Images of an instant go out before its /clock, so a controller on sim time
-            # has them when its timer fires for that instant.
+            spent['physics'] += clock() - started
+            # Images of an instant go out before its /clock when drawn here, so a controller
+            # on sim time has them when its timer fires for that instant.
             if sim.step_index >= self._frame_step(self._next_frame):
-                self._publish_cameras()
+                self._publish_eyes(wait=True)  # the previous instant, before the next
+                self._submit_eyes(overlap)
                 while self._frame_step(self._next_frame) <= sim.step_index:
                     self._next_frame += 1
             if sim.step_index % sim.ticks_per_platform_tick == 0:
+                self._publish_eyes(wait=False)
+                started = clock()
                 self._publish_tick()
+                spent['sensor topics'] += clock() - started
             if sim.time >= self._next_scene:
+                started = clock()
                 self.scene.publish(convert.stamp(sim.time))
                 self._next_scene += 1.0 / SCENE_RATE_HZ
+                spent['scene'] += clock() - started
             rate = self.params.overhead_rate
             if rate > 0 and sim.time >= self._next_overhead:
+                started = clock()
                 self.sim_interface.publish_overhead(convert.stamp(sim.time),
                                                     self.params.jpeg_quality)
                 self._next_overhead += 1.0 / rate
+                spent['overhead'] += clock() - started
 
     # -- publishing ---------------------------------------------------------------------------
     def _publish_tick(self):
@@ -200,22 +240,37 @@ class SimNode(Node):
             interface.publish_tick(when)
         self.sim_interface.publish_ground_truth(when)
 
-    def _publish_cameras(self):
-        """Every eye someone subscribes to, of every robot, drawn together."""
-        wanted = [(interface, eye, side) for interface in self.robots.values()
-                  for eye, side in interface.wanted_eyes()]
-        if not wanted:
-            return
+    def _submit_eyes(self, overlap):
+        """Ask for every eye someone subscribes to, of every robot, drawn together."""
         when = convert.stamp(self.sim.time)
+        drawn = []
+        for interface in self.robots.values():
+            for eye, side, wants in interface.wanted_eyes():
+                if wants.jpeg or wants.raw:
+                    drawn.append((interface, eye, side, wants))
+                else:  # only camera_info: no image to draw
+                    interface.publish_eye(eye, (None, None), when, self.camera)
+        if drawn:
+            started = time.perf_counter()
+            views = self.cameras.eye_views([(i.robot, side) for i, _, side, _ in drawn])
+            self.eyes.submit((when, [(i, eye) for i, eye, _, _ in drawn]), views, self.camera,
+                             [wants for *_, wants in drawn], self.params.jpeg_quality,
+                             overlap)
+            self.stage_seconds['eyes: submit'] += time.perf_counter() - started
+            self._publish_eyes(wait=False)  # drawn here: out before this instant's /clock
+
+    def _publish_eyes(self, wait):
+        """Publish the instants whose eyes are done (``wait``: all of them)."""
         started = time.perf_counter()
-        images = self.cameras.render_eyes([(i.robot, side) for i, _, side in wanted],
-                                          self.camera)
-        for (interface, eye, _), rgb in zip(wanted, images):
-            interface.publish_eye(eye, rgb, when, self.camera, self.params.jpeg_quality)
-        self.frames_published += len(wanted)
-        self.render_seconds.append(time.perf_counter() - started)
+        for (when, eyes), frames, seconds in self.eyes.finished(wait):
+            for (interface, eye), frame in zip(eyes, frames):
+                interface.publish_eye(eye, frame, when, self.camera)
+            self.frames_published += len(eyes)
+            self.render_seconds.append(sum(seconds.values()))
+        self.stage_seconds['eyes: wait and publish'] += time.perf_counter() - started
 
     def destroy_node(self):
+        self.eyes.close()
         self.cameras.close()
         self.sim.close()
         super().destroy_node()
@@ -247,6 +302,9 @@ def make_executor(context=None):
 def main(argv=None):
     argv = sys.argv if argv is None else argv
     args = parse_args(user_args(argv, SIM_NODE_NAME))
+    # OpenCV's pool of one thread per core spun for 20-30 ms a simulated second on the
+    # other core, which the eye worker and the controllers need.
+    cv2.setNumThreads(1)
     overrides = [] if args.world is None else [Parameter('world', value=args.world)]
     # Ctrl+C and SIGTERM end the spin with the context still up (see stopping.py).
     stop = StopRequest()

@@ -41,7 +41,9 @@ class SimParams:
                                         'equidistant distortion in camera_info)'})
     renderer: str = field(default='auto', metadata={'help': ' | '.join(RENDERERS)})
     eye_workers: bool = field(
-        default=True, metadata={'help': 'with TinyRenderer, render eyes in 2 worker processes'})
+        default=True, metadata={'help': 'running on its timer, draw and encode the eyes in '
+                                        'helper processes while physics steps on (egl 1, '
+                                        'tiny 2); false: in the simulator thread'})
     jpeg_quality: int = field(default=80,
                               metadata={'help': 'JPEG quality of sensors/cam?/compressed',
                                         'range': (1, 100)})

@@ -12,7 +12,9 @@ from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.interface import SimTopics
 from miro_sim_bullet.render.overhead import overhead_camera
+from miro_sim_bullet.render.eye_images import jpeg_bytes
 from miro_sim_bullet.ros import convert
+from miro_sim_bullet.ros.endpoints import send_if_listened
 
 # ROS's default keeps 10 requests: a burst of 200 clients lost 190 answers.
 SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
@@ -74,15 +76,17 @@ class SimInterface:
         """Every movable object's and robot's pose, and the ball's centre, stamped when."""
         world = self.world
         for name, (position, orientation) in world.object_poses().items():
-            self.pub_objects[name].publish(convert.pose(position, orientation, when))
+            send_if_listened(self.pub_objects[name],
+                             lambda: convert.pose(position, orientation, when))
         for name, robot in world.robots.items():
-            self.pub_objects[name].publish(convert.robot_pose(*robot.ground_truth(), when))
-        ball = world.ball_position()
-        if ball is not None:
-            self.pub_ball.publish(convert.point(ball, when))
+            send_if_listened(self.pub_objects[name],
+                             lambda: convert.robot_pose(*robot.ground_truth(), when))
+        if world.ball_id is not None:
+            send_if_listened(self.pub_ball, lambda: convert.point(world.ball_position(), when))
 
     def publish_overhead(self, when, jpeg_quality):
         """The view from above, drawn only while someone subscribes."""
         if self.pub_overhead.get_subscription_count():
             rgb = self.cameras.render_view(*self.overhead)
-            self.pub_overhead.publish(convert.jpeg(rgb, when, OVERHEAD_FRAME, jpeg_quality))
+            self.pub_overhead.publish(convert.compressed_image(jpeg_bytes(rgb, jpeg_quality),
+                                                               when, OVERHEAD_FRAME))

@@ -1,0 +1,154 @@
+"""The eyes of each camera instant, drawn and encoded while the world steps on.
+
+The simulator asks for the eyes of instant t with submit() and takes finished ones with
+finished(). Drawn here (``overlap`` False, or before the workers are up) an instant is
+finished at once. With workers (render.eye_workers) it is drawn from a snapshot of
+instant t on the other core while physics goes on to t + dt: the same pixels, the same
+stamp, only later. The simulator bounds how much later: it waits for instant t before it
+submits the next one, and whenever it pauses or is stepped.
+
+If a worker dies, the instants it had are drawn here from their snapshots, on a copy of
+the world built for that, and the eyes are drawn in this thread from then on: no frame
+is lost.
+"""
+import collections
+import time
+
+from miro_sim_bullet.physics.world import SimWorld
+from miro_sim_bullet.render.cameras import Cameras
+from miro_sim_bullet.render.eye_images import draw_and_encode
+from miro_sim_bullet.render.eye_workers import EyeWorkers, WorkerLost
+
+WORKERS = {'egl': 1, 'tiny': 2}  # llvmpipe draws on one core; TinyRenderer is slower
+
+
+class EyePipeline:
+    """Eye images of ``cameras``' world (render.cameras.Cameras). ``use_workers``: draw in
+    helper processes once start_workers() was called and they are up. ``log`` takes
+    one-line notes, ``warn`` one-line warnings. ``seconds`` sums the wall time of each
+    stage: here (submit, wait) and in the workers (pose, draw, encode)."""
+
+    def __init__(self, cameras, use_workers=True, log=print, warn=print):
+        self.cameras = cameras
+        self.world = cameras.world
+        self.use_workers = use_workers
+        self.log, self.warn = log, warn
+        self.workers = None
+        self._in_flight = collections.deque()  # (tag, snapshot, views, camera, wants, quality)
+        self._finished = collections.deque()  # (tag, frames, seconds)
+        self._shadow = None  # a copy of the world to draw lost instants on
+        self.seconds = collections.Counter()
+
+    @property
+    def drawing_in_workers(self):
+        return self.workers is not None
+
+    def start_workers(self):
+        """Start the helper processes in the background, once (a no-op without workers)."""
+        if self.use_workers and self.workers is None:
+            kind = self.cameras.renderer.kind
+            world = self.world
+            self.workers = EyeWorkers(world.description, world.dt, world.robot_name, kind,
+                                      WORKERS[kind])
+            self.use_workers = False  # once: a failed start is not retried
+            self.log(f'eyes drawn in {WORKERS[kind]} helper process'
+                     f'{"es" if WORKERS[kind] > 1 else ""} while physics steps')
+
+    def submit(self, tag, views, camera, wants, quality, overlap=True):
+        """Ask for the eyes of this instant: OpenGL ``views`` through CameraModel ``camera``,
+        each encoded as its EyeWants says, JPEG at ``quality``. ``tag`` comes back with
+        them. Without ``overlap`` (or workers) they are drawn here and now."""
+        if not overlap and self._in_flight:
+            self._receive(wait=True)  # instants come out in the order they were asked for
+        started = time.perf_counter()
+        if overlap and self._workers_ready():
+            job = (tag, self.world.snapshot(), views, camera, wants, quality)
+            try:
+                self.workers.send(*job[1:])
+                self._in_flight.append(job)
+            except WorkerLost as exc:
+                self._lose_workers(exc)
+                overlap = False
+        else:
+            overlap = False
+        if not overlap:
+            self._finish_here(tag, views, camera, wants, quality)
+        self.seconds['submit'] += time.perf_counter() - started
+
+    def finished(self, wait=False):
+        """[(tag, frames, seconds)] of the instants done, oldest first; frames are
+        (jpeg bytes or None, raw RGB bytes or None) per view. ``wait``: all of them, waiting
+        for the workers."""
+        self._receive(wait)
+        done = list(self._finished)
+        self._finished.clear()
+        return done
+
+    def _receive(self, wait):
+        """Move the instants the workers have done (``wait``: all) to the finished ones."""
+        started = time.perf_counter()
+        while self._in_flight and (wait or self._workers_done()):
+            job = self._in_flight[0]
+            try:
+                frames, seconds = self.workers.receive()
+            except WorkerLost as exc:
+                self._lose_workers(exc)
+                break
+            self._in_flight.popleft()
+            self._finished.append((job[0], frames, seconds))
+            self.seconds.update(seconds)
+        self.seconds['wait'] += time.perf_counter() - started
+
+    @property
+    def pending(self):
+        """How many instants are still being drawn."""
+        return len(self._in_flight)
+
+    def _workers_ready(self):
+        if self.workers is None:
+            return False
+        try:
+            return self.workers.ready
+        except WorkerLost as exc:
+            self._lose_workers(exc)
+            return False
+
+    def _workers_done(self):
+        try:
+            return self.workers.done()
+        except WorkerLost as exc:
+            self._lose_workers(exc)
+            return False
+
+    def _finish_here(self, tag, views, camera, wants, quality):
+        seconds = {}
+        frames = draw_and_encode(self.cameras, views, camera, wants, quality, seconds)
+        self._finished.append((tag, frames, seconds))
+        self.seconds.update(seconds)
+
+    def _lose_workers(self, exc):
+        """Draw what the workers had here, on a copy of the world; no workers from now on."""
+        self.warn(f'{exc}: drawing the eyes in the simulator thread from now on')
+        self.workers.close()
+        self.workers = None
+        lost, self._in_flight = list(self._in_flight), collections.deque()
+        if lost and self._shadow is None:
+            world = self.world
+            copy = SimWorld(world.description, physics_dt=world.dt, robot_name=world.robot_name)
+            self._shadow = Cameras(copy, self.cameras.renderer.kind, log=lambda *_: None)
+        for tag, snapshot, views, camera, wants, quality in lost:
+            self._shadow.world.restore(snapshot)
+            seconds = {}
+            frames = draw_and_encode(self._shadow, views, camera, wants, quality, seconds)
+            self._finished.append((tag, frames, seconds))
+
+    def close(self):
+        """Stop the workers (what they still had is dropped). Idempotent."""
+        if self.workers is not None:
+            self.workers.close()
+            self.workers = None
+        self._in_flight.clear()
+        if self._shadow is not None:
+            self._shadow.close()
+            self._shadow.world.close()
+            self._shadow = None
