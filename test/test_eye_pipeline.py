@@ -82,7 +82,7 @@ def test_a_worker_that_dies_loses_no_instant(moving_world):
         workers.done()
     for process in workers.processes:
         os.kill(process.pid, signal.SIGKILL)
-        process.join()
+        process.wait()
     eyes_now(world, cameras, pipeline, camera, overlap=True, tag='lost')
     world.run(0.2)
     eyes_now(world, cameras, pipeline, camera, overlap=True, tag='after')

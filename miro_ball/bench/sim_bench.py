@@ -95,7 +95,8 @@ def measure(renderer, world, watched, sim_seconds, width, height, rate):
                 quiet_since = time.monotonic()
 
     # The node free-runs on its own timer, exactly as `-p real_time_factor:=0` does.
-    spin_until(lambda: len(received) >= 4 * watched)  # subscribed, rendering, warmed up
+    # Subscribed, rendering, warmed up, and the eye helpers (if any) taking the eyes.
+    spin_until(lambda: len(received) >= 4 * watched and node.eyes.settled)
     drain()
     published0, frames0, renders0 = node.frames_published, len(received), len(node.render_seconds)
     stages0, eyes0 = dict(node.stage_seconds), dict(node.eyes.seconds)
@@ -147,7 +148,7 @@ def run_once(args, env, renderer, world, watched, tree=None):
          '--world', world, '--watched', str(watched), '--seconds', str(args.seconds),
          '--size', args.size, '--rate', str(args.rate)],
         env=env if tree is None else baseline.environment(tree[0], env),
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        cwd=None if tree is None else tree[0], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     peak = (0.0, 0.0)
     while True:
         try:

@@ -48,15 +48,15 @@ def encode(image, wants, quality):
     return jpeg, raw
 
 
-def draw_and_encode(cameras, views, camera, wants, quality, seconds):
+def draw_and_encode(render, stages, views, camera, wants, quality, seconds):
     """Encoded images of the eyes at OpenGL ``views`` through CameraModel ``camera``, one
-    (jpeg, raw) per view as its EyeWants asks; ``seconds`` (a dict) gains the wall time
-    spent drawing ('draw', and the renderer's own stages as 'draw: <stage>') and encoding
-    ('encode')."""
-    stages = cameras.renderer.seconds
+    (jpeg, raw) per view as its EyeWants asks. render(views, camera, rgba) draws them;
+    ``stages`` is the renderer's own {stage: seconds} (Renderer.seconds). ``seconds`` (a
+    dict) gains the wall time spent drawing ('draw', and the renderer's stages as
+    'draw: <stage>') and encoding ('encode')."""
     before = dict(stages)
     started = time.perf_counter()
-    images = cameras.render_views(views, camera, rgba=True)
+    images = render(views, camera, rgba=True)
     drawn = time.perf_counter()
     frames = [encode(image, want, quality) for image, want in zip(images, wants)]
     spent = {'draw': drawn - started, 'encode': time.perf_counter() - drawn}

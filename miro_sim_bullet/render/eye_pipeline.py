@@ -1,25 +1,24 @@
 """The eyes of each camera instant, drawn and encoded while the world steps on.
 
 The simulator asks for the eyes of instant t with submit() and takes finished ones with
-finished(). Drawn here (``overlap`` False, or before the workers are up) an instant is
-finished at once. With workers (render.eye_workers) it is drawn from a snapshot of
+finished(). Drawn here (``overlap`` False, or without workers) an instant is finished at
+once; the first instant for the workers waits for them to come up. With workers (render.eye_workers) it is drawn from a snapshot of
 instant t on the other core while physics goes on to t + dt: the same pixels, the same
 stamp, only later. The simulator bounds how much later: it waits for instant t before it
 submits the next one, and whenever it pauses or is stepped.
 
-If a worker dies, the instants it had are drawn here from their snapshots, on a copy of
-the world built for that, and the eyes are drawn in this thread from then on: no frame
-is lost.
+If a worker dies, the instants it had are drawn here from the state they were sent, the
+way the worker would have, and the eyes are drawn in this thread from then on: no frame is
+lost.
 """
 import collections
 import time
 
-from miro_sim_bullet.physics.world import SimWorld
-from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.eye_images import draw_and_encode
-from miro_sim_bullet.render.eye_workers import EyeWorkers, WorkerLost
+from miro_sim_bullet.render.eye_workers import draw_job, EyeWorkers, make_drawer, WorkerLost
 
 WORKERS = {'egl': 1, 'tiny': 2}  # llvmpipe draws on one core; TinyRenderer is slower
+STARTUP_S = 30.0  # a worker is up in ~0.3 s here; one that is not after this never will be
 
 
 class EyePipeline:
@@ -34,22 +33,27 @@ class EyePipeline:
         self.use_workers = use_workers
         self.log, self.warn = log, warn
         self.workers = None
-        self._in_flight = collections.deque()  # (tag, snapshot, views, camera, wants, quality)
+        self._setup = None  # (generation, setup) the workers draw with
+        self._in_flight = collections.deque()  # (tag, setup, state, views, camera, wants, quality)
         self._finished = collections.deque()  # (tag, frames, seconds)
-        self._shadow = None  # a copy of the world to draw lost instants on
         self.seconds = collections.Counter()
 
     @property
     def drawing_in_workers(self):
         return self.workers is not None
 
+    @property
+    def settled(self):
+        """Whether the eyes are drawn where they will be from now on: the workers are up,
+        or there are none (never blocks)."""
+        return self.workers is None or self._workers_ready()
+
     def start_workers(self):
         """Start the helper processes in the background, once (a no-op without workers)."""
         if self.use_workers and self.workers is None:
             kind = self.cameras.renderer.kind
-            world = self.world
-            self.workers = EyeWorkers(world.description, world.dt, world.robot_name, kind,
-                                      WORKERS[kind])
+            self._setup = self.cameras.helper_setup()
+            self.workers = EyeWorkers(self._setup[1], WORKERS[kind])
             self.use_workers = False  # once: a failed start is not retried
             self.log(f'eyes drawn in {WORKERS[kind]} helper process'
                      f'{"es" if WORKERS[kind] > 1 else ""} while physics steps')
@@ -61,10 +65,14 @@ class EyePipeline:
         if not overlap and self._in_flight:
             self._receive(wait=True)  # instants come out in the order they were asked for
         started = time.perf_counter()
-        if overlap and self._workers_ready():
-            job = (tag, self.world.snapshot(), views, camera, wants, quality)
+        if overlap and self._workers_ready(wait=True):
             try:
-                self.workers.send(*job[1:])
+                if self._setup[0] != self.world.generation:  # the world was rebuilt
+                    self._setup = self.cameras.helper_setup()
+                    self.workers.set_up(self._setup[1])
+                job = (tag, self._setup[1], self.cameras.helper_state(), views, camera, wants,
+                       quality)
+                self.workers.send(*job[2:])
                 self._in_flight.append(job)
             except WorkerLost as exc:
                 self._lose_workers(exc)
@@ -104,11 +112,21 @@ class EyePipeline:
         """How many instants are still being drawn."""
         return len(self._in_flight)
 
-    def _workers_ready(self):
+    def _workers_ready(self, wait=False):
+        """Whether the workers can take a job; ``wait``: for them to come up, at most
+        STARTUP_S (their first instant waits, rather than have this process make a GL
+        context of its own for the few instants before)."""
         if self.workers is None:
             return False
+        deadline = time.monotonic() + STARTUP_S
         try:
-            return self.workers.ready
+            while not self.workers.ready:
+                if not wait:
+                    return False
+                if time.monotonic() > deadline:
+                    raise WorkerLost(f'eye workers not up after {STARTUP_S:g} s')
+                time.sleep(0.01)
+            return True
         except WorkerLost as exc:
             self._lose_workers(exc)
             return False
@@ -122,25 +140,27 @@ class EyePipeline:
 
     def _finish_here(self, tag, views, camera, wants, quality):
         seconds = {}
-        frames = draw_and_encode(self.cameras, views, camera, wants, quality, seconds)
+        frames = draw_and_encode(self.cameras.render_views, self.cameras.renderer.seconds,
+                                 views, camera, wants, quality, seconds)
         self._finished.append((tag, frames, seconds))
         self.seconds.update(seconds)
 
     def _lose_workers(self, exc):
-        """Draw what the workers had here, on a copy of the world; no workers from now on."""
+        """Draw what the workers had here, as they would have; no workers from now on."""
         self.warn(f'{exc}: drawing the eyes in the simulator thread from now on')
         self.workers.close()
         self.workers = None
         lost, self._in_flight = list(self._in_flight), collections.deque()
-        if lost and self._shadow is None:
-            world = self.world
-            copy = SimWorld(world.description, physics_dt=world.dt, robot_name=world.robot_name)
-            self._shadow = Cameras(copy, self.cameras.renderer.kind, log=lambda *_: None)
-        for tag, snapshot, views, camera, wants, quality in lost:
-            self._shadow.world.restore(snapshot)
-            seconds = {}
-            frames = draw_and_encode(self._shadow, views, camera, wants, quality, seconds)
-            self._finished.append((tag, frames, seconds))
+        drawers = {}  # one per setup: what a worker had, made here
+        try:
+            for tag, setup, *job in lost:
+                if id(setup) not in drawers:
+                    drawers[id(setup)] = make_drawer(setup)
+                frames, seconds = draw_job(drawers[id(setup)], *job)
+                self._finished.append((tag, frames, seconds))
+        finally:
+            for drawer in drawers.values():
+                drawer.close()
 
     def close(self):
         """Stop the workers (what they still had is dropped). Idempotent."""
@@ -148,7 +168,3 @@ class EyePipeline:
             self.workers.close()
             self.workers = None
         self._in_flight.clear()
-        if self._shadow is not None:
-            self._shadow.close()
-            self._shadow.world.close()
-            self._shadow = None

@@ -1,53 +1,111 @@
 """Helper processes that draw and encode the eyes while the simulator steps on.
 
 pybullet and moderngl hold the GIL while they work, so a thread would not overlap them:
-each worker is a process with a copy of the world (built from the same description, so
-body ids match). It is sent a snapshot of everything that moves at a camera instant,
-poses its copy so, draws its share of the views and sends back the encoded images
-(render.eye_images: the same bytes the simulator's thread would make).
+each worker is a process of its own, a fresh ``python -m`` of this module (no fork of DDS
+or render threads, none of the simulator's modules). It is set up once with what the
+simulator's Cameras.helper_setup() gives and draws each camera instant from
+Cameras.helper_state():
 
-Workers start in the background (spawned: no fork of DDS or render threads); ``ready``
-says when they can take jobs. A job is split between the workers, view k to worker
-k mod n; results come back in the order jobs were sent.
+* egl: the scene's layout, then the rows of the moving instances each instant. The worker
+  draws with our GL renderer alone; it has no PyBullet world (that would cost ~50 MB).
+* tiny: the world's description, from which it builds a copy (same body ids), then a
+  snapshot of everything that moves each instant, to pose the copy and draw it.
+
+It sends back the encoded images (render.eye_images: the same bytes the simulator's thread
+would make). ``ready`` says when the workers can take jobs. A job is split between the
+workers, view k to worker k mod n; results come back in the order jobs were sent.
 """
 import multiprocessing
-import time
+import subprocess
+import sys
+from multiprocessing.connection import Connection
 
 import cv2
 
 from miro_sim_bullet.physics.world import SimWorld
-from miro_sim_bullet.render.cameras import Cameras
+from miro_sim_bullet.render.cameras import Cameras, LensPlans, through_lens
 from miro_sim_bullet.render.eye_images import draw_and_encode
+from miro_sim_bullet.render.gl_renderer import GlBackend
+from miro_sim_bullet.render.renderer import draw_rows
 
 
 class WorkerLost(RuntimeError):
     """A worker process ended or stopped answering; the message says which."""
 
 
-class EyeWorkers:
-    """``count`` worker processes drawing with renderer ``kind`` ('egl' or 'tiny')."""
+class GlDrawer:
+    """Draws a SceneLayout with the moving rows it is given (egl), no PyBullet needed."""
 
-    def __init__(self, world, physics_dt, robot_name, kind, count):
-        context = multiprocessing.get_context('spawn')
-        self.kind = kind
+    def __init__(self, layout):
+        self.gl = GlBackend(layout)
+        self.seconds = self.gl.seconds
+        self._plans = LensPlans()
+
+    def render_views(self, moving_rows, views, camera, rgba):
+        drawn, maps = self._plans[camera]
+        return through_lens(draw_rows(self.gl, moving_rows, views, drawn, rgba), maps)
+
+    def close(self):
+        self.gl.close()
+
+
+class WorldCopyDrawer:
+    """Draws a copy of the world posed from each snapshot (tiny)."""
+
+    def __init__(self, description, physics_dt, robot_name):
+        self.world = SimWorld(description, physics_dt=physics_dt, robot_name=robot_name)
+        self.cameras = Cameras(self.world, 'tiny', log=lambda *_: None)
+        self.seconds = self.cameras.renderer.seconds
+
+    def render_views(self, snapshot, views, camera, rgba):
+        self.world.restore(snapshot)
+        return self.cameras.render_views(views, camera, rgba)
+
+    def close(self):
+        self.cameras.close()
+        self.world.close()
+
+
+def make_drawer(setup):
+    """The drawer of a Cameras.helper_setup() setup."""
+    kind, *args = setup
+    return GlDrawer(*args) if kind == 'egl' else WorldCopyDrawer(*args)
+
+
+def draw_job(drawer, state, views, camera, wants, quality):
+    """(frames, {stage: seconds}) of one instant's share of views."""
+    seconds = {}
+    frames = draw_and_encode(
+        lambda views_, camera_, rgba: drawer.render_views(state, views_, camera_, rgba),
+        drawer.seconds, views, camera, wants, quality, seconds)
+    return frames, seconds
+
+
+class EyeWorkers:
+    """``count`` worker processes drawing as ``setup`` (Cameras.helper_setup()) says."""
+
+    def __init__(self, setup, count):
         self.connections, self.processes = [], []
         self._started = [False] * count
         for _ in range(count):
-            parent, child = context.Pipe()
-            process = context.Process(target=_serve,
-                                      args=(child, world, physics_dt, robot_name, kind),
-                                      daemon=True, name='miro_eye_worker')
-            process.start()
+            parent, child = multiprocessing.Pipe()
+            process = subprocess.Popen(
+                [sys.executable, '-m', __name__, str(child.fileno())],
+                pass_fds=(child.fileno(),), stdin=subprocess.DEVNULL,
+                # Out of the terminal's process group: Ctrl+C stops the simulator, which
+                # stops its workers (they also end when its end of the pipe closes).
+                start_new_session=True)
             child.close()
             self.connections.append(parent)
             self.processes.append(process)
+        self.set_up(setup)
 
     @property
     def ready(self):
-        """Whether every worker has built its world and renderer (never blocks)."""
-        for k, connection in enumerate(self.connections):
+        """Whether every worker has made its drawer (never blocks)."""
+        for k in range(len(self.connections)):
             if not self._started[k]:
-                if not self._poll(k, 0):
+                if not self._poll(k):
                     return False
                 message = self._recv(k)
                 if message != 'ready':
@@ -55,23 +113,27 @@ class EyeWorkers:
                 self._started[k] = True
         return True
 
-    def send(self, snapshot, views, camera, wants, quality):
+    def set_up(self, setup):
+        """Draw as ``setup`` says from the next job on (a world rebuilt by a reset)."""
+        self._send_all([('setup', setup)] * len(self.connections))
+
+    def send(self, state, views, camera, wants, quality):
         """Give every worker its share of one camera instant's views."""
         count = len(self.connections)
-        for k, connection in enumerate(self.connections):
-            try:
-                connection.send((snapshot, views[k::count], camera, wants[k::count], quality))
-            except (BrokenPipeError, OSError) as exc:
-                raise WorkerLost(f'eye worker {k} is gone ({exc})') from None
+        self._send_all([('draw', state, views[k::count], camera, wants[k::count], quality)
+                        for k in range(count)])
 
     def done(self):
         """Whether the oldest job sent has come back from every worker (never blocks)."""
-        return all(self._poll(k, 0) for k in range(len(self.connections)))
+        return all(self._poll(k) for k in range(len(self.connections)))
 
     def receive(self):
         """(frames in view order, {stage: seconds} summed over the workers) of the oldest
         job sent; blocks until it is back."""
         shares = [self._recv(k) for k in range(len(self.connections))]
+        for k, share in enumerate(shares):
+            if isinstance(share, str):  # a setup it could not make
+                raise WorkerLost(f'eye worker {k} stopped: {share}')
         count = len(shares)
         frames = [None] * sum(len(share) for share, _ in shares)
         seconds = {}
@@ -81,23 +143,30 @@ class EyeWorkers:
                 seconds[stage] = seconds.get(stage, 0.0) + value
         return frames, seconds
 
-    def _poll(self, k, timeout):
+    def _send_all(self, messages):
+        for k, (connection, message) in enumerate(zip(self.connections, messages)):
+            try:
+                connection.send(message)
+            except (BrokenPipeError, OSError) as exc:
+                raise WorkerLost(f'eye worker {k} is gone ({_reason(exc)})') from None
+
+    def _poll(self, k):
         try:
-            return self.connections[k].poll(timeout)
+            return self.connections[k].poll(0)
         except (EOFError, OSError) as exc:
-            raise WorkerLost(f'eye worker {k} is gone ({exc})') from None
+            raise WorkerLost(f'eye worker {k} is gone ({_reason(exc)})') from None
 
     def _recv(self, k):
         connection, process = self.connections[k], self.processes[k]
-        # A worker that dies mid-job leaves the pipe open only as long as it lives: look
-        # at it now and then rather than wait forever.
+        # A worker that dies mid-job closes its end of the pipe; one that hangs does not:
+        # look at it now and then rather than wait forever.
         while not connection.poll(1.0):
-            if not process.is_alive():
-                raise WorkerLost(f'eye worker {k} ended (exit code {process.exitcode})')
+            if process.poll() is not None:
+                raise WorkerLost(f'eye worker {k} ended (exit code {process.returncode})')
         try:
             return connection.recv()
         except (EOFError, OSError) as exc:
-            raise WorkerLost(f'eye worker {k} is gone ({exc})') from None
+            raise WorkerLost(f'eye worker {k} is gone ({_reason(exc)})') from None
 
     def close(self):
         for connection in self.connections:
@@ -106,36 +175,49 @@ class EyeWorkers:
             except (BrokenPipeError, OSError):
                 pass
         for process in self.processes:
-            process.join(timeout=5)
-            if process.is_alive():
+            try:
+                process.wait(timeout=5)
+            except subprocess.TimeoutExpired:
                 process.kill()
+                process.wait()
         for connection in self.connections:
             connection.close()
         self.connections, self.processes = [], []
 
 
-def _serve(connection, world, physics_dt, robot_name, kind):
+def _reason(exc):
+    return str(exc) or type(exc).__name__
+
+
+def serve(connection):
+    """A worker's life: a drawer per setup, a reply per job, until told to stop or the
+    simulator's end of the pipe closes."""
     cv2.setNumThreads(1)  # one core per worker: the simulator has the other
-    try:
-        sim = SimWorld(world, physics_dt=physics_dt, robot_name=robot_name)
-        cameras = Cameras(sim, kind, log=lambda *_: None)
-    except Exception as exc:  # told to the simulator, which draws the eyes itself then
-        connection.send(' '.join(str(exc).split()) or type(exc).__name__)
-        return
-    connection.send('ready')
+    drawer = None
     try:
         while True:
-            job = connection.recv()
-            if job is None:
+            message = connection.recv()
+            if message is None:
                 break
-            snapshot, views, camera, wants, quality = job
-            started = time.perf_counter()
-            sim.restore(snapshot)
-            seconds = {'pose': time.perf_counter() - started}
-            frames = draw_and_encode(cameras, views, camera, wants, quality, seconds)
-            connection.send((frames, seconds))
+            if message[0] == 'setup':
+                first = drawer is None
+                if drawer is not None:
+                    drawer.close()
+                try:
+                    drawer = make_drawer(message[1])
+                except Exception as exc:  # the simulator draws the eyes itself then
+                    connection.send(' '.join(str(exc).split()) or type(exc).__name__)
+                    break
+                if first:
+                    connection.send('ready')
+            else:
+                connection.send(draw_job(drawer, *message[1:]))
     except (EOFError, OSError, KeyboardInterrupt):
         pass  # the simulator went away (stopped, or interrupted mid-frame)
     finally:
-        cameras.close()
-        sim.close()
+        if drawer is not None:
+            drawer.close()
+
+
+if __name__ == '__main__':
+    serve(Connection(int(sys.argv[1])))

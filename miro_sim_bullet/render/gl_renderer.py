@@ -16,6 +16,7 @@ import functools
 import math
 import os
 import time
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -189,17 +190,27 @@ def _load_rgb(path):
 
 # ------------------------------------------------------------------------ the renderer
 
-@functools.lru_cache(maxsize=1)
 def probe_egl():
     """(ok, one-line reason): whether an EGL OpenGL 3.3 context can be made here. Decided
     once per process; a failing EGL raises in moderngl, it does not end the process."""
+    ok, reason, _ = _probe()
+    return ok, reason
+
+
+def egl_device():
+    """The GL_RENDERER of this process's EGL contexts (None if there are none)."""
+    return _probe()[2]
+
+
+@functools.lru_cache(maxsize=1)
+def _probe():
     try:
         context = _create_context()
     except GlUnavailable as exc:
-        return False, str(exc)
+        return False, str(exc), None
     name = context.info['GL_RENDERER']
     context.release()
-    return True, f'EGL works: {name}'
+    return True, f'EGL works: {name}', name
 
 
 def _create_context():
@@ -217,13 +228,43 @@ def _create_context():
         raise GlUnavailable(f'no EGL OpenGL 3.3 context: {reason}') from None
 
 
-class GlBackend:
-    """Draws one PyBullet client's visual shapes and ``pictures`` (World.pictures); call
-    scene_changed() after the client's bodies were rebuilt (a world reset)."""
+@dataclass(frozen=True)
+class SceneLayout:
+    """What the GL renderer keeps of a world between frames: the mesh (index into
+    visuals.MESHES) of every instance, static ones first, the static instances' rows (n, 18)
+    and the pictures (World.pictures). Plain data: a process without PyBullet can draw
+    from it, given each frame's moving rows."""
+
+    meshes: np.ndarray
+    static_rows: np.ndarray
+    pictures: tuple
+
+
+class ClientScene:
+    """A PyBullet client's visual shapes as the GL renderer draws them: ``layout``, and
+    moving_rows() of each instant. Make a new one after the client's bodies were rebuilt."""
 
     def __init__(self, client_id, pictures=()):
-        self.client_id = client_id
-        self.pictures = tuple(pictures)
+        bodies = client_visuals(client_id)
+        static = [b for b in bodies if b.static]
+        self.moving = [b for b in bodies if not b.static]
+        self.layout = SceneLayout(
+            meshes=np.concatenate([b.mesh for b in static + self.moving] or [np.empty(0, int)]),
+            static_rows=np.concatenate([_instances(b) for b in static]
+                                       or [np.empty((0, 18), 'f4')]),
+            pictures=tuple(pictures))
+
+    def moving_rows(self):
+        """(n, 18) float32 rows of the moving instances as they are now."""
+        return np.concatenate([_instances(b) for b in self.moving]
+                              or [np.empty((0, 18), 'f4')])
+
+
+class GlBackend:
+    """Draws a SceneLayout with the moving rows of an instant; set_layout() after the
+    world was rebuilt (a reset)."""
+
+    def __init__(self, layout, seconds=None):
         self.ctx = _create_context()
         self.device = self.ctx.info['GL_RENDERER']
         sun = -np.asarray(SUN_DIRECTION) / np.linalg.norm(SUN_DIRECTION)
@@ -242,22 +283,19 @@ class GlBackend:
         self.max_height = self.ctx.info['GL_MAX_RENDERBUFFER_SIZE']
         self.max_height = min(self.max_height, self.ctx.info['GL_MAX_VIEWPORT_DIMS'][1])
         self._framebuffers = {}
-        self.seconds = collections.Counter()  # wall time per stage of drawing, summed
-        self._read_scene()
-
-    def scene_changed(self):
-        """Read the client's bodies and visual shapes again."""
+        # Wall time per stage of drawing, summed (into the caller's counter, if given).
+        self.seconds = collections.Counter() if seconds is None else seconds
         with self.ctx:
-            self._read_scene()
+            self._read_layout(layout)
 
-    def _read_scene(self):
-        bodies = client_visuals(self.client_id)
-        self.static = [b for b in bodies if b.static]
-        self.moving = [b for b in bodies if not b.static]
-        self.static_rows = np.concatenate([_instances(b) for b in self.static]
-                                          or [np.empty((0, 18), 'f4')])
-        meshes = np.concatenate([b.mesh for b in self.static + self.moving]
-                                or [np.empty(0, int)])
+    def set_layout(self, layout):
+        """Draw this SceneLayout from now on."""
+        with self.ctx:
+            self._read_layout(layout)
+
+    def _read_layout(self, layout):
+        self.layout = layout
+        meshes = layout.meshes
         self._release_vaos()
         # The instance counts are fixed until the next rebuild: one buffer and vertex
         # array per mesh, rewritten every frame.
@@ -272,13 +310,13 @@ class GlBackend:
                                (buffer, _INSTANCE_FORMAT, *_INSTANCE_ATTRIBUTES)],
                 index_buffer=indices)
             self.by_mesh.append((chosen, buffer, vao))
-        self._read_pictures()
+        self._read_pictures(layout.pictures)
 
-    def _read_pictures(self):
+    def _read_pictures(self, pictures):
         """A texture per image file and a vertex array of every quad that shows it."""
         import moderngl
         by_image = {}
-        for picture in self.pictures:
+        for picture in pictures:
             by_image.setdefault(picture.image, []).append(picture)
         self.by_texture = []
         for image, pictures in by_image.items():
@@ -307,9 +345,9 @@ class GlBackend:
             texture.release()
         self.by_texture = []
 
-    def _upload_instances(self):
+    def _upload_instances(self, moving_rows):
         """Write this instant's poses and colours into the instance buffers."""
-        rows = np.concatenate([self.static_rows, *(_instances(b) for b in self.moving)])
+        rows = np.concatenate([self.layout.static_rows, moving_rows])
         for chosen, buffer, _ in self.by_mesh:
             buffer.write(rows[chosen].tobytes())
 
@@ -325,18 +363,20 @@ class GlBackend:
             self._framebuffers[key] = (fbo, colour, depth)
         return self._framebuffers[key][0]
 
-    def render_views(self, view_projections, width, height, components=3):
-        """RGB images (height, width, 3) uint8 (RGBA with components=4), one per
+    def render_views(self, moving_rows, view_projections, width, height, components=3):
+        """RGB images (height, width, 3) uint8 (RGBA with components=4) of the layout with
+        the moving instances at ``moving_rows`` (ClientScene.moving_rows()), one per
         column-major 4x4 view-projection matrix (already flipped vertically), drawn in as
         few passes as fit."""
         with self.ctx:  # current in this thread for the call: any thread may render
-            return self._render_views(view_projections, width, height, components)
+            return self._render_views(moving_rows, view_projections, width, height,
+                                      components)
 
-    def _render_views(self, view_projections, width, height, components):
+    def _render_views(self, moving_rows, view_projections, width, height, components):
         import moderngl
         clock = time.perf_counter
         started = clock()
-        self._upload_instances()
+        self._upload_instances(moving_rows)
         uploaded = clock()
         self.seconds['upload'] += uploaded - started
         per_pass = max(1, self.max_height // height)

@@ -10,13 +10,14 @@ Two back ends:
 'auto' picks ``egl`` when an EGL context can be made here (:func:`probe_egl`), else
 ``tiny`` with one log line saying why.
 """
+import collections
 import functools
 
 import cv2
 import numpy as np
 
 from miro_sim_bullet.bullet import pybullet as p
-from miro_sim_bullet.render.gl_renderer import GlBackend, GlUnavailable, probe_egl, \
+from miro_sim_bullet.render.gl_renderer import ClientScene, egl_device, GlBackend, probe_egl, \
     view_projection
 
 _FLAGS = p.ER_NO_SEGMENTATION_MASK
@@ -99,26 +100,43 @@ class _TinyBackend:
 
 
 class _GlBackend:
-    """:class:`gl_renderer.GlBackend` behind the same interface as _TinyBackend."""
+    """:class:`gl_renderer.GlBackend` behind the same interface as _TinyBackend. Its GL
+    context is made at the first image: a simulator whose eyes are drawn in helper
+    processes needs only the scene's layout and rows here (and saves ~35 MB)."""
 
     kind = 'egl'
 
     def __init__(self, client_id, pictures=()):
-        self.gl = GlBackend(client_id, pictures)
+        self.client_id, self.pictures = client_id, tuple(pictures)
+        self.scene = ClientScene(client_id, self.pictures)
+        self.gl = None
+        self.seconds = collections.Counter()
         self.name = 'egl'
-        self.device = self.gl.device
+        self.device = egl_device()
 
     def render_views(self, views, intrinsics, rgba=False):
-        projection = _projection(intrinsics, (0.0, 0.0))
-        return self.gl.render_views([view_projection(view, projection) for view in views],
-                                    intrinsics.width, intrinsics.height,
-                                    components=4 if rgba else 3)
+        if self.gl is None:
+            self.gl = GlBackend(self.scene.layout, self.seconds)
+        return draw_rows(self.gl, self.scene.moving_rows(), views, intrinsics, rgba)
 
     def scene_changed(self):
-        self.gl.scene_changed()
+        self.scene = ClientScene(self.client_id, self.pictures)
+        if self.gl is not None:
+            self.gl.set_layout(self.scene.layout)
 
     def close(self):
-        self.gl.close()
+        if self.gl is not None:
+            self.gl.close()
+            self.gl = None
+
+
+def draw_rows(gl, moving_rows, views, intrinsics, rgba=False):
+    """Images from a GlBackend of its layout with ``moving_rows``, from OpenGL view matrices
+    through pinhole ``intrinsics``: what the egl renderer draws, also where no PyBullet
+    client is (render.eye_workers)."""
+    projection = _projection(intrinsics, (0.0, 0.0))
+    return gl.render_views(moving_rows, [view_projection(view, projection) for view in views],
+                           intrinsics.width, intrinsics.height, components=4 if rgba else 3)
 
 
 @functools.lru_cache(maxsize=32)
@@ -149,7 +167,7 @@ class Renderer:
         self.kind = self.name = self._backend.kind
         self.device = getattr(self._backend, 'device', None)
         # Wall seconds per stage of drawing (upload, draw calls, read back), egl only.
-        self.seconds = getattr(getattr(self._backend, 'gl', None), 'seconds', {})
+        self.seconds = getattr(self._backend, 'seconds', {})
         log(f'camera renderer: {self.name} ({note})')
         if not p.isNumpyEnabled():
             log('pybullet was built without numpy: images cost ~30 ms more each at 640x360')
@@ -160,11 +178,8 @@ class Renderer:
             return _TinyBackend(self.client_id), 'requested'
         ok, reason = probe_egl()
         if ok:
-            try:
-                backend = _GlBackend(self.client_id, self.pictures)
-                return backend, f'rendering on {backend.device}'
-            except GlUnavailable as exc:
-                reason = str(exc)
+            backend = _GlBackend(self.client_id, self.pictures)
+            return backend, f'rendering on {backend.device}'
         if kind == 'egl':
             raise RendererUnavailable(reason)
         return _TinyBackend(self.client_id), f'{reason}; falling back to TinyRenderer'
@@ -172,6 +187,15 @@ class Renderer:
     def scene_changed(self):
         """The client's bodies were rebuilt or added to: read them again."""
         self._backend.scene_changed()
+
+    @property
+    def layout(self):
+        """egl: the gl_renderer.SceneLayout drawn (what stays between frames)."""
+        return self._backend.scene.layout
+
+    def moving_rows(self):
+        """egl: the rows of the moving instances now (what changes between frames)."""
+        return self._backend.scene.moving_rows()
 
     def render(self, view_matrix, intrinsics):
         """RGB image (height, width, 3) uint8 seen through ``intrinsics`` from
