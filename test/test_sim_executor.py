@@ -88,3 +88,28 @@ def test_services_answer_while_free_running(running):
     assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=False)).success
     assert spin_until(executor, lambda: node.sim.time > 0.5, 60)
     assert math.isfinite(node.sim.robot.pose()[0])
+
+
+def test_eyes_drawn_beside_physics_come_at_most_one_camera_period_late(running):
+    node, executor, probe = running
+    eyes = {eye: probe.watch(CompressedImage, T.eye_compressed(eye)) for eye in EYES}
+    late = []  # simulated seconds between an image's instant and its publication
+    for interface in node.robots.values():
+        def recording(eye, frame, when, camera, publish=interface.publish_eye):
+            late.append(node.sim.time - (when.sec + when.nanosec * 1e-9))
+            publish(eye, frame, when, camera)
+        interface.publish_eye = recording
+    assert spin_until(executor, lambda: node.sim.time >= 2.0
+                      and all(len(f) >= 10 for f in eyes.values()), 120)
+    assert node.eyes.drawing_in_workers  # the helper process took the eyes
+    # Each came after its instant (drawn while physics stepped on), none more than one
+    # camera period after it.
+    assert min(late) > 0
+    assert max(late) <= 1 / node.params.camera_rate + 1e-9
+    # Paused, nothing is held back: every image drawn is out.
+    assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True)).success
+    assert node.eyes.pending == 0
+    assert spin_until(executor, lambda: sum(map(len, eyes.values())) == node.frames_published,
+                      10)
+    left, right = ([stamp_s(m) for m in eyes[eye]] for eye in EYES)
+    assert left == right and left == sorted(left)
