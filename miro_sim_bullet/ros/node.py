@@ -87,7 +87,8 @@ class SimNode(Node):
         self.camera = CameraModel(p.frame_width, p.frame_height, p.lens, p.hfov_deg)
         self.paused = p.paused
         self.frames_published = 0
-        self.render_seconds = []  # wall time of each camera instant (all eyes, drawn and encoded)
+        # Seconds spent drawing and encoding each camera instant (summed over helper processes).
+        self.render_seconds = []
         # Wall seconds per stage of the loop in this thread (the benchmark's profile).
         self.stage_seconds = collections.Counter()
         ros = Endpoints.of(self)
