@@ -17,9 +17,9 @@ the world-file table they come from (``wall``, ``ring``, ``table``, ``box``, ``g
 ``picture``). A robot's markers carry the link's name in ``text``.
 """
 import hashlib
+import math
 from pathlib import Path
 
-import numpy as np
 from builtin_interfaces.msg import Duration
 from geometry_msgs.msg import Point
 from sensor_msgs.msg import CompressedImage
@@ -28,6 +28,7 @@ from visualization_msgs.msg import Marker, MarkerArray, UVCoordinate
 
 from miro_ball.miro.constants import LINK_NAMES
 from miro_ball.miro.interface import frame_id, WORLD_FRAME
+from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.render.visuals import BodyVisuals, MESHES
 from miro_sim_bullet.ros.frames import quaternion
 
@@ -93,7 +94,7 @@ class SceneMarkers:
         self.visuals = {body: BodyVisuals(world.client, body) for body in self.labels}
         self.robot_bodies = {robot.body_id: name for name, robot in world.robots.items()}
         self.movers = {body: ns for body, (ns, kind) in self.labels.items() if kind == 'mover'}
-        self._sent = {}  # mover body -> (position, quaternion) last sent
+        self._sent = {}  # mover body -> its base's (position, quaternion) last sent
         self._colours = None
 
     # -- the layout ---------------------------------------------------------------------------
@@ -139,25 +140,28 @@ class SceneMarkers:
     # -- the movers ---------------------------------------------------------------------------
     def movers_if_moved(self):
         """MarkerArray of every movable object if any moved since last sent, else None."""
-        poses = {}
-        moved = False
-        for body in self.movers:
-            rotations, positions = self.visuals[body].world_poses()
-            q = np.asarray(quaternion(rotations[0]))
-            poses[body] = (rotations, positions, q)
-            last = self._sent.get(body)
-            if last is None or np.linalg.norm(positions[0] - last[0]) > MOVED_M \
-                    or 1.0 - abs(float(q @ last[1])) > TURNED:
-                moved = True
-        if not moved:
+        # A look at the bases' poses is all it takes to know (0.01 ms a look, where the
+        # shapes' poses took 0.2: 6 % of the simulator's time at 30 looks a simulated second).
+        poses = {body: pb.getBasePositionAndOrientation(body, physicsClientId=self.world.client)
+                 for body in self.movers}
+        if not any(self._moved(body, pose) for body, pose in poses.items()):
             return None
         markers = []
-        for body, (rotations, positions, q) in poses.items():
+        for body, pose in poses.items():
             visuals = self.visuals[body]
+            rotations, positions = visuals.world_poses()
             colours = visuals.colours()
             for k in range(len(visuals.mesh)):
                 markers.append(_place(_shape_marker(visuals.mesh[k], visuals.scale[k],
                                                     colours[k], WORLD_FRAME, self.movers[body],
                                                     k), rotations[k], positions[k]))
-            self._sent[body] = (positions[0], q)
+            self._sent[body] = pose
         return MarkerArray(markers=markers)
+
+    def _moved(self, body, pose):
+        last = self._sent.get(body)
+        if last is None:
+            return True
+        (position, orientation), (was_at, was_turned) = pose, last
+        turned = 1.0 - abs(sum(a * b for a, b in zip(orientation, was_turned)))
+        return math.dist(position, was_at) > MOVED_M or turned > TURNED
