@@ -166,7 +166,6 @@ class SimNode(Node):
             if self.eyes.pending:  # paused by in-process code, not by the parameter
                 self._publish_eyes(wait=True)
             return
-        self.eyes.start_workers()
         rtf = self.params.real_time_factor
         if rtf == 0:
             self._advance(self.sim.ticks_per_platform_tick, overlap=True)  # no bursts
@@ -252,6 +251,8 @@ class SimNode(Node):
                 else:  # only camera_info: no image to draw
                     interface.publish_eye(eye, (None, None), when, self.camera)
         if drawn:
+            if overlap:
+                self.eyes.start_workers()  # once, when eyes are first wanted
             started = time.perf_counter()
             views = self.cameras.eye_views([(i.robot, side) for i, _, side, _ in drawn])
             self.eyes.submit((when, [(i, eye) for i, eye, _, _ in drawn]), views, self.camera,
