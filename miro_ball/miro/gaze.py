@@ -78,8 +78,8 @@ def look_at(kc, target, frame=FOOT, eye=None):
 
     kc: the chain as it is now (its joints are where the search starts, so the head moves
     as little as it can; its pose matters only for frame=WORLD). eye: CAML or CAMR; None
-    aims whichever eye reaches the target with the smaller movement of the head, or, when
-    neither reaches it, the one that gets closer. Returns a ``Gaze``; ValueError for a
+    aims whichever eye puts the target on its axis with the smaller movement of the head,
+    or, when neither does, the one that gets closer. Returns a ``Gaze``; ValueError for a
     target that is not three finite numbers or an eye that is not CAML or CAMR.
     """
     try:
@@ -95,7 +95,9 @@ def look_at(kc, target, frame=FOOT, eye=None):
     start = np.array(clamp_joints(*kc.joints)[1:])
     eyes = (eye,) if eye is not None else (CAML, CAMR)
     found = [_aim(KinematicChain(kc.joints), tilt, start, in_foot, side) for side in eyes]
-    return min(found, key=lambda gaze: (not gaze.reachable,
+    # An eye whose search ended on the axis beats one that stopped short of it, even within
+    # the 2 degrees that count as reachable (a local minimum can stop there: 1.5 degrees).
+    return min(found, key=lambda gaze: (not gaze.reachable, gaze.error_rad > ON_AXIS_RAD,
                                         _movement(gaze, start) if gaze.reachable
                                         else gaze.error_rad))
 

@@ -21,7 +21,6 @@ import sys
 import time
 
 import cv2
-
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.experimental import EventsExecutor
