@@ -46,9 +46,6 @@ def eyes_now(world, cameras, pipeline, camera, overlap, tag):
 def test_eyes_drawn_while_the_world_steps_on_are_those_of_their_instant(moving_world, lens):
     world, cameras, pipeline, warnings = moving_world
     camera = CameraModel(320, 240, lens=lens)
-    workers = pipeline.workers
-    while not workers.ready:  # they build their world copy in the background
-        workers.done()
     done = []
     for instant in range(3):
         # Drawn in this thread an instant is done at once, after those asked for before.
@@ -76,19 +73,22 @@ def test_a_worker_that_dies_loses_no_instant(moving_world):
     world, cameras, pipeline, warnings = moving_world
     camera = CameraModel(320, 240)
     eyes_now(world, cameras, pipeline, camera, overlap=False, tag='reference')
-    (_, reference, _), = pipeline.finished()
-    workers = pipeline.workers
-    while not workers.ready:
-        workers.done()
-    for process in workers.processes:
+    eyes_now(world, cameras, pipeline, camera, overlap=True, tag='up')  # waits for them
+    (_, reference, _), (_, up, _) = pipeline.finished(wait=True)
+    assert up == reference and pipeline.drawing_in_workers
+    processes = pipeline.workers.processes
+    for process in processes:  # stopped, they can not answer: the next instant stays in flight
+        os.kill(process.pid, signal.SIGSTOP)
+    eyes_now(world, cameras, pipeline, camera, overlap=True, tag='lost')
+    assert pipeline.pending == 1
+    for process in processes:
         os.kill(process.pid, signal.SIGKILL)
         process.wait()
-    eyes_now(world, cameras, pipeline, camera, overlap=True, tag='lost')
     world.run(0.2)
     eyes_now(world, cameras, pipeline, camera, overlap=True, tag='after')
     done = pipeline.finished(wait=True)
     assert [tag for tag, _, _ in done] == ['lost', 'after']
-    assert done[0][1] == reference  # drawn from its snapshot on a copy of the world
+    assert done[0][1] == reference  # drawn here from the state the worker was sent
     assert done[1][1] != reference
     assert len(warnings) == 1 and 'eye worker' in warnings[0]
     assert not pipeline.drawing_in_workers and pipeline.pending == 0

@@ -2,8 +2,8 @@
 
 Plain functions on numpy images, so that the simulator's thread and its eye worker
 processes (render.eye_workers) produce the very same bytes. Images come as RGB or RGBA
-rows: our GL renderer reads RGBA back (four times cheaper than RGB on llvmpipe) and the
-channel order is fixed here, where a copy is made anyway.
+rows: our GL renderer reads RGBA back (0.7 ms a 640x360 stereo pair cheaper than RGB on
+llvmpipe) and the channel order is fixed here, where a copy is made anyway.
 """
 import time
 from dataclasses import dataclass

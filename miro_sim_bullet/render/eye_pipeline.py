@@ -2,10 +2,11 @@
 
 The simulator asks for the eyes of instant t with submit() and takes finished ones with
 finished(). Drawn here (``overlap`` False, or without workers) an instant is finished at
-once; the first instant for the workers waits for them to come up. With workers (render.eye_workers) it is drawn from a snapshot of
-instant t on the other core while physics goes on to t + dt: the same pixels, the same
-stamp, only later. The simulator bounds how much later: it waits for instant t before it
-submits the next one, and whenever it pauses or is stepped.
+once. With workers (render.eye_workers) it is drawn from the state of instant t on the
+other core while physics goes on to t + dt: the same pixels, the same stamp, only later;
+the first instant for the workers waits for them to come up. The simulator bounds how much
+later: it waits for instant t before it submits the next one, and whenever it pauses or is
+stepped.
 
 If a worker dies, the instants it had are drawn here from the state they were sent, the
 way the worker would have, and the eyes are drawn in this thread from then on: no frame is
@@ -25,12 +26,12 @@ class EyePipeline:
     """Eye images of ``cameras``' world (render.cameras.Cameras). ``use_workers``: draw in
     helper processes once start_workers() was called and they are up. ``log`` takes
     one-line notes, ``warn`` one-line warnings. ``seconds`` sums the wall time of each
-    stage: here (submit, wait) and in the workers (pose, draw, encode)."""
+    stage: here (submit, wait) and where the eyes are drawn (draw, its own stages, encode)."""
 
     def __init__(self, cameras, use_workers=True, log=print, warn=print):
         self.cameras = cameras
         self.world = cameras.world
-        self.use_workers = use_workers
+        self._may_start = use_workers  # whether start_workers() is still to start them
         self.log, self.warn = log, warn
         self.workers = None
         self._setup = None  # (generation, setup) the workers draw with
@@ -50,11 +51,11 @@ class EyePipeline:
 
     def start_workers(self):
         """Start the helper processes in the background, once (a no-op without workers)."""
-        if self.use_workers and self.workers is None:
+        if self._may_start:
             kind = self.cameras.renderer.kind
             self._setup = self.cameras.helper_setup()
             self.workers = EyeWorkers(self._setup[1], WORKERS[kind])
-            self.use_workers = False  # once: a failed start is not retried
+            self._may_start = False  # once: a failed start is not retried
             self.log(f'eyes drawn in {WORKERS[kind]} helper process'
                      f'{"es" if WORKERS[kind] > 1 else ""} while physics steps')
 
