@@ -11,6 +11,7 @@ from miro_ball.miro.interface import check_name, frame_id, robot_name, RobotTopi
 from miro_ball.miro.kc import clamp_joints, EYE_FRAMES, FOOT, KinematicChain, WORLD
 from miro_ball.miro.pose_controller import PoseController
 from miro_ball.robot.connection import Connection, node_name
+from miro_ball.robot.held_command import HeldCommand
 from miro_ball.robot.readings import Eyes, READINGS, Readings
 
 FRAMES = {'foot': FOOT, 'odom': WORLD}  # look_at's frames: the robot's own, odometry's
@@ -38,8 +39,8 @@ class Robot:
         topics = RobotTopics()
         self._cmd_vel = self._ros.publisher(TwistStamped, topics.cmd_vel)
         self._head = self._ros.publisher(JointState, topics.kinematic_targets)
-        self._command = None  # (forward, turn) repeated every tick until stop()
-        self._ros.node.create_timer(PLATFORM_TICK_S, self._repeat)
+        self._wheels = HeldCommand(self._send)
+        self._ros.node.create_timer(PLATFORM_TICK_S, self._wheels.repeat)
         # Every reading, not just the pose: they come on topics of their own, in any order
         # (the tutorial's first line of battery found none, once in a full run).
         heard = self._readings.latest
@@ -114,13 +115,11 @@ class Robot:
         forward, turn = float(forward), float(turn)
         if not (math.isfinite(forward) and math.isfinite(turn)):
             raise ValueError(f'drive needs finite speeds, got ({forward}, {turn})')
-        self._command = (forward, turn)
-        self._send(forward, turn)
+        self._wheels.hold(forward, turn)
 
     def stop(self):
         """Stop the wheels."""
-        self._command = None
-        self._send(0.0, 0.0)
+        self._wheels.release()
 
     def sleep(self, seconds):
         """Wait ``seconds`` of simulated time (while the simulator is paused, so is this)."""
@@ -176,9 +175,3 @@ class Robot:
         msg.header.frame_id = frame_id(self.name, 'base_link')
         msg.twist.linear.x, msg.twist.angular.z = forward, turn
         self._cmd_vel.publish(msg)
-
-    def _repeat(self):
-        # MiRo stops a wheel command after half a second: drive() holds until stop().
-        command = self._command
-        if command is not None:
-            self._send(*command)
