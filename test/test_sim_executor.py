@@ -102,9 +102,10 @@ def test_eyes_drawn_beside_physics_come_at_most_one_camera_period_late(running):
     assert spin_until(executor, lambda: node.sim.time >= 2.0
                       and all(len(f) >= 10 for f in eyes.values()), 120)
     assert node.eyes.drawing_in_workers  # the helper process took the eyes
-    # Each came after its instant (drawn while physics stepped on), none more than one
+    # None came before its instant, some after it (drawn while physics stepped on: one the
+    # helper had done before the next step comes at its own instant), none more than one
     # camera period after it.
-    assert min(late) > 0
+    assert min(late) >= -1e-9 and max(late) > 0
     assert max(late) <= 1 / node.params.camera_rate + 1e-9
     # Paused, nothing is held back: every image drawn is out.
     assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True)).success
