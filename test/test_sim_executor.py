@@ -104,9 +104,11 @@ def test_eyes_drawn_beside_physics_come_at_most_one_camera_period_late(running):
     assert node.eyes.drawing_in_workers  # the helper process took the eyes
     # None came before its instant, some after it (drawn while physics stepped on: one the
     # helper had done before the next step comes at its own instant), none more than one
-    # camera period after it.
+    # camera period after it: the gap to the next instant, on a physics step (34 steps of
+    # 2 ms at 15 Hz, 0.068 s, seen in CI under load).
     assert min(late) >= -1e-9 and max(late) > 0
-    assert max(late) <= 1 / node.params.camera_rate + 1e-9
+    period = math.ceil(1 / node.params.camera_rate / node.sim.dt - 1e-9) * node.sim.dt
+    assert max(late) <= period + 1e-9
     # Paused, nothing is held back: every image drawn is out.
     assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True)).success
     assert node.eyes.pending == 0
