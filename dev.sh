@@ -21,6 +21,7 @@ system_packages() {
   python3 -c 'import ensurepip' 2>/dev/null || want+=(python3-venv)
   have_egl || want+=(libegl1 libgl1-mesa-dri)
   command -v chromium >/dev/null || want+=(chromium)  # the GUI's browser tests
+  command -v bwrap >/dev/null || want+=(bubblewrap)  # the grader's sandbox
   [ ${#want[@]} -eq 0 ] && return 0
   local sudo=""
   if [ "$(id -u)" -ne 0 ]; then
@@ -29,6 +30,7 @@ system_packages() {
       say "install them with: sudo apt-get install -y --no-install-recommends ${want[*]}"
       say "(without libegl1/libgl1-mesa-dri the simulator falls back to the slower TinyRenderer)"
       say "(without chromium the browser tests of miro_gui are skipped)"
+      say "(without bubblewrap the grader runs only trusted code, with --unsandboxed)"
       return 0
     fi
   fi
@@ -44,7 +46,7 @@ setup() {
     say "creating $VENV and installing miro_ball with ROS 2 Jazzy wheels"
     python3 -m venv "$VENV"
     "$PY" -m pip install -q --upgrade pip
-    "$PY" -m pip install -q -e '.[ros,test]'
+    "$PY" -m pip install -q -e '.[ros,test,scale]'
     touch "$stamp"
   fi
 }

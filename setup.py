@@ -35,6 +35,8 @@ setup(
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
         # mcap: Foxglove's reference MCAP reader, which checks our bags.
         'test': ['pytest', 'playwright', 'hypothesis', 'mcap'],
+        # Grading on a Ray cluster: python -m miro_ball.grade --ray.
+        'scale': ['ray>=2.40'],
     },
     zip_safe=False,
     maintainer='miro_ball developers',

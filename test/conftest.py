@@ -17,17 +17,19 @@ TIERS = {
               'test_gui_protocol', 'test_interface', 'test_isolation', 'test_jpeg',
               'test_layering', 'test_param_bounds', 'test_processes', 'test_rendering',
               'test_report', 'test_shm', 'test_sim_physics', 'test_world_file',
-              'test_world_fuzz', 'test_kc', 'test_camera_model', 'test_gaze',
+              'test_world_fuzz', 'test_kc', 'test_camera_model', 'test_gaze', 'test_class_report',
               'test_pose_controller', 'test_floor_map', 'test_scene_markers', 'test_touch',
-              'test_pictures', 'test_gui_scene', 'test_eye_pipeline', 'test_held_command')),
+              'test_pictures', 'test_gui_scene', 'test_eye_pipeline', 'test_held_command',
+              'test_kick_judge', 'test_sandbox_args')),
     'ros': ('nodes in-process on executors of their own, a process or two beside them',
             ('test_clients', 'test_controller_node', 'test_fuzz_params', 'test_fuzz_topics',
              'test_gui_bridge', 'test_multi_robot', 'test_sim_executor', 'test_sim_node',
-             'test_client_map', 'test_robot_object', 'test_scene')),
+             'test_client_map', 'test_robot_object', 'test_scene', 'test_grade_host')),
     'e2e': ('whole runs as processes: demo, grader, recorder, tutorial, soak, packaging',
             ('test_closed_loop', 'test_demo', 'test_grade', 'test_gui_packaging',
              'test_packaging', 'test_record', 'test_restart', 'test_scenario_bench',
-             'test_signals', 'test_sim_domain', 'test_soak', 'test_tutorial')),
+             'test_signals', 'test_sim_domain', 'test_soak', 'test_tutorial', 'test_grade_class',
+             'test_grade_ray')),
     'browser': ('the GUI in Debian\'s chromium through Playwright', ('test_gui_browser',)),
     'netns': ('hosts in network namespaces (root)', ('test_two_hosts',)),
 }
@@ -82,19 +84,20 @@ def executor(ros_context):
 
 @pytest.fixture
 def make_sim(ros_context, executor):
-    """make_sim(name=value, ..., robot=None): a simulator node in-process, paused (the test
-    steps it, rostools.advance_ticks), with those parameters and the world's unnamed robot
-    named robot (as --robot does); destroyed after the test."""
+    """make_sim(name=value, ..., robot=None, privileged=True): a simulator node in-process,
+    paused (the test steps it, rostools.advance_ticks), with those parameters and the world's
+    unnamed robot named robot (as --robot does); destroyed after the test."""
     from rclpy.parameter import Parameter
 
     from miro_sim_bullet.ros.node import SimNode
 
     made = []
 
-    def make(robot=None, **params):
+    def make(robot=None, privileged=True, **params):
         params = {'paused': True, 'world': 'miro', **params}
-        made.append(SimNode(context=ros_context, robot=robot, parameter_overrides=[
-            Parameter(name, value=value) for name, value in params.items()]))
+        made.append(SimNode(context=ros_context, robot=robot, privileged=privileged,
+                            parameter_overrides=[Parameter(name, value=value)
+                                                 for name, value in params.items()]))
         executor.add_node(made[-1])
         return made[-1]
     yield make

@@ -1,39 +1,50 @@
-"""The grader: scores, table and JSON (pure), its command line, and whole gradings of our
+"""The grader: notes, table and total (pure), its command line, and whole gradings of our
 controller, of one that does nothing and of one that dies at once printing garbage."""
 import json
+import os
 import subprocess
 import sys
 
 import pytest
 
 from miro_ball.grade import parse_args
-from miro_ball.grading.scores import notes, report, to_json, total_line
-from miro_ball.run.episode import EpisodeResult
-from miro_ball.run.process_rig import last_bytes, printable_tail
+from miro_ball.grading.command import printable_tail
+from miro_ball.grading.episode_facts import complete, episode_folder, notes
+from miro_ball.grading.hosts import lost
+from miro_ball.grading.scores import report, total_line
 
 PY = sys.executable
 PLACE = ((0.1, 0.2, 0.5), (0.6, -0.3))
 
 
 def result(index=1, **facts):
-    return EpisodeResult(index, *PLACE, **{'commands': 100, 'sim_time': 5.0, **facts})
+    spec = {'student': '', 'index': index, 'robot': list(PLACE[0]), 'ball': list(PLACE[1])}
+    return complete(spec, {**lost(''), 'ended': 'limit', 'commands': 100, 'sim_time': 5.0,
+                           **facts})
 
 
 def test_an_episode_is_won_by_kicking_without_falling():
-    assert result(kicked=True, time_to_kick=3.0).success
-    assert not result(kicked=True, time_to_kick=3.0, fell=True).success
-    assert not result().success
+    assert result(kicked=True, time_to_kick=3.0)['success']
+    assert not result(kicked=True, time_to_kick=3.0, fell=True)['success']
+    assert not result(kicked=True, time_to_kick=3.0, cheated='published on /clock')['success']
+    assert not result()['success']
 
 
 def test_what_went_wrong_with_the_command_is_said():
     assert notes(result()) == []
-    assert notes(result(exit_code=1, exited_after_s=0.24, ended='command exited')) == [
-        'exited with code 1 after 0.2 s']
+    crashed = result(exit_code=1, sim_time=0.24, ended='command exited')
+    assert notes(crashed) == ['exited with code 1 after 0.2 s simulated'] and crashed['crashed']
     assert notes(result(commands=0)) == ['never published on control/cmd_vel']
     assert 'flooded control/cmd_vel: 20000 messages' in notes(result(commands=100000))[0]
     assert notes(result(killed=True)) == ['ignored Ctrl+C, killed']
-    assert notes(result(ended='the simulator did not take the placement')) == [
-        'the simulator did not take the placement']
+    assert notes(result(cheated='published on /clock')) == ['cheated: published on /clock']
+    assert notes(result(ended='the grading host died')) == ['the grading host died']
+
+
+def test_an_episodes_files_go_in_its_students_folder():
+    assert episode_folder('alice', 3) == 'alice/episode_03'
+    assert episode_folder('', 12) == 'command/episode_12'
+    assert result(video='video.mp4')['video'] == 'command/episode_01/video.mp4'
 
 
 def test_output_tails_are_safe_to_print():
@@ -52,7 +63,7 @@ def test_the_total_counts_every_planned_episode():
                result(3, distance_m=0.25)]
     line = total_line(results, 4)
     assert line.startswith('score 1/4 (25 %) (only 3 ran): kicked 2, median time to kick 2.0 s')
-    assert 'fell 1, driven 1.75 m' in line
+    assert 'fell 1, cheated 0, driven 1.75 m' in line
 
 
 def test_report_has_a_row_per_episode_then_the_output_of_those_that_failed():
@@ -66,18 +77,14 @@ def test_report_has_a_row_per_episode_then_the_output_of_those_that_failed():
                          'its output:', '    Traceback', '    boom']
 
 
-def test_json_is_a_list_of_episodes_with_kicked_and_time_to_kick():
-    data = json.loads(to_json([result(2), result(1, kicked=True, time_to_kick=2.5)]))
-    assert [(d['index'], d['kicked'], d['time_to_kick']) for d in data] == [
-        (1, True, 2.5), (2, False, None)]
-    assert data[0]['robot'] == list(PLACE[0]) and data[0]['success'] is True
-
-
 @pytest.mark.parametrize('argv, message', [
-    ([], 'no command to grade'),
+    ([], 'give either --class DIR or a command to grade after --'),
+    (['--class', 'x', '--', PY], 'give either --class DIR or a command'),
     (['--count', '0', '--', PY], '--count must be in 1..1000'),
     (['--limit', 'nan', '--', PY], '--limit must be in (0, 3600]'),
     (['--', 'no-such-program-here'], 'command not found: no-such-program-here'),
+    (['--world', '/no/such/world.toml', '--', PY], '--world: no file /no/such/world.toml'),
+    (['--world', '/dev/null', '--', PY], '--world: /dev/null is not a regular file'),
     (['--json', '/no/such/dir/g.json', '--', PY], '--json: no folder /no/such/dir'),
 ])
 def test_a_bad_command_line_is_one_line(argv, message, capsys):
@@ -89,14 +96,22 @@ def test_a_bad_command_line_is_one_line(argv, message, capsys):
 
 
 def grade(tmp_path, *args, timeout=120):
-    """Run the grader as a user would; (its output, the episodes from --json)."""
+    """Run the grader as a user would; (its output, the episodes of its report)."""
     out = subprocess.run(
-        [PY, '-m', 'miro_ball.grade', '--json', str(tmp_path / 'g.json'),
-         '--out', str(tmp_path / 'logs'), '--grace', '2', *args],
+        [PY, '-m', 'miro_ball.grade', '--out', str(tmp_path / 'out'), '--grace', '2', *args],
         capture_output=True, text=True, timeout=timeout, cwd=tmp_path)
     assert out.returncode == 0, out.stdout + out.stderr
     assert 'Traceback' not in out.stderr
-    return out.stdout, json.loads((tmp_path / 'g.json').read_text())
+    [report] = (tmp_path / 'out').iterdir()
+    return out.stdout, json.loads((report / 'results.json').read_text())['episodes'], report
+
+
+def test_a_fifo_world_is_refused_not_waited_on(tmp_path):
+    fifo = tmp_path / 'world.toml'
+    os.mkfifo(fifo)
+    out = subprocess.run([PY, '-m', 'miro_ball.grade', '--world', str(fifo), '--', PY],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 2 and 'is not a regular file' in out.stderr
 
 
 def test_a_world_the_grader_cannot_use_is_refused(tmp_path):
@@ -108,19 +123,20 @@ def test_a_world_the_grader_cannot_use_is_refused(tmp_path):
 
 
 def test_our_controller_kicks(tmp_path):
-    stdout, episodes = grade(tmp_path, '--count', '1', '--limit', '20', '--video',
-                             str(tmp_path / 'video'), '--',
-                             PY, '-m', 'miro_ball', '--ros-args', '-p', 'use_sim_time:=true')
+    stdout, episodes, report = grade(tmp_path, '--count', '1', '--limit', '20', '--',
+                                     PY, '-m', 'miro_ball', '--ros-args', '-p',
+                                     'use_sim_time:=true')
     [episode] = episodes
     assert episode['kicked'] and not episode['fell'] and episode['ended'] == 'kicked'
     assert 0 < episode['time_to_kick'] < 20 and episode['distance_m'] > 0.3
     assert episode['notes'] == [] and not episode['killed']
     assert 'score 1/1 (100 %)' in stdout
-    assert (tmp_path / 'video' / 'episode_01.mp4').stat().st_size > 10_000
+    assert (report / episode['video']).stat().st_size > 10_000
+    assert (report / 'index.html').is_file() and (report / 'results.csv').is_file()
 
 
 def test_a_controller_that_does_nothing_scores_zero(tmp_path):
-    stdout, episodes = grade(tmp_path, '--count', '2', '--limit', '3',
+    stdout, episodes, _ = grade(tmp_path, '--count', '2', '--limit', '3',
                              '--real-time-factor', '0', '--command-wait', '1', '--',
                              PY, '-c', 'import time; time.sleep(1000)')
     assert [(e['kicked'], e['time_to_kick']) for e in episodes] == [(False, None)] * 2
@@ -132,17 +148,10 @@ def test_a_controller_that_does_nothing_scores_zero(tmp_path):
 
 def test_a_command_that_dies_printing_garbage_is_reported(tmp_path):
     garbage = 'import os, sys; os.write(1, bytes(range(256)) * 4); sys.exit(3)'
-    stdout, [episode] = grade(tmp_path, '--count', '1', '--', PY, '-c', garbage)
+    stdout, [episode], _ = grade(tmp_path, '--count', '1', '--', PY, '-c', garbage)
     assert not episode['kicked'] and episode['ended'] == 'command exited'
-    assert episode['exit_code'] == 3 and episode['exited_after_s'] < 30
+    assert episode['exit_code'] == 3 and episode['crashed'] and episode['sim_time'] < 30
     assert episode['notes'][0].startswith('exited with code 3 after')
     assert episode['output_tail'] and 'score 0/1 (0 %)' in stdout
     assert 'the last lines of its output:' in stdout
     assert all(c.isprintable() for line in stdout.splitlines() for c in line)
-
-
-def test_only_the_end_of_a_huge_output_is_read(tmp_path):
-    log = tmp_path / 'command.log'
-    log.write_bytes(b'x' * 200_000 + b'\nthe end\n')
-    assert last_bytes(log, 100).endswith(b'\nthe end\n') and len(last_bytes(log, 100)) == 100
-    assert last_bytes(log) == log.read_bytes()[-65536:]

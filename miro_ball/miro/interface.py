@@ -204,6 +204,20 @@ class RobotTopics:
         """part: 'head' or 'body'."""
         return self._row('touch', part=part)
 
+    def all(self, direction=None):
+        """Every topic name of the interface (only SENSOR's or CONTROL's if direction is
+        given), placeholders filled in with every eye and part."""
+        fill = {'eye': EYES, 'part': TOUCH_PARTS}
+        names = []
+        for row in ROBOT_INTERFACE:
+            if direction not in (None, row.direction):
+                continue
+            holes = [key for key in fill if '{' + key + '}' in row.name]
+            values = fill[holes[0]] if holes else [None]
+            names += [self.topic(row.name.format(**({holes[0]: v} if holes else {})))
+                      for v in values]
+        return names
+
     def __getattr__(self, key):
         # The rows without a placeholder: t.odom, t.cliff, t.cmd_vel, ...
         row = TOPIC.get(key)

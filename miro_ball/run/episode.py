@@ -1,4 +1,5 @@
-"""One episode, the one way the grader and the scenario benchmark run one.
+"""One episode of our controllers, the one way the scenario benchmark and the closed-loop
+tests run one (the grader, which runs any program, has its own: miro_ball/grading/host.py).
 
 An episode: the nodes come up with the simulator paused; robot and ball are put at
 the placement (or stay at the world's start); the clock starts once the controllers
@@ -7,15 +8,10 @@ the ball has moved KICK_DISTANCE_M (a fall in that time still counts), when a ro
 fell, when the limit of simulated time passed, or early (a node exited, Ctrl+C).
 It is judged on the simulator's ground truth by the rig's referee (Monitor).
 
-The rig says where the nodes run (each in a module of its own):
-- ProcessRig (process_rig.py): the simulator and any command under test as processes
-  on a ROS domain of their own, the clock free-running at a real-time factor: the
-  grader, which must run a student's program as they would.
-- SteppedRig (stepped_rig.py): the simulator and our controllers in this process on
-  one executor, stepped one platform tick at a time, each tick waited for until
-  every controller commanded: outcomes depend on simulated time only, whatever the
-  machine's load: the scenario benchmark (the same with any --jobs) and the
-  closed-loop tests.
+The rig says where the nodes run: SteppedRig (stepped_rig.py), the simulator and our
+controllers in this process on one executor, stepped one platform tick at a time, each
+tick waited for until every controller commanded: outcomes depend on simulated time
+only, whatever the machine's load (the same with any --jobs).
 
 A rig has: referee (after open), open(), place(placement), wait_for_controllers(),
 start(), advance(), ended_early() (why it ended, or None) and close(result) (its own
@@ -23,7 +19,7 @@ facts into the result); the steps before start raise RunError when the episode c
 not go on.
 """
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from miro_ball.run.referee import RunError
 
@@ -45,11 +41,6 @@ class EpisodeResult:
     clock_wall_time: float = 0.0  # s while the episode's clock ran
     ended: str = ''  # why it stopped: kicked, fell, limit, command exited, ...
     frames: int | None = None  # camera frames the controllers took in (if known)
-    commands: int = 0  # messages published on control/cmd_vel
-    exit_code: int | None = None  # when the command ended by itself
-    exited_after_s: float | None = None  # wall s after its start
-    killed: bool = False  # it ignored Ctrl+C for the grace period
-    output_tail: list = field(default_factory=list)  # its last lines when something was wrong
 
     @property
     def success(self):

@@ -12,10 +12,11 @@ class Video:
     each). times: (first, last) simulated s of the frames written, None before any."""
 
     def __init__(self, path, robots):
+        """robots: the names of those whose eyes are shown ([]: the overhead view only)."""
         self.path = path
         self.robots = robots
         rows, self.columns = (2, 1) if len(robots) == 1 else (len(robots), 2)
-        height = VIDEO_HEIGHT // rows
+        height = VIDEO_HEIGHT // max(1, rows)
         self.panel = (height * 16 // 9, height)
         self.eyes = [np.zeros((height, self.panel[0], 3), np.uint8)
                      for _ in range(rows * self.columns)]
@@ -33,11 +34,11 @@ class Video:
 
     def overhead(self, bgr, t, note=''):
         """A video frame of this overhead image at simulated time t (s) of the run."""
-        rows = [np.hstack(self.eyes[i:i + self.columns])
-                for i in range(0, len(self.eyes), self.columns)]
-        eyes = np.vstack(rows)
-        frame = np.hstack([cv2.resize(bgr, (VIDEO_HEIGHT, eyes.shape[0]),
-                                      interpolation=cv2.INTER_AREA), eyes])
+        frame = cv2.resize(bgr, (VIDEO_HEIGHT, VIDEO_HEIGHT), interpolation=cv2.INTER_AREA)
+        if self.eyes:
+            frame = np.hstack([frame, np.vstack([
+                np.hstack(self.eyes[i:i + self.columns])
+                for i in range(0, len(self.eyes), self.columns)])])
         cv2.putText(frame, f't = {t:5.1f} s   {note}', (8, 22), cv2.FONT_HERSHEY_SIMPLEX, 0.6,
                     (0, 0, 0), 2)
         if self.writer is None:

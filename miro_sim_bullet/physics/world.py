@@ -209,6 +209,11 @@ class SimWorld:
             return None
         return pb.getBasePositionAndOrientation(self.ball_id, **self._kw())[0]
 
+    def touching(self, robot_name, object_name=BALL_NAME):
+        """Whether robot robot_name touches movable object_name after the last step."""
+        return bool(pb.getContactPoints(bodyA=self.robots[robot_name].body_id,
+                                        bodyB=self.objects[object_name], **self._kw()))
+
     # -- time -----------------------------------------------------------------------------------
     @property
     def time(self):

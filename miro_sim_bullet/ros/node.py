@@ -64,12 +64,19 @@ class SimNode(Node):
     guard_domain, as the command line simulator does: refuse to start (SharedDomain) when
     another node publishes /clock on the ROS domain, and say so once, in one line, when
     one appears later.
+    privileged=False offers MiRo's own interface and /clock only: no ground truth, scene,
+    overhead view, set_pose, reset, pause, step or parameter services. A grader that runs
+    untrusted code beside it places, paces and judges the world in-process (miro_ball's
+    grading host); nothing on the ROS graph can.
     """
 
     def __init__(self, *, context=None, parameter_overrides=None, robot=None,
-                 guard_domain=False):
-        super().__init__(SIM_NODE_NAME, context=context,
-                         parameter_overrides=parameter_overrides)
+                 guard_domain=False, privileged=True):
+        overrides = list(parameter_overrides or [])
+        if not privileged:
+            overrides.append(Parameter('start_type_description_service', value=False))
+        super().__init__(SIM_NODE_NAME, context=context, parameter_overrides=overrides,
+                         start_parameter_services=privileged)
         unnamed_robot = robot_name(robot)
         self.params = p = declare(self, SimParams)
         self._live = LiveParams(self, (p,), self._apply, fixed=FIXED_PARAMS)
@@ -93,9 +100,14 @@ class SimNode(Node):
         ros = Endpoints.of(self)
         self.robots = {name: RobotInterface(name, ros, self._robot_lookup(name), self.warn)
                        for name in self.sim.robots}
-        self.sim_interface = SimInterface(ros, self.sim, self.cameras, reset=self.reset,
-                                          pause=self.pause, step=self.step, warn=self.warn)
-        self.scene = SceneInterface(ros, self.sim)
+        self.sim_interface = self.scene = None
+        if privileged:
+            self.sim_interface = SimInterface(ros, self.sim, self.cameras, reset=self.reset,
+                                              pause=self.pause, step=self.step, warn=self.warn)
+            self.scene = SceneInterface(ros, self.sim)
+        # Called after every physics step with the world: an in-process judge sees each
+        # contact, however brief.
+        self.step_observers = []
         self.get_logger().info(
             f'world {self.sim.description.source}; robots {", ".join(self.robots)}; renderer '
             f'{self.cameras.renderer.name}; cameras {p.frame_width}x{p.frame_height} @ '
@@ -206,6 +218,8 @@ class SimNode(Node):
             started = clock()
             sim.step()
             spent['physics'] += clock() - started
+            for observe in self.step_observers:
+                observe(sim)
             # Images of an instant go out before its /clock when drawn here, so a controller
             # on sim time has them when its timer fires for that instant.
             if sim.step_index >= self._frame_step(self._next_frame):
@@ -218,13 +232,13 @@ class SimNode(Node):
                 started = clock()
                 self._publish_tick()
                 spent['sensor topics'] += clock() - started
-            if sim.time >= self._next_scene:
+            if self.scene is not None and sim.time >= self._next_scene:
                 started = clock()
                 self.scene.publish(convert.stamp(sim.time))
                 self._next_scene += 1.0 / SCENE_RATE_HZ
                 spent['scene'] += clock() - started
             rate = self.params.overhead_rate
-            if rate > 0 and sim.time >= self._next_overhead:
+            if rate > 0 and self.sim_interface is not None and sim.time >= self._next_overhead:
                 started = clock()
                 self.sim_interface.publish_overhead(convert.stamp(sim.time),
                                                     self.params.jpeg_quality)
@@ -237,7 +251,8 @@ class SimNode(Node):
         self.pub_clock.publish(ClockMsg(clock=when))
         for interface in self.robots.values():
             interface.publish_tick(when)
-        self.sim_interface.publish_ground_truth(when)
+        if self.sim_interface is not None:
+            self.sim_interface.publish_ground_truth(when)
 
     def _submit_eyes(self, overlap):
         """Ask for every eye someone subscribes to, of every robot, drawn together."""
