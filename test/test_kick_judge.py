@@ -60,6 +60,17 @@ def test_a_fall_is_the_axle_dropping():
     assert judge.fell
 
 
+def test_the_robot_may_be_looked_at_less_often_than_the_ball():
+    judge = KickJudge()
+    judge.start(0.0)
+    judge.observe(0.002, (0.5, 0.0), (0.0, 0.0, 0.0), False)
+    judge.observe(0.004, (0.5, 0.0), None, True)
+    judge.observe(0.020, (0.6, 0.0), (0.1, 0.0, 0.0), False)
+    judge.observe(0.022, (0.5 + KICK_DISTANCE_M, 0.0), None, False)
+    assert judge.touch_time == 0.004 and judge.kick_time == 0.022
+    assert judge.distance == 0.1 and not judge.fell
+
+
 def ends(*rows):
     return [Endpoint(kind, name, '/student') for kind, name in rows]
 

@@ -2,6 +2,7 @@
 EventsExecutor), free-running as `-p real_time_factor:=0` runs it: time, sensors, every
 eye frame, commands and services all flow."""
 import math
+import time
 
 import pytest
 from geometry_msgs.msg import TwistStamped
@@ -88,6 +89,20 @@ def test_services_answer_while_free_running(running):
     assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=False)).success
     assert spin_until(executor, lambda: node.sim.time > 0.5, 60)
     assert math.isfinite(node.sim.robot.pose()[0])
+
+
+def test_a_paused_free_running_simulator_leaves_the_cpu_to_others(running):
+    """A grader pauses it while the next controller starts: that controller needs the core."""
+    node, executor, _ = running
+    assert spin_until(executor, lambda: node.sim.time > 0.1, 60)
+    node.pause(True)
+    wall, cpu = time.monotonic(), time.thread_time()
+    while time.monotonic() - wall < 0.5:
+        executor.spin_once(timeout_sec=0.05)
+    assert time.thread_time() - cpu < 0.25 * (time.monotonic() - wall)
+    node.pause(False)
+    resumed_at = node.sim.time
+    assert spin_until(executor, lambda: node.sim.time > resumed_at + 0.1, 60)
 
 
 def test_eyes_drawn_beside_physics_come_at_most_one_camera_period_late(running):

@@ -81,9 +81,13 @@ def place(sim, name, robot, ball):
 
 
 def observe(judge, sim, name):
-    """What the world says now, to the judge: after each physics step."""
-    x, y, z, _ = sim.robots[name].ground_truth()
-    judge.observe(sim.time, sim.ball_position(), (x, y, z), sim.touching(name))
+    """What the world says now, to the judge: after each physics step. The robot's pose,
+    the dearest to read, is read on platform ticks only (50 Hz): enough for the distance
+    driven and a fall, and the simulator's steps go about a fifth faster."""
+    foot = None
+    if sim.step_index % sim.ticks_per_platform_tick == 0:
+        foot = sim.robots[name].ground_truth()[:3]
+    judge.observe(sim.time, sim.ball_position(), foot, sim.touching(name))
 
 
 def _key(spec):

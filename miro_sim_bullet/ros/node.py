@@ -121,14 +121,17 @@ class SimNode(Node):
         return lambda: self.sim.robots[name]
 
     def _make_timer(self):
-        period = 0.005 if self.params.real_time_factor > 0 else 0.0
+        # Free-running, the simulator steps whenever the executor is free (period 0);
+        # paused, such a timer would keep a core busy doing nothing: it looks in at 200 Hz.
+        free = self.params.real_time_factor == 0 and not self.params.paused
+        period = 0.0 if free else 0.005
         return self.create_timer(period, self._on_timer,
                                  clock=Clock(clock_type=ClockType.STEADY_TIME))
 
     def _apply(self, params):
         """A set_parameters change that passed the checks (pause, speed, image quality)."""
         old, self.params = self.params, params
-        if params.real_time_factor != old.real_time_factor:
+        if (params.real_time_factor, params.paused) != (old.real_time_factor, old.paused):
             self.destroy_timer(self.timer)
             self.timer = self._make_timer()
         self.paused = params.paused
