@@ -173,7 +173,7 @@ def big_png(tmp_path, name, side):
 
 
 @pytest.mark.parametrize('text, expected', [
-    (f'[[box]]\nsize = [1, 1, 1]\npicture = "nowhere.png"\n',
+    ('[[box]]\nsize = [1, 1, 1]\npicture = "nowhere.png"\n',
      "box[0].picture: no picture 'nowhere.png': bundled pictures are face_poster.png, "
      'miro_lab_logo.png, apriltag36h11_N.png (N = 0, 1, 2, 3), or give a path to a PNG'),
     ('[[box]]\nsize = [1, 1, 1]\npicture = 3\n',

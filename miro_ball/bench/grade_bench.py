@@ -1,15 +1,17 @@
 """Grading throughput: episodes per hour of this grader beside an earlier commit's, in turns.
 
-    python -m miro_ball.bench.grade_bench --against REF [--count 12] [--rounds 2]
+    python -m miro_ball.bench.grade_bench --against REF [--count 20] [--rounds 2]
 
 Each case grades our controller on the same seeded placements, as a teacher would
-(python -m miro_ball.grade), with 1 and 2 workers at real-time factor 1 and free-running,
-and this grader also on a Ray cluster of two nodes on this machine (Ray's own test
-helper, one CPU a node). Episodes per hour = episodes / the grader's whole wall time,
+(python -m miro_ball.grade): 1, 2 and 4 workers at real-time factor 1, 1 and 2
+free-running, and this grader also on Ray clusters of one and two nodes on this machine
+(Ray's own test helper, one CPU a node). Episodes per hour = episodes / the grader's whole wall time,
 start-up included; the median of the rounds is shown, the rounds run case after case in
 turns so that both graders see the same load.
 """
 import argparse
+import contextlib
+import os
 import statistics
 import subprocess
 import sys
@@ -23,26 +25,23 @@ CONTROLLER = [sys.executable, '-m', 'miro_ball', '--ros-args', '-p', 'use_sim_ti
 CASES = [  # (label, real-time factor, workers, Ray nodes (0: no Ray))
     ('real-time factor 1, 1 worker', 1.0, 1, 0),
     ('real-time factor 1, 2 workers', 1.0, 2, 0),
-    ('real-time factor 1, 3 workers', 1.0, 3, 0),
+    ('real-time factor 1, 4 workers', 1.0, 4, 0),
     ('real-time factor 1, Ray: 1 node of 1 CPU', 1.0, 1, 1),
     ('real-time factor 1, Ray: 2 nodes of 1 CPU', 1.0, 2, 2),
     ('free-running, 1 worker', 0.0, 1, 0),
     ('free-running, 2 workers', 0.0, 2, 0),
+    ('free-running, Ray: 2 nodes of 1 CPU', 0.0, 2, 2),
 ]
 
 
-def grade_once(args, rtf, workers, ray_address=None, tree=None):
-    """(episodes per hour, episodes won) of one grading; tree: an earlier commit's."""
-    import os
-
-    with tempfile.TemporaryDirectory() as out:
+def grade_once(args, rtf, workers, ray_nodes=0, tree=None):
+    """(episodes per hour, episodes won) of one grading; tree: an earlier commit's; on a
+    Ray cluster of ``ray_nodes`` nodes made for it (its start is not counted) if not 0."""
+    with tempfile.TemporaryDirectory() as out, ray_cluster(ray_nodes) as address:
         argv = [sys.executable, '-m', 'miro_ball.grade', '--count', str(args.count),
                 '--seed', str(args.seed), '--real-time-factor', str(rtf),
                 '--out', out, '--limit', str(args.limit)]
-        if ray_address:
-            argv += ['--ray', ray_address]
-        else:
-            argv += ['--jobs', str(workers)]
+        argv += ['--ray', address] if address else ['--jobs', str(workers)]
         if tree is None:
             argv.append('--no-video')  # the earlier grader made none by default
         started = time.monotonic()
@@ -56,15 +55,24 @@ def grade_once(args, rtf, workers, ray_address=None, tree=None):
     return args.count / wall * 3600, score[0].split()[1] if score else '?'
 
 
+@contextlib.contextmanager
 def ray_cluster(nodes):
-    """A Ray cluster of ``nodes`` nodes of one CPU each on this machine."""
+    """The address of a Ray cluster of ``nodes`` nodes of one CPU each on this machine, shut
+    down on leaving (None for 0 nodes): only while its case runs, so that its daemons take
+    nothing from the other cases."""
+    if not nodes:
+        yield None
+        return
     from ray.cluster_utils import Cluster
 
     cluster = Cluster(initialize_head=True, head_node_args={'num_cpus': 1})
-    for _ in range(nodes - 1):
-        cluster.add_node(num_cpus=1)
-    cluster.wait_for_nodes()
-    return cluster
+    try:
+        for _ in range(nodes - 1):
+            cluster.add_node(num_cpus=1)
+        cluster.wait_for_nodes()
+        yield cluster.address
+    finally:
+        cluster.shutdown()
 
 
 def main(argv=None):
@@ -72,7 +80,8 @@ def main(argv=None):
                                 description=__doc__.split('\n\n')[0])
     p.add_argument('--against', metavar='REF', required=True,
                    help="the earlier commit to compare with (today's grader)")
-    p.add_argument('--count', type=int, default=12, help='episodes per grading (12)')
+    p.add_argument('--count', type=int, default=20,
+                   help='episodes per grading (20: a student\'s, as a teacher grades)')
     p.add_argument('--seed', type=int, default=0)
     p.add_argument('--limit', type=float, default=60.0, help='simulated s per episode (60)')
     p.add_argument('--rounds', type=int, default=2, help='runs per case (median shown)')
@@ -82,22 +91,15 @@ def main(argv=None):
         tree, _ = checkout(args.against)
     except BaselineError as err:
         p.error(str(err))
-    clusters = {nodes: ray_cluster(nodes) for nodes in (1, 2)}
     figures = {}
-    try:
-        for round_ in range(1, args.rounds + 1):
-            for label, rtf, workers, nodes in CASES:
-                runs = [('this', None)] if nodes else [('this', None), ('before', tree)]
-                for who, where in runs:
-                    rate, score = grade_once(args, rtf, workers,
-                                             clusters[nodes].address if nodes else None,
-                                             where)
-                    figures.setdefault((label, who), []).append(rate)
-                    print(f'round {round_}: {label}, {who}: {rate:.0f} episodes/hour '
-                          f'(score {score})', flush=True)
-    finally:
-        for cluster in clusters.values():
-            cluster.shutdown()
+    for round_ in range(1, args.rounds + 1):
+        for label, rtf, workers, nodes in CASES:
+            runs = [('this', None)] if nodes else [('this', None), ('before', tree)]
+            for who, where in runs:
+                rate, score = grade_once(args, rtf, workers, nodes, where)
+                figures.setdefault((label, who), []).append(rate)
+                print(f'round {round_}: {label}, {who}: {rate:.0f} episodes/hour '
+                      f'(score {score})', flush=True)
     lines = table(figures, args)
     print('\n'.join(lines))
     if args.output:
