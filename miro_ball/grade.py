@@ -152,7 +152,9 @@ def make_specs(args, students, folder):
             for index, placement in enumerate(placements(args.count, seed=args.seed), 1)]
 
 
-def make_pool(args, settings, folder, stop, p):
+def make_pool(args, settings, stop, p):
+    """The pool that runs the episodes; a Ray cluster that does not answer is an error of
+    the command line, said before any report folder is made."""
     if args.ray:
         from miro_ball.grading.ray_pool import RayPool, RayUnavailable
 
@@ -162,7 +164,7 @@ def make_pool(args, settings, folder, stop, p):
             p.error(str(err))
     from miro_ball.grading.hosts import LocalPool
 
-    return LocalPool(settings, args.jobs, folder, stop)
+    return LocalPool(settings, args.jobs, stop)
 
 
 def main(argv=None):
@@ -184,6 +186,8 @@ def main(argv=None):
     settings = HostSettings(world=args.world, robot=robot, renderer=args.renderer,
                             real_time_factor=args.real_time_factor,
                             sandboxed=not args.unsandboxed)
+    stop = StopRequest()
+    pool = make_pool(args, settings, stop, p)
     now = datetime.datetime.now()
     folder = class_report.report_folder(args.out, now)
     specs = make_specs(args, students, folder)
@@ -196,7 +200,6 @@ def main(argv=None):
     for name, why in skipped:
         print(f'  skipped {name}: {why}', flush=True)
     print(f'  {kept_apart}', flush=True)
-    stop = StopRequest()
     episodes, lock = [], threading.Lock()
     started = time.monotonic()
 
@@ -206,7 +209,7 @@ def main(argv=None):
             episodes.append(episode)
             print(progress_line(episode, len(episodes), len(specs), started), flush=True)
 
-    make_pool(args, settings, folder, stop, p).run(specs, done)
+    pool.run(specs, done, folder)
     meta = {'seed': args.seed, 'count': args.count, 'world': args.world,
             'limit_s': args.limit, 'real_time_factor': args.real_time_factor,
             'isolation': isolation_sentence(settings, kept_apart),

@@ -114,6 +114,17 @@ def test_a_fifo_world_is_refused_not_waited_on(tmp_path):
     assert out.returncode == 2 and 'is not a regular file' in out.stderr
 
 
+def test_a_ray_address_where_nobody_answers_is_one_line_at_once(tmp_path):
+    out = subprocess.run([PY, '-m', 'miro_ball.grade', '--ray', '127.0.0.1:1', '--out',
+                          str(tmp_path / 'out'), '--', PY],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 2 and 'Traceback' not in out.stderr
+    assert not (tmp_path / 'out').exists()  # no empty report
+    assert out.stderr.strip().splitlines()[-1].endswith(
+        'no Ray cluster answers at 127.0.0.1:1 (start one with `ray start --head`, or check '
+        'the address and port)')
+
+
 def test_a_world_the_grader_cannot_use_is_refused(tmp_path):
     out = subprocess.run([PY, '-m', 'miro_ball.grade', '--world', 'football_pitch', '--', PY],
                          capture_output=True, text=True, timeout=60)

@@ -135,13 +135,14 @@ def episode_timeout_s(spec, settings):
 
 
 class LocalPool:
-    """``workers`` hosts on this machine; ``run(specs, done)`` calls done(spec, result)
-    as each episode ends (from worker threads) and returns when all have."""
+    """``workers`` hosts on this machine; ``run(specs, done, log_dir)`` calls done(spec,
+    result) as each episode ends (from worker threads) and returns when all have; the
+    hosts' logs go in log_dir."""
 
-    def __init__(self, settings, workers, log_dir, stop=None):
-        self.settings, self.workers, self.log_dir, self.stop = settings, workers, log_dir, stop
+    def __init__(self, settings, workers, stop=None):
+        self.settings, self.workers, self.stop = settings, workers, stop
 
-    def run(self, specs, done):
+    def run(self, specs, done, log_dir):
         todo = queue.Queue()
         for spec in specs:
             todo.put(spec)
@@ -160,7 +161,7 @@ class LocalPool:
                 while spec is not None and not (self.stop and self.stop.requested):
                     upcoming = take()
                     result, host = run_on(host, dict(spec, next=upcoming), self.settings,
-                                          self.log_dir / f'host_{slot}.log', self.stop)
+                                          log_dir / f'host_{slot}.log', self.stop)
                     if result['ended'] != INTERRUPTED:
                         done(spec, result)
                     spec = upcoming

@@ -7,6 +7,7 @@ runs a task again elsewhere when its node is lost (max_retries); each episode's 
 is taken once, from the task that finished, so none is lost or counted twice. A task
 uses one CPU of its node: a node runs as many episodes at a time as it has CPUs.
 """
+import socket
 import tempfile
 from dataclasses import asdict
 from pathlib import Path
@@ -15,6 +16,7 @@ from miro_ball.grading.hosts import HostSettings, run_on
 
 RETRIES = 3  # per task, when its node or worker process is lost
 WAIT_S = 1.0  # between looks for finished tasks (and at a Ctrl+C)
+CONNECT_S = 5.0  # for the cluster's address to answer at all
 _hosts = {}  # in a Ray worker process: HostSettings -> its grading host
 
 
@@ -37,6 +39,17 @@ def episode_task(settings, spec):
     return result, files, ray.get_runtime_context().get_node_id()
 
 
+def _answers(address, timeout_s=CONNECT_S):
+    """Whether anything listens at a Ray address ([ray://]host:port): ray.init would retry
+    an address where nothing does for minutes."""
+    host, _, port = address.split('://', 1)[-1].rpartition(':')
+    try:
+        socket.create_connection((host or 'localhost', int(port)), timeout=timeout_s).close()
+    except (OSError, ValueError):
+        return False
+    return True
+
+
 class RayPool:
     """run(specs, done) as LocalPool does, on the Ray cluster at ``address`` ('auto': the
     one this machine is in)."""
@@ -46,6 +59,9 @@ class RayPool:
             import ray
         except ImportError:
             raise RayUnavailable("--ray needs Ray: pip install -e '.[scale]'") from None
+        if address != 'auto' and not _answers(address):
+            raise RayUnavailable(f'--ray: no Ray cluster answers at {address} (start one with '
+                                 '`ray start --head`, or check the address and port)')
         try:
             ray.init(address=address, logging_level='ERROR', log_to_driver=False)
         except (ConnectionError, RuntimeError, ValueError) as err:
@@ -54,7 +70,8 @@ class RayPool:
         self.ray, self.settings, self.stop = ray, settings, stop
         self.remote = ray.remote(num_cpus=1, max_retries=RETRIES)(episode_task)
 
-    def run(self, specs, done):
+    def run(self, specs, done, log_dir=None):
+        """As LocalPool.run; the hosts' logs stay on their nodes (log_dir is not used)."""
         ray = self.ray
         pending = {self.remote.remote(asdict(self.settings), spec): spec for spec in specs}
         try:
