@@ -1,4 +1,4 @@
-"""A whole class: who is found in the class folder, and the report a teacher reads (issue 18).
+"""A whole class: who is found in the class folder, and the report a teacher reads.
 Pure Python: no ROS, no simulator."""
 import csv
 import json
@@ -21,7 +21,7 @@ META = {'seed': 7, 'count': 3, 'world': 'miro', 'limit_s': 60.0, 'real_time_fact
 
 
 def episode(student, index, **changes):
-    """One result dict of the contract in the brief of issue 18: a miss by default."""
+    """One episode as the report gets it (episode_facts.complete): a miss by default."""
     result = {'student': student, 'index': index, 'robot': [0.5, -0.25, 1.0],
               'ball': [0.0, 0.3], 'success': False, 'kicked': False, 'time_to_kick': None,
               'fell': False, 'distance_m': 1.2, 'sim_time': 60.0, 'wall_time': 61.3,

@@ -2,10 +2,10 @@
 table per student, each failed episode's video one click away), results.csv (one row per
 student, for a spreadsheet) and results.json (everything).
 
-Plain Python, no ROS. The episodes are dicts of the episode result contract (brief of issue
-18). The files depend only on what is given: the same meta and episodes give byte-identical
-files, so a re-run with the same seed gives the same table (wall times live only in meta and in
-each episode's wall_time). Students choose their folder names and their output, so every
+Plain Python, no ROS. The episodes are the report's dicts (episode_facts.complete). The
+files depend only on what is given: the same meta and episodes give byte-identical files, so
+a re-run with the same seed gives the same table (wall times live only in meta and in each
+episode's wall_time). Students choose their folder names and their output, so every
 string from them is HTML-escaped and control characters are replaced.
 """
 import csv
@@ -157,8 +157,7 @@ STYLE = ('body{font-family:sans-serif;margin:1.5em;color:#222}'
          'background:#f6f6f6;padding:.4em;white-space:pre-wrap}')
 META = (('seed', 'seed'), ('count', 'placements'), ('world', 'world'),
         ('limit_s', 'limit (simulated s)'), ('real_time_factor', 'real-time factor'),
-        ('started', 'started'), ('wall_s', 'wall time (s)'), ('version', 'version'),
-        ('commit', 'commit'))
+        ('started', 'started'), ('wall_s', 'wall time (s)'))
 
 
 def _html(meta, table, episodes):
