@@ -33,8 +33,9 @@ setup(
     extras_require={
         # Left out for users whose ROS 2 Jazzy is installed and sourced.
         'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
-        # mcap: Foxglove's reference MCAP reader, which checks our bags.
-        'test': ['pytest', 'playwright', 'hypothesis', 'mcap'],
+        # mcap: Foxglove's reference MCAP reader, which checks our bags; pytest-xdist runs
+        # test files side by side (./dev.sh test).
+        'test': ['pytest', 'pytest-xdist', 'playwright', 'hypothesis', 'mcap'],
         # Grading on a Ray cluster: python -m miro_ball.grade --ray.
         'scale': ['ray>=2.40'],
     },

@@ -20,7 +20,7 @@ TIERS = {
               'test_world_fuzz', 'test_kc', 'test_camera_model', 'test_gaze', 'test_class_report',
               'test_pose_controller', 'test_floor_map', 'test_scene_markers', 'test_touch',
               'test_pictures', 'test_gui_scene', 'test_eye_pipeline', 'test_held_command',
-              'test_kick_judge', 'test_sandbox_args')),
+              'test_kick_judge', 'test_sandbox_args', 'test_param_overrides')),
     'ros': ('nodes in-process on executors of their own, a process or two beside them',
             ('test_clients', 'test_controller_node', 'test_fuzz_params', 'test_fuzz_topics',
              'test_gui_bridge', 'test_multi_robot', 'test_sim_executor', 'test_sim_node',
@@ -29,7 +29,7 @@ TIERS = {
             ('test_closed_loop', 'test_demo', 'test_grade', 'test_gui_packaging',
              'test_packaging', 'test_record', 'test_restart', 'test_scenario_bench',
              'test_signals', 'test_sim_domain', 'test_soak', 'test_tutorial', 'test_grade_class',
-             'test_grade_ray')),
+             'test_grade_ray', 'test_refusals')),
     'browser': ('the GUI in Debian\'s chromium through Playwright', ('test_gui_browser',)),
     'netns': ('hosts in network namespaces (root)', ('test_two_hosts',)),
 }

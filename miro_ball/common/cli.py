@@ -2,13 +2,24 @@
 import sys
 
 
-def user_args(argv, prog):
-    """argv[1:] without its --ros-args part; a malformed --ros-args part ends the program
-    with one line on stderr and exit code 2, like any other bad command line."""
+def user_args(argv, prog, params=(), node=None):
+    """argv[1:] without its --ros-args part. A malformed --ros-args part, or one that sets a
+    parameter that is none of ``params`` (dataclasses of common.params) nor ROS's own, or
+    sets one to a value of the wrong type, ends the program with one line on stderr and exit
+    code 2, like any other bad command line. ``node``: the node's name in a --params-file
+    (default prog)."""
     from rclpy.utilities import remove_ros_args
 
+    from miro_ball.common.params import check_overrides, ros_overrides
+
     try:
-        return remove_ros_args(argv)[1:]
+        own = remove_ros_args(argv)[1:]
     except Exception as err:  # rclpy's malformed --ros-args error has no public class
         print(f'{prog}: error: {err}', file=sys.stderr)
         sys.exit(2)
+    try:
+        check_overrides(ros_overrides(argv, node or prog), *params)
+    except ValueError as err:
+        print(f'{prog}: error: {err}', file=sys.stderr)
+        sys.exit(2)
+    return own

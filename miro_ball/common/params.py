@@ -10,6 +10,10 @@ Every number is bounded: a value that is legal but absurd (a 1e9 s tick, a
 import math
 from dataclasses import fields, MISSING, replace
 
+# Parameters every rclpy node has; a user may set them on any of ours.
+ROS_OWN_PARAMS = {'use_sim_time': False, 'start_type_description_service': True}
+ROS_OWN_PREFIXES = ('qos_overrides.',)
+
 
 def default_of(f):
     return f.default_factory() if f.default is MISSING else f.default
@@ -62,11 +66,9 @@ def check_ranges(values):
                              % (f.name, _show(lowest), _show(highest), _show(value)))
 
 
-def declare(node, cls, overrides=None):
-    """Declare every field of cls on the node and return the filled-in dataclass.
-
-    overrides: {name: value} that win over the node's own (e.g. from the command line).
-    """
+def declare(node, cls):
+    """Declare every field of cls on the node and return the filled-in dataclass (the
+    command line's values checked: coerce, then the dataclass's ranges)."""
     from rcl_interfaces.msg import ParameterDescriptor
 
     values = {}
@@ -75,10 +77,83 @@ def declare(node, cls, overrides=None):
         descriptor = ParameterDescriptor(description=f.metadata['help'], dynamic_typing=True)
         declared = list(default) if isinstance(default, tuple) else default
         value = node.declare_parameter(f.name, declared, descriptor).value
-        if overrides and f.name in overrides:
-            value = overrides[f.name]
         values[f.name] = coerce(f.name, value, default)
     return cls(**values)
+
+
+def ros_overrides(argv, node_name):
+    """{name: value} of every parameter the ``--ros-args`` parts of argv set for a node called
+    node_name: ``-p name:=value`` and the node's (or ``/**``'s) part of ``--params-file``.
+
+    rclpy keeps the overrides it parsed to itself (a private attribute of Node), and a node
+    that never declares a name never sees it: so the command line is read here, as rcl reads
+    it (a value is YAML). ValueError in one line for what can not be read.
+    """
+    import yaml
+
+    found, inside, tokens = {}, False, iter(argv)
+    for token in tokens:
+        if token == '--ros-args':
+            inside = True
+        elif token == '--':
+            inside = False
+        elif inside and token in ('-p', '--param'):
+            rule = next(tokens, '')
+            name, sep, text = rule.partition(':=')
+            if not sep or not name:
+                raise ValueError(f'{token} {rule!r}: expected name:=value')
+            try:
+                found[name] = yaml.safe_load(text)
+            except yaml.YAMLError:
+                found[name] = text
+        elif inside and token == '--params-file':
+            found.update(_params_file(next(tokens, ''), node_name))
+    return found
+
+
+def _params_file(path, node_name):
+    import yaml
+
+    try:
+        with open(path) as f:
+            content = yaml.safe_load(f) or {}
+    except (OSError, yaml.YAMLError) as err:
+        raise ValueError(f'--params-file {path!r}: {err}') from None
+    found = {}
+    for node, section in (content.items() if isinstance(content, dict) else ()):
+        if str(node) in ('/**', node_name, '/' + node_name) or str(node).endswith('/' + node_name):
+            _flatten((section or {}).get('ros__parameters') or {}, '', found)
+    return found
+
+
+def _flatten(tree, prefix, into):
+    for key, value in tree.items():
+        if isinstance(value, dict):
+            _flatten(value, f'{prefix}{key}.', into)
+        else:
+            into[prefix + str(key)] = value
+
+
+def check_overrides(overrides, *groups):
+    """ValueError in one line for the first override that names no parameter of the groups
+    (nor one of ROS's own), with the nearest known names, or whose value has the wrong type.
+    A typo must not run the defaults as if nothing had been said."""
+    import difflib
+
+    known = {f.name: f for cls in groups for f in fields(cls)}
+    for name, value in overrides.items():
+        if name.startswith(ROS_OWN_PREFIXES):
+            continue
+        if name in ROS_OWN_PARAMS:
+            coerce(name, value, ROS_OWN_PARAMS[name])
+            continue
+        if name not in known:
+            near = difflib.get_close_matches(name, list(known) + list(ROS_OWN_PARAMS), n=3)
+            hint = (' (did you mean %s?)' % ', '.join(near)) if near else (
+                ' (--help lists the parameters)' if known else
+                ' (this node has none of its own; ROS\'s: %s)' % ', '.join(ROS_OWN_PARAMS))
+            raise ValueError(f'unknown parameter {name!r}{hint}')
+        coerce(name, value, default_of(known[name]))
 
 
 def _show(value):

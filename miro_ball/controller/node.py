@@ -391,7 +391,8 @@ def _fail(parser, err):
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
     parser = build_parser()
-    options = parser.parse_args(user_args(argv, parser.prog))
+    options = parser.parse_args(user_args(
+        argv, parser.prog, GROUPS, NODE_NAME))
     if options.save_debug:
         try:
             os.makedirs(options.save_debug, exist_ok=True)

@@ -321,7 +321,7 @@ def make_executor(context=None):
 
 def main(argv=None):
     argv = sys.argv if argv is None else argv
-    args = parse_args(user_args(argv, SIM_NODE_NAME))
+    args = parse_args(user_args(argv, SIM_NODE_NAME, (SimParams,)))
     # OpenCV's pool of one thread per core spun for 20-30 ms a simulated second on the
     # other core, which the eye worker and the controllers need.
     cv2.setNumThreads(1)
