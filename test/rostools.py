@@ -1,4 +1,5 @@
 """Helpers for ROS tests: collect messages, spin until something holds, step the world."""
+import inspect
 import os
 import signal
 import subprocess
@@ -7,14 +8,30 @@ import time
 import rclpy
 
 
-def spin_until(executor, predicate, timeout_s=10.0):
-    """Spin until predicate() holds; the wall-clock limit only guards against a hang."""
+def spin_until(executor, predicate, timeout_s=10.0, what=None):
+    """Spin until predicate() holds, and say so (True); a wait that runs out fails the test
+    (AssertionError naming ``what``), so no wait goes unchecked. The wall-clock limit only
+    guards against a hang; poll() is for a wait whose answer may be no."""
+    assert poll(executor, predicate, timeout_s), \
+        f'timed out after {timeout_s:g} s waiting for {what or _source(predicate)}'
+    return True
+
+
+def poll(executor, predicate, timeout_s):
+    """Spin until predicate() holds (True) or timeout_s have passed (False)."""
     deadline = time.monotonic() + timeout_s
     while not predicate():
         if time.monotonic() > deadline:
             return False
         executor.spin_once(timeout_sec=0.01)
     return True
+
+
+def _source(predicate):
+    try:
+        return inspect.getsource(predicate).strip()
+    except (OSError, TypeError):
+        return repr(predicate)
 
 
 def drain(executor, rounds=50):

@@ -24,7 +24,7 @@ from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
 from miro_ball.controller.names import debug_topic
 from miro_ball.miro.interface import CLOCK, default_robot_name, EYES, RobotTopics
 from hostile import decompression_bomb
-from rostools import drain, kill_if_running, Probe, spin_until
+from rostools import drain, kill_if_running, poll, Probe, spin_until
 from test_behaviour import AHEAD, camera_info_k, column
 
 TICK = 0.02
@@ -335,7 +335,7 @@ def test_a_remapped_namespace_picks_the_robot(ros_context, executor):
         while not mine and t < 60.0:  # sim time moves only as the test says
             clock.publish(Clock(clock=Time(sec=int(t), nanosec=int(t % 1 * 1e9))))
             drain(executor)
-            spin_until(executor, lambda: mine, timeout_s=0.05)
+            poll(executor, lambda: mine, timeout_s=0.05)
             t += 0.02
         assert mine and mine[-1].header.frame_id == f'{robot}/base_link'
         assert not theirs

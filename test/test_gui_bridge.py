@@ -22,7 +22,7 @@ from miro_ball.miro.constants import (DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, LINK
 from miro_ball.miro.interface import (BALL_NAME, EYES, RobotTopics, SimTopics,
                                       default_robot_name)
 from miro_ball.miro.touch import pads_at
-from rostools import Probe, spin_until
+from rostools import poll, Probe, spin_until
 
 T = RobotTopics(default_robot_name())
 SIM = SimTopics()
@@ -115,7 +115,7 @@ def test_a_drive_that_is_not_renewed_stops_and_another_page_cannot_stop_it(
     assert time.monotonic() - sent >= DEADMAN_S
     assert len([t for t in twists if t.twist.linear.x > 0]) > 3  # renewed at 50 Hz meanwhile
     count = len(twists)
-    assert not spin_until(executor, lambda: len(twists) > count, timeout_s=0.3), \
+    assert not poll(executor, lambda: len(twists) > count, timeout_s=0.3), \
         'went on publishing after the stop'
 
 

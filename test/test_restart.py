@@ -21,7 +21,7 @@ from miro_ball.run.nodes import controller_command, sim_command
 from miro_ball.run.processes import Processes
 from miro_ball.miro.interface import default_robot_name, RobotTopics, SimTopics
 from miro_sim_bullet.physics.robot import CMD_TIMEOUT_S
-from rostools import drain, Probe, spin_until
+from rostools import drain, poll, Probe, spin_until
 
 ROBOT = default_robot_name()
 TOPICS = RobotTopics(ROBOT)
@@ -79,7 +79,7 @@ def step_until(executor, probe, predicate, max_steps=500):
         executor.spin_until_future_complete(future, timeout_sec=2.0)
         assert future.result() is None or future.result().success, future.result().message
         # Time for the controller to answer this tick; the limit only bounds each try.
-        if spin_until(executor, predicate, timeout_s=0.2):
+        if poll(executor, predicate, timeout_s=0.2):
             return
     pytest.fail(f'nothing after {max_steps} ticks')
 
