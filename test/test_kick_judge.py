@@ -94,3 +94,32 @@ def test_each_way_beyond_miros_interface_is_named():
     assert any('/miro/sensors/odom' in s and "faking the robot's sensors" in s for s in said)
     assert any('/miro02/control/cmd_vel' in s and "another robot's" in s for s in said)
     assert sum("the simulator's own" in s for s in said) == 3
+
+
+class _Graph:
+    """A node's graph API where listing one node's service clients fails."""
+
+    def __init__(self, still_there):
+        self.still_there = still_there
+
+    def get_topic_names_and_types(self):
+        return []
+
+    def get_node_names_and_namespaces(self):
+        return [('cheat', '/')] if self.still_there else []
+
+    def get_client_names_and_types_by_node(self, name, namespace):
+        raise RuntimeError('lookup failed')
+
+
+def test_a_watch_that_can_not_look_fails_the_episode():
+    from miro_ball.grading.watch import GraphWatch, verdict
+
+    reasons = verdict(GraphWatch(_Graph(still_there=True)), 'miro')
+    assert len(reasons) == 1 and 'graph watch failed' in reasons[0] and '/cheat' in reasons[0]
+
+
+def test_a_node_that_left_while_it_was_looked_at_is_no_failure():
+    from miro_ball.grading.watch import GraphWatch, verdict
+
+    assert verdict(GraphWatch(_Graph(still_there=False)), 'miro') == []

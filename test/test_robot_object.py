@@ -122,9 +122,12 @@ def test_sleep_counts_simulated_time_across_a_reset_of_the_world(sim):
         assert started < 2.0
         miro.sleep(1.0)  # the world is reset during this second: time starts again from 0
         assert reset
-        # Within three 20 ms ticks: the sleep's start, its end and the reset each fall on
-        # one (1.05 was seen in a full run).
-        assert (reset[0] - started) + miro.now == pytest.approx(1.0, abs=0.061)
+        # Never early by more than three 20 ms ticks (the sleep's start, its end and the
+        # reset each fall on one). Late by as much as this thread is kept waiting for a
+        # core while the simulator runs on in real time (1.09 seen with two test files at
+        # a time); a sleep that forgot the reset would end 2 s or more late.
+        slept = (reset[0] - started) + miro.now
+        assert 1.0 - 0.061 <= slept <= 1.3, slept
     sim.script(script, meanwhile=reset_once)
 
 

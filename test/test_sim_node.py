@@ -22,6 +22,7 @@ from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics, default_robot_name, robot_name
 from miro_sim_bullet.physics.world import PHYSICS_DT_S
+from miro_sim_bullet.scene.world_file import WorldError
 from rostools import Probe, drain, spin_until
 
 T = RobotTopics(default_robot_name())
@@ -230,6 +231,18 @@ def test_bad_start_options_fail_in_one_line(args, message):
     errors = out.stderr.splitlines()  # one line: no pybullet banner, no traceback
     assert len(errors) == 1 and errors[0].startswith('miro_sim: error:') \
         and message in errors[0], out.stderr
+
+
+def test_a_bad_world_is_said_before_the_look_for_another_simulator(ros_context, monkeypatch):
+    """The look takes peer_check_s (3.5 s): a typo in the world's name costs none of it."""
+    from miro_sim_bullet.ros import node as sim_module
+
+    def look(*_):
+        raise AssertionError('looked for another simulator before reading the world')
+    monkeypatch.setattr(sim_module, 'refuse_shared_domain', look)
+    with pytest.raises(WorldError, match="unknown world 'nowhere'"):
+        sim_module.SimNode(context=ros_context, guard_domain=True,
+                           parameter_overrides=[Parameter('world', value='nowhere')])
 
 
 def test_help_lists_the_parameters_and_worlds():

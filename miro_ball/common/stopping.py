@@ -8,10 +8,17 @@ simulator), so the handler never ran; and when it did run inside rclpy's C++
 and the spin wakes at least every WAKE_PERIOD_S to look at that note.
 """
 import signal
+import traceback
 
+from rclpy.exceptions import InvalidHandle
 from rclpy.executors import ExternalShutdownException
 
+from miro_ball.common.throttle import Throttled
+
 WAKE_PERIOD_S = 0.1
+FAULT_PERIOD_S = 10.0
+# What no node can go on from: its memory, or its handles into ROS, are gone.
+FATAL = (MemoryError, InvalidHandle)
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
@@ -35,11 +42,38 @@ class StopRequest:
         return self.signum is not None
 
 
-def spin_until_stopped(executor, stop, context=None):
-    """Spin until a stop signal, or until the context is shut down from elsewhere."""
+def spin_until_stopped(executor, stop, context=None, fatal=()):
+    """Spin until a stop signal, or until the context is shut down from elsewhere.
+
+    A callback that raises costs its own message, not the node: its traceback is logged
+    once for each place it comes from (then counted, at most a line every FAULT_PERIOD_S)
+    and the node serves on. What the node can not go on from (no memory, its ROS handles
+    gone, and the caller's ``fatal`` exception classes) ends the spin with its traceback.
+    """
     context = context or executor.context
-    try:
-        while not stop.requested and context.ok():
-            executor.spin_once(timeout_sec=WAKE_PERIOD_S)
-    except ExternalShutdownException:
-        pass
+    faults = None
+    while True:
+        try:
+            while not stop.requested and context.ok():
+                executor.spin_once(timeout_sec=WAKE_PERIOD_S)
+            return
+        except ExternalShutdownException:
+            return
+        except FATAL + tuple(fatal):
+            raise
+        except Exception as err:  # noqa: BLE001 -- a bug in one callback must not end the node
+            faults = faults or _fault_log(executor)
+            faults(err)
+
+
+def _fault_log(executor):
+    nodes = executor.get_nodes()
+    log = nodes[0].get_logger().error if nodes else print
+    throttled = Throttled(log, period_s=FAULT_PERIOD_S)
+
+    def fault(err):
+        where = traceback.extract_tb(err.__traceback__)[-1:]
+        key = (type(err), *((where[0].filename, where[0].lineno) if where else ()))
+        throttled(key, 'a callback failed; its message is dropped and the node goes on:\n'
+                  + ''.join(traceback.format_exception(err)).rstrip())
+    return fault

@@ -23,6 +23,7 @@ import rclpy
 from geometry_msgs.msg import TwistStamped
 from rclpy.clock import Clock, ClockType, JumpThreshold
 from rclpy.duration import Duration
+from rclpy.exceptions import NameValidationException, ParameterException
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
@@ -406,7 +407,8 @@ def main(argv=None):
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
         node = KickBlueBall(save_debug=options.save_debug, robot=options.robot)
-    except Exception as err:  # a bad parameter or topic name: say so in one line
+    except (ValueError, ParameterException, NameValidationException) as err:
+        # a bad parameter or name: say so in one line
         rclpy.try_shutdown()
         _fail(parser, err)
     executor = SingleThreadedExecutor()

@@ -34,7 +34,7 @@ from miro_ball.grading import dds_profiles, sandbox
 from miro_ball.grading.command import Command
 from miro_ball.grading.kick_judge import KickJudge
 from miro_ball.grading.warm_start import python_args
-from miro_ball.grading.watch import GraphWatch, breaches
+from miro_ball.grading.watch import GraphWatch, verdict
 from miro_ball.miro.interface import RobotTopics
 from miro_ball.run.episode import SETTLE_S
 
@@ -217,7 +217,7 @@ class Host:
             node.pause(True)
             lap('clock')
             # Before it stops: what it did on the graph is still there to see.
-            self.cheats = self.cheats or breaches(self.watch.endpoints(), self.args.robot)
+            self.cheats = self.cheats or verdict(self.watch, self.args.robot)
             if result['ended'] == 'command exited':
                 result['exit_code'] = command.exited()
             result['killed'] = command.stop(spec['grace_s'])
@@ -297,7 +297,7 @@ class Host:
             now = time.monotonic()
             if now >= next_watch:
                 next_watch = now + WATCH_EVERY_S
-                self.cheats = breaches(self.watch.endpoints(), self.args.robot)
+                self.cheats = verdict(self.watch, self.args.robot)
                 if self.cheats:
                     return 'cheated'
             if now > guard:

@@ -49,6 +49,19 @@ def _other_robots(topic, robot, interface_rows):
     return len(parts) == 3 and parts[1] != robot and parts[2] in interface_rows
 
 
+class WatchFailed(Exception):
+    """The graph could not be looked at: what was not seen can not pass."""
+
+
+def verdict(watch, robot):
+    """breaches() of what ``watch`` (a GraphWatch) sees; a watch that fails fails the episode
+    (the reason in the same words as a breach), never lets it pass unseen."""
+    try:
+        return breaches(watch.endpoints(), robot)
+    except WatchFailed as err:
+        return [f'the graph watch failed ({err}): the episode is not scored']
+
+
 class GraphWatch:
     """The endpoints on node's graph that are not the host's: ``mark_own()`` once, before
     the command starts, takes every endpoint there is as the host's (by its GID: node
@@ -77,8 +90,11 @@ class GraphWatch:
         for name, namespace in self.node.get_node_names_and_namespaces():
             try:
                 clients = self.node.get_client_names_and_types_by_node(name, namespace)
-            except Exception:  # noqa: B902 - the node left meanwhile (rclpy raises its own)
-                continue
+            except Exception as err:  # noqa: B902 - rclpy's lookup error has no public class
+                if (name, namespace) not in self.node.get_node_names_and_namespaces():
+                    continue  # the node left meanwhile: nothing of it to see
+                raise WatchFailed(f'could not list the service clients of '
+                                  f'{_full(namespace, name)}: {err}') from err
             ends += [Endpoint(CLIENT, service, _full(namespace, name))
                      for service, _ in clients]
         return ends

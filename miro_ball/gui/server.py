@@ -19,6 +19,7 @@ import logging
 import re
 import socket
 import time
+import traceback
 from pathlib import Path
 from urllib.parse import urlsplit
 
@@ -223,9 +224,10 @@ class GuiServer:
             except protocol.Rejected as err:
                 self.warn(f'bad:{page.number}', f'page {page.number}: message ignored: {err}')
                 continue
-            except Exception as err:  # noqa: BLE001 -- a gap in the checks must not end the page
-                self.warn(f'bad:{page.number}', f'page {page.number}: message ignored: '
-                          f'{type(err).__name__} (please report)')
+            except Exception:  # noqa: BLE001 -- a gap in the checks must not end the page
+                self.warn(f'bad:{page.number}', f'page {page.number}: message ignored, the '
+                          f'checks of gui/protocol.py let it through and then failed on it '
+                          f'(please report): {msg.data[:200]!r}\n{traceback.format_exc()}')
                 continue
             if clamped:
                 self.warn(f'clamp:{page.number}', f'page {page.number}: '

@@ -207,7 +207,7 @@ def main(argv=None):
     executor.add_node(node)
     code = 0
     try:
-        spin_until_stopped(executor, stop)
+        spin_until_stopped(executor, stop, fatal=(RecordingFailed,))
     except RecordingFailed as err:
         node.get_logger().error(f'{err}: recording stopped')
         code = 1

@@ -49,7 +49,7 @@ from miro_sim_bullet.ros.robot_interface import RobotInterface
 from miro_sim_bullet.ros.scene import SCENE_RATE_HZ
 from miro_sim_bullet.ros.scene_interface import SceneInterface
 from miro_sim_bullet.ros.sim_interface import SimInterface
-from miro_sim_bullet.scene.world_file import WorldError, bundled_worlds
+from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, WorldError
 
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 FIXED_PARAMS = ('world', 'physics_dt', 'frame_width', 'frame_height',
@@ -81,12 +81,15 @@ class SimNode(Node):
         self.params = p = declare(self, SimParams)
         self._live = LiveParams(self, (p,), self._apply, fixed=FIXED_PARAMS)
         self.warn = Throttled(self.get_logger().warning)
+        # The world file is read first: a typo in its name is said at once, not after the
+        # look for another simulator (peer_check_s).
+        world = load_world(p.world)
         # Before the look for another simulator: two started together see each other.
         self.pub_clock = self.create_publisher(ClockMsg, CLOCK, profile(CLOCK_QOS))
         if guard_domain:  # before the world is built: a refusal costs no time
             refuse_shared_domain(self, p.peer_check_s)
             self._clock_watch = ClockWatch(self, own=1)
-        self.sim = SimWorld(p.world, physics_dt=p.physics_dt, robot_name=unnamed_robot)
+        self.sim = SimWorld(world, physics_dt=p.physics_dt, robot_name=unnamed_robot)
         self.cameras = Cameras(self.sim, p.renderer, log=self.get_logger().info)
         self.eyes = EyePipeline(self.cameras, p.eye_workers, log=self.get_logger().info,
                                 warn=self.get_logger().warning)
@@ -329,16 +332,18 @@ def main(argv=None):
     # Ctrl+C and SIGTERM end the spin with the context still up (see stopping.py).
     stop = StopRequest()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    node = None
     try:
         node = SimNode(parameter_overrides=overrides, robot=args.robot, guard_domain=True)
+    except (WorldError, RendererUnavailable, ValueError, SharedDomain) as err:
+        # A bad start (world, renderer, parameter, another simulator): one line. Errors
+        # once running are not the user's: spin_until_stopped logs their tracebacks.
+        rclpy.try_shutdown()
+        print(f'{SIM_NODE_NAME}: error: {err}', file=sys.stderr)
+        sys.exit(2)
+    try:
         executor = make_executor()
         executor.add_node(node)
         spin_until_stopped(executor, stop)
-    except (WorldError, RendererUnavailable, ValueError, SharedDomain) as err:
-        print(f'{SIM_NODE_NAME}: error: {err}', file=sys.stderr)
-        sys.exit(2)
     finally:
-        if node is not None:
-            node.destroy_node()
+        node.destroy_node()
         rclpy.try_shutdown()
