@@ -124,8 +124,8 @@ def test_sleep_counts_simulated_time_across_a_reset_of_the_world(sim):
         assert reset
         # Never early by more than three 20 ms ticks (the sleep's start, its end and the
         # reset each fall on one). Late by as much as this thread is kept waiting for a
-        # core while the simulator runs on in real time (1.09 seen with two test files at
-        # a time); a sleep that forgot the reset would end 2 s or more late.
+        # core while the simulator runs on in real time (more than 0.061 twice with two test
+        # files at a time); a sleep that forgot the reset would end 2 s or more late.
         slept = (reset[0] - started) + miro.now
         assert 1.0 - 0.061 <= slept <= 1.3, slept
     sim.script(script, meanwhile=reset_once)
