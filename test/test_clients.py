@@ -184,8 +184,8 @@ def test_a_client_as_a_command_drives_its_robot_and_exits_cleanly(module, args, 
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         interface = paused_sim.robots[T.name]
-        assert spin_until(executor, lambda: interface.pub_odom.get_subscription_count()
-                          + interface.pub_battery.get_subscription_count(), timeout_s=60.0)
+        assert spin_until(executor, lambda: interface.publisher('odom').get_subscription_count()
+                          + interface.publisher('battery').get_subscription_count(), timeout_s=60.0)
         advance_until(paused_sim, executor, lambda: proc.poll() is not None)
         output, _ = proc.communicate(timeout=10)
     finally:

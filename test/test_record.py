@@ -160,8 +160,8 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
         String, '/latched', QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL))
     latched.publish(String(data='before the clock'))
     interface = paused_sim.robots[ROBOT.name]
-    assert spin_until(executor, lambda: interface.pub_odom.get_subscription_count()
-                      and interface.pub_cliff.get_subscription_count()
+    assert spin_until(executor, lambda: interface.publisher('odom').get_subscription_count()
+                      and interface.publisher('cliff').get_subscription_count()
                       and interface.pub_eyes['caml'][0].get_subscription_count()
                       and latched.get_subscription_count())
     advance_ticks(paused_sim, executor)  # the first /clock starts the recording
@@ -220,7 +220,7 @@ def test_a_full_disk_ends_the_recording_and_keeps_the_finished_files(
     recorder = Recorder(bag, Selection([ROBOT.odom]), context=ros_context)
     executor.add_node(recorder)
     interface = paused_sim.robots[ROBOT.name]
-    assert spin_until(executor, lambda: interface.pub_odom.get_subscription_count())
+    assert spin_until(executor, lambda: interface.publisher('odom').get_subscription_count())
     advance_ticks(paused_sim, executor)  # the first /clock
     first_clock = round(paused_sim.sim.time * 1e9)
     advance_ticks(paused_sim, executor, 25)
@@ -292,7 +292,7 @@ def test_a_killed_recorder_leaves_a_readable_bag_or_nothing_like_one(
     proc = start_recorder('-o', str(first), ROBOT.odom)
     try:
         advance_until(paused_sim, executor,
-                      lambda: paused_sim.robots[ROBOT.name].pub_odom.get_subscription_count())
+                      lambda: paused_sim.robots[ROBOT.name].publisher('odom').get_subscription_count())
         advance_ticks(paused_sim, executor, 20)
     finally:
         proc.kill()

@@ -58,7 +58,7 @@ def test_sensors_and_clock_follow_simulated_time(sim_node, probe, executor):
     flags = probe.watch(UInt32, T.sensor_flags)
     cliff = probe.watch(Float32MultiArray, T.cliff)
     kin = probe.watch(JointState, T.kinematic_joints)
-    spin_until(executor, lambda: sim_node.robots[T.name].pub_odom.get_subscription_count() > 0)
+    spin_until(executor, lambda: sim_node.robots[T.name].publisher('odom').get_subscription_count() > 0)
     run(sim_node, executor, 1.0)
     assert spin_until(executor, lambda: len(odom) >= 50)
     assert len(odom) == 50  # 50 Hz for 1 s of simulated time
@@ -93,7 +93,7 @@ def test_every_stamped_message_names_its_robots_frame(make_sim, probe, executor,
     heard = {topic: probe.watch(kind, topic) for topic, (kind, _) in expected.items()}
     eyes = node.robots[name].pub_eyes
     spin_until(executor, lambda: all(p.get_subscription_count() for p in
-                                     (*eyes['caml'], *eyes['camr'], node.robots[name].pub_odom)))
+                                     (*eyes['caml'], *eyes['camr'], node.robots[name].publisher('odom'))))
     run(node, executor, 0.1)
     assert spin_until(executor, lambda: all(heard.values()))
     assert {topic: {m.header.frame_id for m in messages} for topic, messages in heard.items()} \

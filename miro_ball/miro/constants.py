@@ -35,6 +35,11 @@ KIN_CALIB_RAD = (TILT_RAD, LIFT_RAD_CALIB, 0.0, 0.0)
 # Cosmetic joints (section 1.5): droop, wag, eyelid l/r, ear l/r, each 0..1.
 COSMETIC_CALIB = (0.0, 0.5, 0.0, 0.0, 1.0 / 3.0, 1.0 / 3.0)
 
+# Speaker (section 3.2): control/stream's samples, control/tone's frequency and volume.
+SPEAKER_SAMPLE_RATE_HZ = 8000
+TONE_FREQUENCY_RANGE_HZ = (200.0, 2000.0)  # the MDK's interface clips to this
+TONE_VOLUME_MAX = 255
+
 # Cameras (section 2)
 CAM_ELEVATION_RAD = math.radians(45.0)
 CAM_DIVERGENCE_RAD = math.radians(27.0)

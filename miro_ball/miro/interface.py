@@ -25,6 +25,8 @@ EYE_SIDE = {'caml': +1, 'camr': -1}  # +1 left, -1 right: the sign of the eye's 
 SIM_NODE_NAME = 'miro_sim'
 WORLD_FRAME = 'world'  # the simulator's frame (ground truth, the scene)
 TOUCH_PARTS = ('head', 'body')
+# What a row's {placeholder} stands for (the IMUs are in the same two parts as the pads).
+PLACEHOLDERS = {'eye': EYES, 'part': TOUCH_PARTS}
 BALL_NAME = 'ball'  # the simulator's name of the ball, for set_pose and its ground truth
 MAX_NAME_LENGTH = 64
 # A ROS name token: what may stand between two slashes of a topic name.
@@ -49,12 +51,15 @@ CONTROL_QOS = Qos(depth=10)
 CLOCK_QOS = Qos(depth=10)  # matches rclpy's own best-effort /clock subscription
 
 SENSOR, CONTROL = 'sensor', 'control'  # out of the robot, into the robot
+PLATFORM_HZ = 50.0  # MiRo's platform tick: its sensors, /clock
+CAMERA = 'camera'  # a stream at the eyes' rate (the simulator's camera_rate parameter)
 
 
 @dataclass(frozen=True)
 class Topic:
     """One row of MiRo's interface; ``name`` is relative to the robot's namespace and may
-    hold ``{eye}`` or ``{part}``."""
+    hold ``{eye}`` or ``{part}``. ``rate``: how often a sensor stream is published, in Hz
+    of simulated time (or CAMERA); a control topic is taken as it comes (None)."""
 
     key: str
     name: str
@@ -62,41 +67,57 @@ class Topic:
     direction: str
     qos: Qos
     about: str
+    rate: object = None
+
+    @property
+    def holes(self):
+        """The placeholders of the name, and the values each takes: {'eye': EYES}, ..."""
+        return {hole: values for hole, values in PLACEHOLDERS.items()
+                if '{' + hole + '}' in self.name}
+
+    def names(self):
+        """[(fields, relative name)] for every value of the name's placeholder."""
+        holes = self.holes
+        if not holes:
+            return [({}, self.name)]
+        (hole, values), = holes.items()
+        return [({hole: v}, self.name.format(**{hole: v})) for v in values]
 
 
-ROBOT_INTERFACE = tuple(Topic(*row) for row in (
-    # key, relative name, type, direction, QoS, what it carries
+ROBOT_INTERFACE = tuple(Topic(*row[:6], *(row[6:] or (None,))) for row in (
+    # key, relative name, type, direction, QoS, what it carries[, rate of a sensor]
     ('eye_compressed', 'sensors/{eye}/compressed', 'sensor_msgs/msg/CompressedImage', SENSOR,
-     EYE_QOS, 'eye image, JPEG'),
+     EYE_QOS, 'eye image, JPEG', CAMERA),
     ('eye_raw', 'sensors/{eye}', 'sensor_msgs/msg/Image', SENSOR, EYE_QOS,
-     'eye image, rgb8 (rendered only while subscribed)'),
+     'eye image, rgb8 (rendered only while subscribed)', CAMERA),
     ('camera_info', 'sensors/{eye}/camera_info', 'sensor_msgs/msg/CameraInfo', SENSOR, EYE_QOS,
-     "the eye's camera model, with each frame"),
+     "the eye's camera model, with each frame", CAMERA),
     ('kinematic_joints', 'sensors/kinematic_joints', 'sensor_msgs/msg/JointState', SENSOR,
-     SENSOR_QOS, 'tilt, lift, yaw, pitch, rad'),
+     SENSOR_QOS, 'tilt, lift, yaw, pitch, rad', PLATFORM_HZ),
     ('odom', 'sensors/odom', 'nav_msgs/msg/Odometry', SENSOR, SENSOR_QOS,
-     'pose in <robot>/odom, twist in <robot>/base_link'),
+     'pose in <robot>/odom, twist in <robot>/base_link', PLATFORM_HZ),
     ('body_pose', 'sensors/body_pose', 'geometry_msgs/msg/Pose2D', SENSOR, SENSOR_QOS,
-     'x, y, theta in <robot>/odom'),
+     'x, y, theta in <robot>/odom', PLATFORM_HZ),
     ('body_vel', 'sensors/body_vel', 'geometry_msgs/msg/Twist', SENSOR, SENSOR_QOS,
-     'body velocity'),
+     'body velocity', PLATFORM_HZ),
     ('wheel_speed_cmd', 'sensors/wheel_speed_cmd', 'std_msgs/msg/Float32MultiArray', SENSOR,
-     SENSOR_QOS, 'commanded wheel speeds [L, R], m/s'),
+     SENSOR_QOS, 'commanded wheel speeds [L, R], m/s', PLATFORM_HZ),
     ('wheel_speed_opto', 'sensors/wheel_speed_opto', 'std_msgs/msg/Float32MultiArray', SENSOR,
-     SENSOR_QOS, 'measured wheel speeds [L, R], m/s'),
+     SENSOR_QOS, 'measured wheel speeds [L, R], m/s', PLATFORM_HZ),
     ('cliff', 'sensors/cliff', 'std_msgs/msg/Float32MultiArray', SENSOR, SENSOR_QOS,
-     '[L, R]: 1 floor, below 0.7 a drop'),
-    ('sonar', 'sensors/sonar', 'sensor_msgs/msg/Range', SENSOR, SENSOR_QOS, 'range ahead, m'),
+     '[L, R]: 1 floor, below 0.7 a drop', PLATFORM_HZ),
+    ('sonar', 'sensors/sonar', 'sensor_msgs/msg/Range', SENSOR, SENSOR_QOS, 'range ahead, m',
+     PLATFORM_HZ),
     ('imu', 'sensors/imu_{part}', 'sensor_msgs/msg/Imu', SENSOR, SENSOR_QOS,
-     'part body or head'),
+     'part body or head', PLATFORM_HZ),
     ('battery', 'sensors/battery', 'sensor_msgs/msg/BatteryState', SENSOR, SENSOR_QOS,
-     'battery voltage'),
+     'battery voltage', PLATFORM_HZ),
     ('light', 'sensors/light', 'std_msgs/msg/Float32MultiArray', SENSOR, SENSOR_QOS,
-     'four light sensors, 0..1'),
+     'four light sensors, 0..1', PLATFORM_HZ),
     ('touch', 'sensors/touch_{part}', 'std_msgs/msg/UInt16', SENSOR, SENSOR_QOS,
-     'part head or body: a bit per touch sensor'),
+     'part head or body: a bit per touch sensor', PLATFORM_HZ),
     ('sensor_flags', 'sensors/flags', 'std_msgs/msg/UInt32', SENSOR, SENSOR_QOS,
-     'platform flags (bit 15: simulator)'),
+     'platform flags (bit 15: simulator)', PLATFORM_HZ),
     ('cmd_vel', 'control/cmd_vel', 'geometry_msgs/msg/TwistStamped', CONTROL, CONTROL_QOS,
      'body velocity, 0.4 m/s a wheel at most'),
     ('kinematic_targets', 'control/kinematic_joints', 'sensor_msgs/msg/JointState', CONTROL,
@@ -107,6 +128,8 @@ ROBOT_INTERFACE = tuple(Topic(*row) for row in (
      'six LEDs, ARGB'),
     ('tone', 'control/tone', 'std_msgs/msg/UInt16MultiArray', CONTROL, CONTROL_QOS,
      'frequency, volume, ticks'),
+    ('stream', 'control/stream', 'std_msgs/msg/Int16MultiArray', CONTROL, CONTROL_QOS,
+     'speaker samples, 8 kHz, appended to its buffer'),
     ('control_flags', 'control/flags', 'std_msgs/msg/UInt32', CONTROL, CONTROL_QOS,
      'platform flags'),
 ))
@@ -207,16 +230,8 @@ class RobotTopics:
     def all(self, direction=None):
         """Every topic name of the interface (only SENSOR's or CONTROL's if direction is
         given), placeholders filled in with every eye and part."""
-        fill = {'eye': EYES, 'part': TOUCH_PARTS}
-        names = []
-        for row in ROBOT_INTERFACE:
-            if direction not in (None, row.direction):
-                continue
-            holes = [key for key in fill if '{' + key + '}' in row.name]
-            values = fill[holes[0]] if holes else [None]
-            names += [self.topic(row.name.format(**({holes[0]: v} if holes else {})))
-                      for v in values]
-        return names
+        return [self.topic(name) for row in ROBOT_INTERFACE
+                if direction in (None, row.direction) for _, name in row.names()]
 
     def __getattr__(self, key):
         # The rows without a placeholder: t.odom, t.cliff, t.cmd_vel, ...

@@ -19,6 +19,7 @@ from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics import model as rb
 from miro_sim_bullet.physics.sensors import (SONAR_DIRECTIONS, Accelerometer, Sensors,
                                              cliff_value)
+from miro_sim_bullet.physics.speaker import Speaker
 
 CMD_TIMEOUT_S = 0.5
 WHEEL_TORQUE_NM = 0.5  # enough to reach 0.4 m/s in a few cm, weak enough to stall on a wall
@@ -61,6 +62,7 @@ class MiroRobot:
         self.cosmetic = list(COSMETIC_CALIB)
         self.flags = 0
         self.illum = [0] * 6
+        self.speaker = Speaker()
         self.touched_at = {part: [-math.inf] * TOUCH_PADS for part in TOUCH_PARTS}
         for accelerometer in self.imu.values():
             accelerometer.reset()
@@ -98,6 +100,15 @@ class MiroRobot:
         """Six 0xAARRGGBB LEDs, shown as the colour of the body patches."""
         self.illum = list(argb)
         self.model.show_illum(self.illum)
+
+    def play_tone(self, frequency, volume, ticks):
+        """control/tone: [frequency Hz, volume 0..255, duration in platform ticks]."""
+        return self.speaker.play_tone(frequency, volume, ticks, self.clock())
+
+    def stream(self, samples):
+        """control/stream: int16 samples at 8 kHz for the speaker; returns how many were
+        dropped (the speaker's buffer was full)."""
+        return self.speaker.append(samples)
 
     def touch(self, part, mask):
         """A hand on the pads of mask (bits 0..13) of 'head' or 'body', now."""
@@ -149,6 +160,7 @@ class MiroRobot:
             self.body_id, [rb.WHEEL_L, rb.WHEEL_R], pb.VELOCITY_CONTROL,
             targetVelocities=[left / WHEEL_RADIUS_M, right / WHEEL_RADIUS_M],
             forces=[WHEEL_TORQUE_NM] * 2, **self._kw())
+        self.speaker.tick(self.clock())
         self.sensors = self._read_sensors(cliff)
 
     # -- ground truth -----------------------------------------------------------------------

@@ -36,7 +36,8 @@ from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.interface import CLOCK, CLOCK_QOS, robot_name, SIM_NODE_NAME
+from miro_ball.miro.interface import (CAMERA, CLOCK, CLOCK_QOS, PLATFORM_HZ, ROBOT_INTERFACE,
+                                      robot_name, SENSOR, SIM_NODE_NAME)
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.eye_pipeline import EyePipeline
@@ -115,6 +116,12 @@ class SimNode(Node):
             f'world {self.sim.description.source}; robots {", ".join(self.robots)}; renderer '
             f'{self.cameras.renderer.name}; cameras {p.frame_width}x{p.frame_height} @ '
             f'{p.camera_rate:g} Hz; real-time factor {p.real_time_factor:g}')
+        # Physics steps between two messages of each sensor stream's rate (the interface
+        # table's); /clock and the ground truth go with the platform tick.
+        self._stream_steps = {rate: max(1, round(1.0 / (rate * self.sim.dt)))
+                              for rate in {PLATFORM_HZ} | {row.rate for row in ROBOT_INTERFACE
+                                                           if row.direction == SENSOR
+                                                           and row.rate != CAMERA}}
         self._restart_schedule()
         self._progress = (time.monotonic(), 0.0)
         self.timer = self._make_timer()
@@ -233,10 +240,12 @@ class SimNode(Node):
                 self._submit_eyes(overlap)
                 while self._frame_step(self._next_frame) <= sim.step_index:
                     self._next_frame += 1
-            if sim.step_index % sim.ticks_per_platform_tick == 0:
+            due = [rate for rate, every in self._stream_steps.items()
+                   if sim.step_index % every == 0]
+            if due:
                 self._publish_eyes(wait=False)
                 started = clock()
-                self._publish_tick()
+                self._publish_streams(due)
                 spent['sensor topics'] += clock() - started
             if self.scene is not None and sim.time >= self._next_scene:
                 started = clock()
@@ -252,12 +261,17 @@ class SimNode(Node):
                 spent['overhead'] += clock() - started
 
     # -- publishing ---------------------------------------------------------------------------
-    def _publish_tick(self):
+    def _publish_streams(self, rates):
+        """The sensor streams of the rates due now, after /clock on a platform tick, and
+        then the ground truth."""
         when = convert.stamp(self.sim.time)
-        self.pub_clock.publish(ClockMsg(clock=when))
-        for interface in self.robots.values():
-            interface.publish_tick(when)
-        if self.sim_interface is not None:
+        platform_tick = PLATFORM_HZ in rates
+        if platform_tick:
+            self.pub_clock.publish(ClockMsg(clock=when))
+        for rate in rates:
+            for interface in self.robots.values():
+                interface.publish_streams(rate, when)
+        if platform_tick and self.sim_interface is not None:
             self.sim_interface.publish_ground_truth(when)
 
     def _submit_eyes(self, overlap):

@@ -1,6 +1,6 @@
 """MiRo's ROS interface for one robot of the simulated world, under /<name>/.
 
-It publishes the robot's 50 Hz sensors and its eyes, and turns control messages
+It publishes the robot's sensor streams and its eyes, and turns control messages
 into platform commands after checking them: wrong lengths and non-finite values
 are ignored, finite values out of range are clamped, both with a rate-limited
 warning. The robot is looked up each time, so a world reset (which rebuilds
@@ -8,65 +8,60 @@ every robot) needs nothing from here.
 """
 import math
 
-from geometry_msgs.msg import Pose2D, Twist, TwistStamped
-from nav_msgs.msg import Odometry
-from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState, \
-    Range
-from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, UInt32MultiArray
+from std_msgs.msg import UInt16
 
+from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
-from miro_ball.miro.constants import JOINT_NAMES, UPSTREAM_FLAG_SIMULATOR
-from miro_ball.miro.interface import (EYE_SIDE, EYES, frame_id, RobotTopics, SimTopics, TOPIC,
+from miro_ball.miro.constants import JOINT_NAMES
+from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id,
+                                      ROBOT_INTERFACE, RobotTopics, SimTopics, TOPIC,
                                       TOUCH_PARTS)
 from miro_ball.miro.kinematics import finite
 from miro_ball.miro.touch import ALL_PADS
 from miro_sim_bullet.render.eye_images import EyeWants
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.endpoints import send_if_listened
+from miro_sim_bullet.ros.streams import PRODUCERS
 
+# An eye's three rows, in the order of pub_eyes[eye].
+EYE_ROWS = ('eye_compressed', 'eye_raw', 'camera_info')
 
 class RobotInterface:
     """The topics of robot ``name``: ros (Endpoints) makes them, robot() gives the robot
-    (a MiroRobot) as it is now, warn(kind, message) is a rate-limited warning."""
+    (a MiroRobot) as it is now, warn(kind, message) is a rate-limited warning.
+
+    Every row of MiRo's interface table is one endpoint here: a SENSOR row with a producer
+    (streams.PRODUCERS) is published at its rate by publish_streams(), the eyes' rows by
+    publish_eye(), a CONTROL row is applied to the robot by its handler below.
+    """
 
     def __init__(self, name, ros, robot, warn):
         self.name = name
         self._robot = robot
         self._warn = lambda kind, message: warn(f'{name}:{kind}', message)
         self.topics = t = RobotTopics(name)
-
-        def pub(msg_type, key, **fields):
-            """A publisher of the interface's row ``key``, with the row's QoS."""
-            row = TOPIC[key]
-            return ros.publisher(msg_type, t.topic(row.name.format(**fields)),
-                                 profile(row.qos))
-
-        self.pub_eyes = {eye: (pub(CompressedImage, 'eye_compressed', eye=eye),
-                               pub(Image, 'eye_raw', eye=eye),
-                               pub(CameraInfo, 'camera_info', eye=eye))
-                         for eye in EYES}
-        self.pub_kin = pub(JointState, 'kinematic_joints')
-        self.pub_odom = pub(Odometry, 'odom')
-        self.pub_pose = pub(Pose2D, 'body_pose')
-        self.pub_vel = pub(Twist, 'body_vel')
-        self.pub_wheel_cmd = pub(Float32MultiArray, 'wheel_speed_cmd')
-        self.pub_wheel_opto = pub(Float32MultiArray, 'wheel_speed_opto')
-        self.pub_cliff = pub(Float32MultiArray, 'cliff')
-        self.pub_sonar = pub(Range, 'sonar')
-        self.pub_imu = {part: pub(Imu, 'imu', part=part) for part in ('body', 'head')}
-        self.pub_battery = pub(BatteryState, 'battery')
-        self.pub_light = pub(Float32MultiArray, 'light')
-        self.pub_touch = {part: pub(UInt16, 'touch', part=part) for part in TOUCH_PARTS}
-        self.pub_flags = pub(UInt32, 'sensor_flags')
-        self.subs = [ros.subscription(msg_type, getattr(t, key), callback,
-                                      profile(TOPIC[key].qos))
-                     for msg_type, key, callback in (
-                         (TwistStamped, 'cmd_vel', self._on_cmd_vel),
-                         (JointState, 'kinematic_targets', self._on_kinematic),
-                         (Float32MultiArray, 'cosmetic_joints', self._on_cosmetic),
-                         (UInt32MultiArray, 'illum', self._on_illum),
-                         (UInt16MultiArray, 'tone', self._on_tone),
-                         (UInt32, 'control_flags', self._on_flags))]
+        apply = {'cmd_vel': self._on_cmd_vel, 'kinematic_targets': self._on_kinematic,
+                 'cosmetic_joints': self._on_cosmetic, 'illum': self._on_illum,
+                 'tone': self._on_tone, 'stream': self._on_stream,
+                 'control_flags': self._on_flags}
+        self.pub_eyes = {eye: [None] * 3 for eye in EYES}
+        self.streams = {}  # rate -> [(producer, fields, publisher)]
+        self._publishers = {}  # (row key, its placeholder's value if any) -> publisher
+        self.subs = []
+        for row in ROBOT_INTERFACE:
+            msg_type, qos = message_class(row.type), profile(row.qos)
+            for fields, relative in row.names():
+                topic = t.topic(relative)
+                if row.direction == CONTROL:
+                    self.subs.append(ros.subscription(msg_type, topic, apply[row.key], qos))
+                    continue
+                publisher = ros.publisher(msg_type, topic, qos)
+                self._publishers[row.key, *fields.values()] = publisher
+                if row.rate == CAMERA:
+                    self.pub_eyes[fields['eye']][EYE_ROWS.index(row.key)] = publisher
+                else:
+                    self.streams.setdefault(row.rate, []).append(
+                        (PRODUCERS[row.key], fields, publisher))
         # The hand: the simulator's input for touching this robot (not part of MiRo's own
         # interface: a real MiRo is touched by people, not by topics).
         sim = SimTopics()
@@ -78,6 +73,10 @@ class RobotInterface:
     @property
     def robot(self):
         return self._robot()
+
+    def publisher(self, key, *placeholder):
+        """The publisher of the interface row ``key`` (and its placeholder's value: 'head')."""
+        return self._publishers[(key, *placeholder)]
 
     # -- control topics -----------------------------------------------------------------------
     def _on_cmd_vel(self, msg):
@@ -121,12 +120,15 @@ class RobotInterface:
 
     def _on_tone(self, msg):
         if len(msg.data) != 3:
-            self._warn('tone', f'{self.topics.tone} ignored: need 3 values, got '
-                       f'{len(msg.data)}')
+            self._warn('tone', f'{self.topics.tone} ignored: need 3 values [frequency Hz, '
+                       f'volume 0..255, duration in ticks], got {len(msg.data)}')
             return
-        frequency, volume, ticks = msg.data
-        self._warn('tone_play', f'{self.name}: tone {frequency} Hz, volume {volume}, '
-                   f'{ticks} ticks (not audible in simulation)')
+        self.robot.play_tone(*msg.data)
+
+    def _on_stream(self, msg):
+        if self.robot.stream(msg.data):
+            self._warn('stream', f"{self.topics.stream}: the speaker's buffer is full "
+                       '(more than the speaker plays): the rest dropped')
 
     def _on_touch(self, part, msg):
         if msg.data > ALL_PADS:
@@ -138,31 +140,13 @@ class RobotInterface:
         self.robot.flags = msg.data
 
     # -- publishing ---------------------------------------------------------------------------
-    def publish_tick(self, when):
-        """This platform tick's sensor readings, stamped ``when``. A message is built only
-        for a topic someone subscribes to (building and publishing them all took ~10 % of
-        the simulator's time, listened to or not)."""
-        s = self.robot.sensors
-        name = self.name
-        send = send_if_listened
-        if self.pub_odom.get_subscription_count() or self.pub_vel.get_subscription_count():
-            odom = convert.odometry(s, when, name)
-            send(self.pub_odom, lambda: odom)
-            send(self.pub_vel, lambda: odom.twist.twist)
-        send(self.pub_kin, lambda: convert.kinematic_joints(s, when, name))
-        send(self.pub_pose, lambda: convert.body_pose(s))
-        send(self.pub_wheel_cmd, lambda: convert.floats(s.wheel_speed_cmd))
-        send(self.pub_wheel_opto, lambda: convert.floats(s.wheel_speed_opto))
-        send(self.pub_cliff, lambda: convert.floats(s.cliff))
-        send(self.pub_sonar, lambda: convert.sonar(s, when, name))
-        for part, reading in (('body', s.imu_body), ('head', s.imu_head)):
-            send(self.pub_imu[part],
-                 lambda: convert.imu(reading, when, frame_id(name, f'imu_{part}')))
-        send(self.pub_battery, lambda: convert.battery(s, when, name))
-        send(self.pub_light, lambda: convert.floats(s.light))
-        send(self.pub_touch['head'], lambda: UInt16(data=s.touch_head))
-        send(self.pub_touch['body'], lambda: UInt16(data=s.touch_body))
-        send(self.pub_flags, lambda: UInt32(data=UPSTREAM_FLAG_SIMULATOR))
+    def publish_streams(self, rate, when):
+        """The sensor streams of this rate (Hz of simulated time), stamped ``when``. A message
+        is built only for a topic someone subscribes to (building and publishing them all
+        took ~10 % of the simulator's time, listened to or not)."""
+        robot, name = self.robot, self.name
+        for make, fields, publisher in self.streams.get(rate, ()):
+            send_if_listened(publisher, lambda: make(robot, when, name, **fields))
 
     def wanted_eyes(self):
         """[(eye, side, EyeWants)] of the eyes someone subscribes to (images or only
