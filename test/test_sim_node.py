@@ -3,19 +3,21 @@
 The world is stepped by the test (the node starts paused), never by wall-clock time.
 """
 import math
+import os
 import subprocess
 import sys
 
 import cv2
 import numpy as np
 import pytest
-from geometry_msgs.msg import PointStamped, PoseStamped, TwistStamped
+from geometry_msgs.msg import PointStamped, PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState, \
     Range
-from std_msgs.msg import Float32MultiArray, UInt16MultiArray, UInt32, UInt32MultiArray
+from std_msgs.msg import Float32, Float32MultiArray, Int16MultiArray, UInt16MultiArray, UInt32, \
+    UInt32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.camera_model import CameraModel
@@ -292,3 +294,68 @@ def test_a_burst_of_service_calls_is_answered_in_full(sim_node, probe, executor)
         f'{sum(f.done() for f in futures)} of {len(futures)} answered'
     assert all(f.result().success for f in futures)
     assert sim_node.sim.step_index == 200 * sim_node.params.step_count
+
+
+def test_tone_and_stream_reach_the_robots_speaker(sim_node, probe, executor):
+    tone = probe.publisher(UInt16MultiArray, T.tone)
+    stream = probe.publisher(Int16MultiArray, T.stream)
+    assert spin_until(executor, lambda: tone.get_subscription_count()
+                      and stream.get_subscription_count())
+    tone.publish(UInt16MultiArray(data=[5000, 128, 25]))  # too high: clipped, as the MDK does
+    stream.publish(Int16MultiArray(data=list(range(400))))
+    speaker = sim_node.sim.robot.speaker
+    assert spin_until(executor, lambda: speaker.tone is not None and speaker.buffered == 400)
+    assert (speaker.tone.frequency, speaker.tone.volume) == (2000.0, pytest.approx(128 / 255))
+    run(sim_node, executor, 0.04)  # two platform ticks: the speaker plays 2 x 160 samples
+    assert speaker.buffered == 80 and speaker.tone is not None
+    run(sim_node, executor, 0.5)
+    assert speaker.tone is None and speaker.buffered == 0  # 25 ticks, then silence
+
+
+def test_a_stream_is_one_row_and_its_producer(make_sim, probe, executor, monkeypatch):
+    """What adding a stream takes (docs/development.md): a row of the interface table with
+    its rate, and a producer; the simulator publishes it at that rate of simulated time."""
+    from miro_ball.miro import interface
+    from miro_sim_bullet.ros import robot_interface, streams
+
+    row = interface.Topic('hum', 'sensors/hum', 'std_msgs/msg/Float32', interface.SENSOR,
+                          interface.SENSOR_QOS, 'a made-up 40 Hz stream', 40.0)
+    monkeypatch.setattr(robot_interface, 'ROBOT_INTERFACE', interface.ROBOT_INTERFACE + (row,))
+    monkeypatch.setitem(streams.PRODUCERS, 'hum',
+                        lambda robot, when, name: Float32(data=seconds(when)))
+    node = make_sim()
+    hums = probe.watch(Float32, T.topic('sensors/hum'))
+    assert spin_until(executor, lambda: node.robots[T.name].publisher('hum')
+                      .get_subscription_count() > 0)
+    run(node, executor, 1.0)
+    assert spin_until(executor, lambda: len(hums) >= 40)
+    # 40 a simulated second, each on the physics step nearest its instant k / 40 s.
+    assert [m.data for m in hums] == pytest.approx([0.025 * k for k in range(1, 41)],
+                                                   abs=node.sim.dt / 2 + 1e-6)
+
+
+def test_a_twist_on_cmd_vel_is_said_once_with_the_type_it_wants(sim_node, executor, capfd):
+    """The MDK's cmd_vel is TwistStamped; a Twist there is not heard, and the user is told."""
+    import rclpy
+    from rclpy.context import Context
+
+    # Another participant, as a user's node would be (one participant holds one type a
+    # topic).
+    context = Context()
+    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
+    user = rclpy.create_node('twister', context=context)
+    try:
+        user.create_publisher(Twist, T.cmd_vel, 10)
+        wanted = f'geometry_msgs/msg/Twist on {T.cmd_vel}, which takes geometry_msgs/msg/' \
+            'TwistStamped only'
+        seen = []
+
+        def said():
+            seen.append(capfd.readouterr().err)
+            return wanted in ''.join(seen)
+        assert spin_until(executor, said, what='the warning about a Twist on cmd_vel')
+        sim_node._check_control_types()  # looked at again: not said again
+    finally:
+        user.destroy_node()
+        rclpy.try_shutdown(context=context)
+    assert ''.join(seen + [capfd.readouterr().err]).count(wanted) == 1

@@ -36,8 +36,7 @@ from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.interface import (CAMERA, CLOCK, CLOCK_QOS, PLATFORM_HZ, ROBOT_INTERFACE,
-                                      robot_name, SENSOR, SIM_NODE_NAME)
+from miro_ball.miro.interface import CLOCK, CLOCK_QOS, PLATFORM_HZ, robot_name, SIM_NODE_NAME
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.eye_pipeline import EyePipeline
@@ -53,6 +52,7 @@ from miro_sim_bullet.ros.sim_interface import SimInterface
 from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, WorldError
 
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
+TYPE_CHECK_PERIOD_S = 1.0  # wall seconds between looks for control publishers of a wrong type
 FIXED_PARAMS = ('world', 'physics_dt', 'frame_width', 'frame_height',
                 'camera_rate', 'hfov_deg', 'lens', 'renderer', 'eye_workers', 'peer_check_s')
 
@@ -116,15 +116,17 @@ class SimNode(Node):
             f'world {self.sim.description.source}; robots {", ".join(self.robots)}; renderer '
             f'{self.cameras.renderer.name}; cameras {p.frame_width}x{p.frame_height} @ '
             f'{p.camera_rate:g} Hz; real-time factor {p.real_time_factor:g}')
-        # Physics steps between two messages of each sensor stream's rate (the interface
-        # table's); /clock and the ground truth go with the platform tick.
-        self._stream_steps = {rate: max(1, round(1.0 / (rate * self.sim.dt)))
-                              for rate in {PLATFORM_HZ} | {row.rate for row in ROBOT_INTERFACE
-                                                           if row.direction == SENSOR
-                                                           and row.rate != CAMERA}}
+        # The rates of the robots' sensor streams (the interface table's); /clock and the
+        # ground truth go with the platform tick.
+        self._stream_rates = sorted({PLATFORM_HZ}.union(*(i.streams for i in
+                                                          self.robots.values())))
         self._restart_schedule()
         self._progress = (time.monotonic(), 0.0)
         self.timer = self._make_timer()
+        # A Twist on control/cmd_vel (the MDK's is TwistStamped) is not heard at all: say so.
+        self._wrong_types_said = set()
+        self._type_check = self.create_timer(TYPE_CHECK_PERIOD_S, self._check_control_types,
+                                             clock=Clock(clock_type=ClockType.STEADY_TIME))
 
     def _robot_lookup(self, name):
         # The world's robots are made anew by a reset: looked up each time.
@@ -153,6 +155,20 @@ class SimNode(Node):
             # frame is its start, whatever steps placed robot and ball before).
             self._next_overhead = min(self._next_overhead, self.sim.time)
 
+    def _check_control_types(self):
+        """Warn once for each publisher of the wrong type on a robot's control topic."""
+        for interface in self.robots.values():
+            for topic, wanted in interface.controls:
+                for info in self.get_publishers_info_by_topic(topic):
+                    said = (topic, info.topic_type, info.node_namespace, info.node_name)
+                    if info.topic_type == wanted or said in self._wrong_types_said:
+                        continue
+                    self._wrong_types_said.add(said)
+                    node = f'{info.node_namespace.rstrip("/")}/{info.node_name}'
+                    self.get_logger().warning(
+                        f'{node} publishes {info.topic_type} on {topic}, which takes '
+                        f'{wanted} only: the robot does not hear it')
+
     # -- what the simulator's services do to time ---------------------------------------------
     def reset(self):
         """The world back to its initial state, time and schedule from zero."""
@@ -179,6 +195,9 @@ class SimNode(Node):
         self._anchor = (time.monotonic(), self.sim.time)
         if not keep_time:
             self._next_frame = 0
+            # The index of each rate's next message: the k-th is due at the physics step
+            # nearest k / rate (50 Hz falls on every 5th step of 4 ms, 40 Hz between).
+            self._next_stream = dict.fromkeys(self._stream_rates, 1)
             self._next_overhead = 0.0
             self._next_scene = 0.0
 
@@ -240,9 +259,11 @@ class SimNode(Node):
                 self._submit_eyes(overlap)
                 while self._frame_step(self._next_frame) <= sim.step_index:
                     self._next_frame += 1
-            due = [rate for rate, every in self._stream_steps.items()
-                   if sim.step_index % every == 0]
+            due = [rate for rate, k in self._next_stream.items()
+                   if sim.step_index >= round(k / rate / sim.dt)]
             if due:
+                for rate in due:
+                    self._next_stream[rate] += 1
                 self._publish_eyes(wait=False)
                 started = clock()
                 self._publish_streams(due)

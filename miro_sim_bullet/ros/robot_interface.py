@@ -48,12 +48,14 @@ class RobotInterface:
         self.streams = {}  # rate -> [(producer, fields, publisher)]
         self._publishers = {}  # (row key, its placeholder's value if any) -> publisher
         self.subs = []
+        self.controls = []  # (topic, the type it takes)
         for row in ROBOT_INTERFACE:
             msg_type, qos = message_class(row.type), profile(row.qos)
             for fields, relative in row.names():
                 topic = t.topic(relative)
                 if row.direction == CONTROL:
                     self.subs.append(ros.subscription(msg_type, topic, apply[row.key], qos))
+                    self.controls.append((topic, row.type))
                     continue
                 publisher = ros.publisher(msg_type, topic, qos)
                 self._publishers[row.key, *fields.values()] = publisher
