@@ -15,6 +15,8 @@ from miro_ball.robot.held_command import HeldCommand
 from miro_ball.robot.readings import Eyes, READINGS, Readings
 
 FRAMES = {'foot': FOOT, 'odom': WORLD}  # look_at's frames: the robot's own, odometry's
+# At rest: moved less than this in a platform tick (20 ms).
+REST_M, REST_RAD = 1e-4, math.radians(0.05)
 
 
 class Robot:
@@ -156,15 +158,35 @@ class Robot:
         controller = PoseController((x, y, theta), position_tolerance, heading_tolerance)
         count = self._readings.count
         elapsed = self._ros.stopwatch()
+
+        def next_pose():
+            heard = count['pose']
+            self._ros.wait_until(lambda: count['pose'] > heard, 'odometry')
+
+        def at_rest():
+            """Until MiRo has stopped moving (or the time is up)."""
+            before = self.pose
+            while elapsed() < timeout:
+                next_pose()
+                now = self.pose
+                if math.dist(before[:2], now[:2]) < REST_M and \
+                        abs(math.remainder(now[2] - before[2], math.tau)) < REST_RAD:
+                    return
+                before = now
         try:
             while elapsed() < timeout:
-                heard = count['pose']
                 command = controller.command(self.pose)
                 if controller.arrived:
-                    return True
+                    # Arrived while moving: the stop reaches the wheels a moment later (more
+                    # on a busy machine), so it counts once MiRo is at rest; if it coasted
+                    # out of the tolerances meanwhile, it drives back.
+                    self.stop()
+                    at_rest()
+                    command = controller.command(self.pose)
+                    if controller.arrived:
+                        return True
                 self.drive(*command)
-                # The next reading of the pose, a platform tick later.
-                self._ros.wait_until(lambda: count['pose'] > heard, 'odometry')
+                next_pose()  # a platform tick later
             return False
         finally:
             self.stop()
