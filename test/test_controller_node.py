@@ -462,7 +462,8 @@ def run_controller(*args, **env):
 
 def test_bad_ros_parameter_from_the_shell_is_one_line():
     assert run_controller('--ros-args', '-p', 'mode:=fancy') == (2, [
-        "kick_blue_ball: error: mode must be one of tutorial, improved, not 'fancy'"])
+        "kick_blue_ball: error: mode must be one of tutorial, improved, wag or module:Class "
+        "of your own, not 'fancy'"])
 
 
 @pytest.mark.parametrize('args,env,said', [
@@ -482,14 +483,14 @@ def test_run_time_parameters_apply_or_are_refused_with_a_reason(make_rig):
     rig = make_rig(*short_hold())
     node = rig.node
     results = node.set_parameters([Parameter('blur', value=7)])
-    assert results[0].successful and node.detector.params.blur == 7
+    assert results[0].successful and node.detection_params.blur == 7
     # The same checks as at start: refused, and nothing changed.
     for name, value, reason in [('hough_param2', 0.0, 'hough_param2'), ('blur', 8, 'odd'),
                                 ('tick', 0.05, 'restart'),
                                 ('slow', 'fast', 'number')]:
         result = node.set_parameters([Parameter(name, value=value)])[0]
         assert not result.successful and reason in result.reason, (name, result.reason)
-    assert node.detector.params.blur == 7 and node.config.tick == pytest.approx(0.02)
+    assert node.detection_params.blur == 7 and node.config.tick == pytest.approx(0.02)
     # A new mode takes over at once: tutorial mode turns at its own speed.
     assert node.set_parameters([Parameter('mode', value='tutorial')])[0].successful
     rig.set_clock(10.0)

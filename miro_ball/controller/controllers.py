@@ -1,0 +1,34 @@
+"""Controllers by name: the `mode` parameter picks one.
+
+A built-in name (tutorial, improved, wag) or ``package.module:Class`` of your own: a
+class built as ``Class(BehaviourParams)`` that implements the contract (contract.py).
+"""
+import importlib
+
+from miro_ball.controller.behaviour import BehaviourParams, MODES
+
+BUILT_IN = dict({name: 'miro_ball.controller.behaviour:%s' % cls.__name__
+                 for name, cls in MODES.items()},
+                wag='miro_ball.examples.controller_wag:Wag')
+
+
+def controller_class(mode):
+    """The class `mode` names; ValueError (one line) when it names none."""
+    path = BUILT_IN.get(mode, mode)
+    module_name, _, class_name = path.partition(':')
+    if not class_name:
+        raise ValueError("mode must be one of %s or module:Class of your own, not '%s'"
+                         % (', '.join(BUILT_IN), mode))
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as err:
+        raise ValueError("mode '%s': cannot import %s: %s" % (mode, module_name, err)) from None
+    cls = getattr(module, class_name, None)
+    if cls is None or not callable(getattr(cls, 'act', None)):
+        raise ValueError("mode '%s': %s has no controller class %s (one with act(percepts))"
+                         % (mode, module_name, class_name))
+    return cls
+
+
+def make_controller(mode, params: BehaviourParams):
+    return controller_class(mode)(params)
