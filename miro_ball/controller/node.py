@@ -5,9 +5,9 @@ the `mode` parameter (controllers.py). It decodes each eye's JPEG itself, runs t
 detectors the controller asks for on it (detectors.py), and on every control tick
 (node clock: simulated time unless use_sim_time is set false) gives the controller one
 Percepts value of the freshest frames, detections and readings, publishing each part
-of the Action it returns on its control topic (wheels as a TwistStamped). Each eye's pinhole model comes from its
-camera_info (MiRo's simulated 120 deg eye until one arrives), so bearings stay
-right whatever field of view the camera has.
+of the Action it returns on its control topic (wheels as a TwistStamped). Each eye's
+pinhole model comes from its camera_info (MiRo's simulated 120 deg eye until one
+arrives), so bearings stay right whatever field of view the camera has.
 
 The node lives in its robot's namespace and uses relative names, so
 ``--ros-args -r __ns:=/miro02`` (or ``--robot miro02``, or $MIRO_ROBOT_NAME)
