@@ -14,13 +14,13 @@ from geometry_msgs.msg import TwistStamped
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
-from std_msgs.msg import Float32MultiArray
+from std_msgs.msg import Float32MultiArray, UInt32MultiArray
 
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
 from miro_ball.controller.node import build_parser, KickBlueBall, main
 from miro_ball.bench.synthetic import Disc, jpeg, render
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
+from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, COSMETIC_CALIB, JOINT_NAMES
 from miro_ball.controller.names import debug_topic
 from miro_ball.miro.interface import CLOCK, default_robot_name, EYES, RobotTopics
 from hostile import decompression_bomb
@@ -45,8 +45,8 @@ class Rig:
 
     def __init__(self, context, executor, overrides=(), robot=None, **kwargs):
         robot = robot or default_robot_name()
-        params = [Parameter('use_sim_time', value=True)]
-        self.node = KickBlueBall(context=context, parameter_overrides=params + list(overrides),
+        # No use_sim_time: the node follows /clock by default.
+        self.node = KickBlueBall(context=context, parameter_overrides=list(overrides),
                                  robot=robot, **kwargs)
         self.probe = rclpy.create_node('fake_sim', context=context)
         self.executor = executor
@@ -357,6 +357,50 @@ def test_debug_image_only_while_subscribed(make_rig, tmp_path):
     green = (image[:, :, 1] > 200) & (image[:, :, 0] < 80) & (image[:, :, 2] < 80)
     assert green.sum() > 100, 'no circle drawn'
     assert sorted(p.name for p in tmp_path.iterdir()) == ['caml_000001.jpg', 'camr_000002.jpg']
+
+
+def test_save_debug_keeps_only_the_newest_frames(make_rig, tmp_path):
+    rig = make_rig(*short_hold(Parameter('save_debug_keep', value=3)), save_debug=str(tmp_path))
+    for _ in range(4):
+        rig.both_eyes(0.1, None)
+    assert rig.node.frames_processed == 8
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        'caml_000007.jpg', 'camr_000006.jpg', 'camr_000008.jpg']
+
+
+def test_wag_controller_wags_the_tail_while_it_sees_the_ball(make_rig):
+    rig = make_rig(Parameter('mode', value='wag'), Parameter('head_hold_s', value=0.0))
+    cosmetic = []
+    rig.probe.create_subscription(Float32MultiArray, rig.names.cosmetic_joints,
+                                  cosmetic.append, 100)
+    illum = []
+    rig.probe.create_subscription(UInt32MultiArray, rig.names.illum, illum.append, 100)
+    rig.wait_until(lambda: rig.node.pub_cosmetic.get_subscription_count() > 0, 'discovery')
+    rig.set_clock(10.0)
+    rig.advance(0.2)
+    rig.wait_until(lambda: cosmetic, 'cosmetic joints')
+    assert rig.node.state == 'watching' and rig.last_twist() == (0.0, 0.0)
+    assert tuple(cosmetic[-1].data) == pytest.approx(COSMETIC_CALIB)
+    rig.image(0, ball_frame(0.1))
+    seen = len(cosmetic)
+    rig.advance(0.3)
+    assert rig.node.state == 'wagging'
+    rig.wait_until(lambda: len(cosmetic) > seen + 5, 'cosmetic joints while wagging')
+    wags = [msg.data[1] for msg in cosmetic[seen:]]
+    assert max(wags) - min(wags) > 0.3, 'the tail did not move'
+    assert not illum  # fields the action leaves None are not published
+
+
+def test_sim_time_is_the_default_and_the_command_line_can_turn_it_off(ros_context):
+    on = KickBlueBall(context=ros_context, args=['kick_blue_ball'])
+    off = KickBlueBall(context=ros_context, robot='other',
+                       args=['kick_blue_ball', '--ros-args', '-p', 'use_sim_time:=false'])
+    try:
+        assert on.get_parameter('use_sim_time').value is True
+        assert off.get_parameter('use_sim_time').value is False
+    finally:
+        on.destroy_node()
+        off.destroy_node()
 
 
 def test_the_robot_is_the_namespace_and_frames_carry_it(make_rig):
