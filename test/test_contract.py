@@ -3,6 +3,7 @@ example wag controller, the sim-time rule and --save-debug's bound."""
 import dataclasses
 import math
 import random
+from pathlib import Path
 
 import pytest
 
@@ -130,3 +131,11 @@ def test_debug_folder_keeps_the_newest(tmp_path):
     (tmp_path / 'f07.jpg').unlink()  # tidied by hand meanwhile
     folder.save('f10.jpg', b'')
     assert sorted(p.name for p in tmp_path.iterdir()) == ['f08.jpg', 'f09.jpg', 'f10.jpg']
+
+
+def test_docs_show_the_wag_controller_as_it_is():
+    root = Path(__file__).resolve().parents[1]
+    source = (root / 'miro_ball' / 'examples' / 'controller_wag.py').read_text()
+    code = source.split('"""', 2)[2].strip()  # after the module docstring
+    assert '```python\n' + code + '\n```' in (root / 'docs' / 'controller.md').read_text()
+    assert len(code.splitlines()) <= 25
