@@ -13,10 +13,11 @@ from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TwistStamped
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
-from std_msgs.msg import Float32MultiArray, UInt32MultiArray
+from sensor_msgs.msg import CameraInfo, CompressedImage, JointState, Range
+from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32MultiArray
 
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
+from miro_ball.controller.contract import Action
 from miro_ball.controller.node import build_parser, KickBlueBall, main
 from miro_ball.bench.synthetic import Disc, jpeg, render
 from miro_ball.miro.camera_model import CameraModel
@@ -389,6 +390,62 @@ def test_wag_controller_wags_the_tail_while_it_sees_the_ball(make_rig):
     wags = [msg.data[1] for msg in cosmetic[seen:]]
     assert max(wags) - min(wags) > 0.3, 'the tail did not move'
     assert not illum  # fields the action leaves None are not published
+
+
+class Expressive:
+    """A controller of a student's own (-p mode:=test_controller_node:Expressive): sets every
+    part of the action and keeps the percepts it was given."""
+
+    detectors = ()
+    ACTION = Action(wheels=(0.1, 0.1), head=(0.0, 0.5, 0.2, -0.1),
+                    cosmetic=(0.0, 1.0, 0.5, 0.5, 0.2, 0.8),
+                    illum=(0xFF0000FF,) * 6, tone=(440, 100, 5), state='showing off')
+
+    def __init__(self, params):
+        self.percepts = []
+
+    def act(self, percepts):
+        self.percepts.append(percepts)
+        return self.ACTION
+
+
+def test_a_controller_of_your_own_reads_every_percept_and_sets_every_action(make_rig):
+    rig = make_rig(Parameter('mode', value='test_controller_node:Expressive'),
+                   Parameter('head_hold_s', value=0.0))
+    p, names = rig.probe, rig.names
+    got = {key: [] for key in ('cosmetic', 'illum', 'tone')}
+    for key, kind, topic in (('cosmetic', Float32MultiArray, names.cosmetic_joints),
+                             ('illum', UInt32MultiArray, names.illum),
+                             ('tone', UInt16MultiArray, names.tone)):
+        p.create_subscription(kind, topic, got[key].append, 100)
+    readings = [(p.create_publisher(Range, names.sonar, 2), Range(range=0.25)),
+                (p.create_publisher(Float32MultiArray, names.light, 2),
+                 Float32MultiArray(data=[0.1, 0.2, 0.3, 0.4]))]
+    readings += [(p.create_publisher(UInt16, names.touch(part), 2), UInt16(data=bits))
+                 for part, bits in (('head', 3), ('body', 8))]
+    rig.wait_until(lambda: all(pub.get_subscription_count() > 0 for pub, _ in readings)
+                   and rig.node.pub_tone.get_subscription_count() > 0, 'discovery')
+    rig.set_clock(10.0)
+    rig.image(1, ball_frame(0.1))
+    for pub, msg in readings:
+        pub.publish(msg)
+    controller = rig.node.controller
+    rig.wait_until(lambda: all(latest.value is not None for latest in rig.node.readings.values()),
+                   'the readings')
+    rig.advance(0.1)
+    rig.wait_until(lambda: all(got.values()) and rig.joints, 'every part of the action')
+    seen = controller.percepts[-1]
+    assert seen.t == pytest.approx(rig.now) and seen.sonar == pytest.approx(0.25)
+    assert seen.light == pytest.approx((0.1, 0.2, 0.3, 0.4))
+    assert (seen.touch_head, seen.touch_body) == (3, 8)
+    assert seen.eyes[0].image is None and seen.eyes[1].image.shape == (360, 640, 3)
+    assert seen.found('ball') == (None, None)  # no detector asked for: none run
+    action = Expressive.ACTION
+    assert tuple(got['cosmetic'][-1].data) == pytest.approx(action.cosmetic)
+    assert tuple(got['illum'][-1].data) == action.illum
+    assert tuple(got['tone'][-1].data) == action.tone
+    assert tuple(rig.joints[-1].position) == pytest.approx(action.head)
+    assert rig.last_twist()[0] == pytest.approx(0.1) and rig.node.state == 'showing off'
 
 
 def test_sim_time_is_the_default_and_the_command_line_can_turn_it_off(ros_context):
