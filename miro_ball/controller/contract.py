@@ -23,7 +23,7 @@ class Eye:
     """What one eye saw: its latest fresh frame and what the detectors found in it."""
 
     camera: CameraModel  # the eye's pinhole at the size of `image`
-    image: Any = None  # BGR frame (numpy array), None when no fresh frame
+    image: Any = field(default=None, compare=False)  # BGR frame (numpy), None: no fresh one
     detections: Mapping[str, Any] = field(default_factory=dict)  # detector name -> result
 
     def found(self, name):
