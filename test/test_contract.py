@@ -75,11 +75,19 @@ def test_a_mode_names_a_controller(mode, cls):
     assert ControllerParams(mode=mode).mode == mode
 
 
+class NeedsAFace:
+    detectors = ('ball', 'face')
+
+    def act(self, percepts):
+        return Action()
+
+
 @pytest.mark.parametrize('mode,said', [
     ('clever', 'must be one of tutorial, improved, wag or module:Class'),
     ('no_such_module:Thing', 'cannot import no_such_module'),
     ('miro_ball.examples.controller_wag:Nope', 'has no controller class Nope'),
-    ('miro_ball.controller.contract:Action', 'has no controller class Action')])
+    ('miro_ball.controller.contract:Action', 'has no controller class Action'),
+    ('test_contract:NeedsAFace', "no detector named 'face' .*known: ball")])
 def test_a_mode_that_names_no_controller_is_refused(mode, said):
     with pytest.raises(ValueError, match=said):
         ControllerParams(mode=mode)

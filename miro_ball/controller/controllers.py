@@ -6,6 +6,7 @@ class built as ``Class(BehaviourParams)`` that implements the contract (contract
 import importlib
 
 from miro_ball.controller.behaviour import BehaviourParams, MODES
+from miro_ball.controller.detectors import DETECTORS
 
 BUILT_IN = dict({name: 'miro_ball.controller.behaviour:%s' % cls.__name__
                  for name, cls in MODES.items()},
@@ -27,6 +28,11 @@ def controller_class(mode):
     if cls is None or not callable(getattr(cls, 'act', None)):
         raise ValueError("mode '%s': %s has no controller class %s (one with act(percepts))"
                          % (mode, module_name, class_name))
+    # Checked here, with the mode, so a set_parameters change to it is refused with the reason.
+    unknown = [name for name in getattr(cls, 'detectors', ()) if name not in DETECTORS]
+    if unknown:
+        raise ValueError("mode '%s': no detector named %s (known: %s)"
+                         % (mode, ', '.join(map(repr, unknown)), ', '.join(sorted(DETECTORS))))
     return cls
 
 
