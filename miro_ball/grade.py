@@ -20,8 +20,7 @@ from pathlib import Path
 from miro_ball.run.judge import KICK_DISTANCE_M
 from miro_ball.run.placements import ARENA_FREE_RADIUS
 
-EXAMPLE = 'python -m miro_ball.grade --count 5 -- python -m miro_ball --ros-args -p ' \
-          'use_sim_time:=true'
+EXAMPLE = 'python -m miro_ball.grade --count 5 -- python -m miro_ball'
 
 
 def parser():

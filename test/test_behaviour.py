@@ -9,6 +9,7 @@ from miro_ball.controller.behaviour import (APPROACH, AVOID, ball_bearing, Behav
                                             eye_bearing, EXPLORE, fit_to_limit,
                                             ImprovedBehaviour, KICK, LOCK_ON, LOST,
                                             make_behaviour, MESSAGES, SEARCH, TutorialBehaviour)
+from miro_ball.controller.contract import Eye, Percepts
 from miro_ball.controller.detection import Ball, normalise
 from miro_ball.miro.camera_model import CameraModel, Intrinsics
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, FRAME_SIZES, WHEEL_MAX_SPEED_M_PER_S
@@ -45,6 +46,27 @@ def run(machine, seconds, left=None, right=None, cliff=FLOOR, t0=0.0):
     return [machine.step(t0 + i * TICK, left, right, cliff) for i in range(steps)]
 
 
+class ViaContract:
+    """A behaviour driven through the controller contract (act on Percepts) behind step()'s
+    signature: the fixtures' cases run both ways and must give the same commands."""
+
+    def __init__(self, machine):
+        self._machine = machine
+
+    def __getattr__(self, name):
+        return getattr(self._machine, name)
+
+    def step(self, t, left, right, cliff=None, cameras=DEFAULT_CAMERAS):
+        eyes = tuple(Eye(camera, detections={'ball': found})
+                     for camera, found in zip(cameras, (left, right)))
+        action = self._machine.act(Percepts(t, eyes, cliff=cliff))
+        assert action.head is action.cosmetic is action.illum is action.tone is None
+        return Command(*action.wheels, action.state, action.messages)
+
+
+DRIVERS = {'step': lambda machine: machine, 'contract': ViaContract}
+
+
 def forward(command):
     return wheel_speed2cmd_vel((command.left, command.right))[0]
 
@@ -55,9 +77,9 @@ def turn(command):
 
 # Tutorial -----------------------------------------------------------------
 
-@pytest.fixture
-def tutorial():
-    return TutorialBehaviour(BehaviourParams())
+@pytest.fixture(params=DRIVERS)
+def tutorial(request):
+    return DRIVERS[request.param](TutorialBehaviour(BehaviourParams()))
 
 
 def test_tutorial_searches_clockwise(tutorial):
@@ -188,9 +210,9 @@ def test_fit_to_limit_keeps_the_curve():
 
 # Improved -----------------------------------------------------------------
 
-@pytest.fixture
-def improved():
-    return ImprovedBehaviour(BehaviourParams(seed=1))
+@pytest.fixture(params=DRIVERS)
+def improved(request):
+    return DRIVERS[request.param](ImprovedBehaviour(BehaviourParams(seed=1)))
 
 
 def test_improved_searches_clockwise_until_it_has_seen_a_ball(improved):

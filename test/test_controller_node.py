@@ -13,14 +13,15 @@ from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TwistStamped
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
-from std_msgs.msg import Float32MultiArray
+from sensor_msgs.msg import CameraInfo, CompressedImage, JointState, Range
+from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32MultiArray
 
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
+from miro_ball.controller.contract import Action
 from miro_ball.controller.node import build_parser, KickBlueBall, main
 from miro_ball.bench.synthetic import Disc, jpeg, render
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, JOINT_NAMES
+from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, COSMETIC_CALIB, JOINT_NAMES
 from miro_ball.controller.names import debug_topic
 from miro_ball.miro.interface import CLOCK, default_robot_name, EYES, RobotTopics
 from hostile import decompression_bomb
@@ -45,8 +46,8 @@ class Rig:
 
     def __init__(self, context, executor, overrides=(), robot=None, **kwargs):
         robot = robot or default_robot_name()
-        params = [Parameter('use_sim_time', value=True)]
-        self.node = KickBlueBall(context=context, parameter_overrides=params + list(overrides),
+        # No use_sim_time: the node follows /clock by default.
+        self.node = KickBlueBall(context=context, parameter_overrides=list(overrides),
                                  robot=robot, **kwargs)
         self.probe = rclpy.create_node('fake_sim', context=context)
         self.executor = executor
@@ -359,6 +360,106 @@ def test_debug_image_only_while_subscribed(make_rig, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ['caml_000001.jpg', 'camr_000002.jpg']
 
 
+def test_save_debug_keeps_only_the_newest_frames(make_rig, tmp_path):
+    rig = make_rig(*short_hold(Parameter('save_debug_keep', value=3)), save_debug=str(tmp_path))
+    for _ in range(4):
+        rig.both_eyes(0.1, None)
+    assert rig.node.frames_processed == 8
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        'caml_000007.jpg', 'camr_000006.jpg', 'camr_000008.jpg']
+
+
+def test_wag_controller_wags_the_tail_while_it_sees_the_ball(make_rig):
+    rig = make_rig(Parameter('mode', value='wag'), Parameter('head_hold_s', value=0.0))
+    cosmetic = []
+    rig.probe.create_subscription(Float32MultiArray, rig.names.cosmetic_joints,
+                                  cosmetic.append, 100)
+    illum = []
+    rig.probe.create_subscription(UInt32MultiArray, rig.names.illum, illum.append, 100)
+    rig.wait_until(lambda: rig.node.pub_cosmetic.get_subscription_count() > 0, 'discovery')
+    rig.set_clock(10.0)
+    rig.advance(0.2)
+    rig.wait_until(lambda: cosmetic, 'cosmetic joints')
+    assert rig.node.state == 'watching' and rig.last_twist() == (0.0, 0.0)
+    assert tuple(cosmetic[-1].data) == pytest.approx(COSMETIC_CALIB)
+    rig.image(0, ball_frame(0.1))
+    seen = len(cosmetic)
+    rig.advance(0.3)
+    assert rig.node.state == 'wagging'
+    rig.wait_until(lambda: len(cosmetic) > seen + 5, 'cosmetic joints while wagging')
+    wags = [msg.data[1] for msg in cosmetic[seen:]]
+    assert max(wags) - min(wags) > 0.3, 'the tail did not move'
+    assert not illum  # fields the action leaves None are not published
+
+
+class Expressive:
+    """A controller of a student's own (-p mode:=test_controller_node:Expressive): sets every
+    part of the action and keeps the percepts it was given."""
+
+    detectors = ()
+    ACTION = Action(wheels=(0.1, 0.1), head=(0.0, 0.5, 0.2, -0.1),
+                    cosmetic=(0.0, 1.0, 0.5, 0.5, 0.2, 0.8),
+                    illum=(0xFF0000FF,) * 6, tone=(440, 100, 5), state='showing off')
+
+    def __init__(self, params):
+        self.percepts = []
+
+    def act(self, percepts):
+        self.percepts.append(percepts)
+        return self.ACTION
+
+
+def test_a_controller_of_your_own_reads_every_percept_and_sets_every_action(make_rig):
+    rig = make_rig(Parameter('mode', value='test_controller_node:Expressive'),
+                   Parameter('head_hold_s', value=0.0))
+    p, names = rig.probe, rig.names
+    got = {key: [] for key in ('cosmetic', 'illum', 'tone')}
+    for key, kind, topic in (('cosmetic', Float32MultiArray, names.cosmetic_joints),
+                             ('illum', UInt32MultiArray, names.illum),
+                             ('tone', UInt16MultiArray, names.tone)):
+        p.create_subscription(kind, topic, got[key].append, 100)
+    readings = [(p.create_publisher(Range, names.sonar, 2), Range(range=0.25)),
+                (p.create_publisher(Float32MultiArray, names.light, 2),
+                 Float32MultiArray(data=[0.1, 0.2, 0.3, 0.4]))]
+    readings += [(p.create_publisher(UInt16, names.touch(part), 2), UInt16(data=bits))
+                 for part, bits in (('head', 3), ('body', 8))]
+    rig.wait_until(lambda: all(pub.get_subscription_count() > 0 for pub, _ in readings)
+                   and rig.node.pub_tone.get_subscription_count() > 0, 'discovery')
+    rig.set_clock(10.0)
+    rig.image(1, ball_frame(0.1))
+    for pub, msg in readings:
+        pub.publish(msg)
+    controller = rig.node.controller
+    rig.wait_until(lambda: all(latest.value is not None for latest in rig.node.readings.values()),
+                   'the readings')
+    rig.advance(0.1)
+    rig.wait_until(lambda: all(got.values()) and rig.joints, 'every part of the action')
+    seen = controller.percepts[-1]
+    assert seen.t == pytest.approx(rig.now) and seen.sonar == pytest.approx(0.25)
+    assert seen.light == pytest.approx((0.1, 0.2, 0.3, 0.4))
+    assert (seen.touch_head, seen.touch_body) == (3, 8)
+    assert seen.eyes[0].image is None and seen.eyes[1].image.shape == (360, 640, 3)
+    assert seen.found('ball') == (None, None)  # no detector asked for: none run
+    action = Expressive.ACTION
+    assert tuple(got['cosmetic'][-1].data) == pytest.approx(action.cosmetic)
+    assert tuple(got['illum'][-1].data) == action.illum
+    assert tuple(got['tone'][-1].data) == action.tone
+    assert tuple(rig.joints[-1].position) == pytest.approx(action.head)
+    assert rig.last_twist()[0] == pytest.approx(0.1) and rig.node.state == 'showing off'
+
+
+def test_sim_time_is_the_default_and_the_command_line_can_turn_it_off(ros_context):
+    on = KickBlueBall(context=ros_context, args=['kick_blue_ball'])
+    off = KickBlueBall(context=ros_context, robot='other',
+                       args=['kick_blue_ball', '--ros-args', '-p', 'use_sim_time:=false'])
+    try:
+        assert on.get_parameter('use_sim_time').value is True
+        assert off.get_parameter('use_sim_time').value is False
+    finally:
+        on.destroy_node()
+        off.destroy_node()
+
+
 def test_the_robot_is_the_namespace_and_frames_carry_it(make_rig):
     robot = default_robot_name() + '2'  # not the default
     rig = make_rig(*short_hold(), robot=robot)
@@ -462,7 +563,8 @@ def run_controller(*args, **env):
 
 def test_bad_ros_parameter_from_the_shell_is_one_line():
     assert run_controller('--ros-args', '-p', 'mode:=fancy') == (2, [
-        "kick_blue_ball: error: mode must be one of tutorial, improved, not 'fancy'"])
+        "kick_blue_ball: error: mode must be one of tutorial, improved, wag or module:Class "
+        "of your own, not 'fancy'"])
 
 
 @pytest.mark.parametrize('args,env,said', [
@@ -482,14 +584,15 @@ def test_run_time_parameters_apply_or_are_refused_with_a_reason(make_rig):
     rig = make_rig(*short_hold())
     node = rig.node
     results = node.set_parameters([Parameter('blur', value=7)])
-    assert results[0].successful and node.detector.params.blur == 7
+    assert results[0].successful and node.detection_params.blur == 7
     # The same checks as at start: refused, and nothing changed.
     for name, value, reason in [('hough_param2', 0.0, 'hough_param2'), ('blur', 8, 'odd'),
                                 ('tick', 0.05, 'restart'),
-                                ('slow', 'fast', 'number')]:
+                                ('slow', 'fast', 'number'),
+                                ('mode', 'test_contract:NeedsAFace', "no detector named 'face'")]:
         result = node.set_parameters([Parameter(name, value=value)])[0]
         assert not result.successful and reason in result.reason, (name, result.reason)
-    assert node.detector.params.blur == 7 and node.config.tick == pytest.approx(0.02)
+    assert node.detection_params.blur == 7 and node.config.tick == pytest.approx(0.02)
     # A new mode takes over at once: tutorial mode turns at its own speed.
     assert node.set_parameters([Parameter('mode', value='tutorial')])[0].successful
     rig.set_clock(10.0)

@@ -7,6 +7,10 @@ or None when unknown) and each eye's camera model (camera_model.CameraModel) at 
 size of the frame its detection came from. It gets back a Command: wheel speeds in m/s, the
 state name and the messages to log for behaviour changes that happened during the
 tick.
+
+Both behaviours also implement the controller contract (contract.py): ``act(percepts)``
+reads the "ball" detections, the cliff and the cameras from the Percepts and returns
+an Action with the same wheel speeds; that is how the node runs them.
 """
 import math
 import random
@@ -14,6 +18,7 @@ from dataclasses import dataclass, field
 from typing import NamedTuple, Optional, Sequence, Tuple
 
 from miro_ball.common.params import check_ranges
+from miro_ball.controller.contract import Action, Percepts
 from miro_ball.controller.detection import to_pixels
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, CLIFF_THRESHOLD, WHEEL_MAX_SPEED_M_PER_S
@@ -143,11 +148,19 @@ class _Machine:
 
     # The tutorial sets the head pose before its loop starts: wheels still meanwhile.
     waits_for_head = True
+    detectors = ('ball',)  # the contract: what the node runs on each eye's frames
 
     def __init__(self, params: BehaviourParams):
         self.params = params
         self.state = None
         self._said = []
+
+    def act(self, percepts: Percepts) -> Action:
+        """The contract: step() on the percepts' ball detections, cliff and cameras."""
+        left, right = percepts.found('ball')
+        command = self.step(percepts.t, left, right, percepts.cliff, percepts.cameras)
+        return Action(wheels=(command.left, command.right), state=command.state,
+                      messages=command.messages)
 
     def _go(self, state, *extra):
         self._said.extend(extra)

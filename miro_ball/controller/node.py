@@ -1,11 +1,13 @@
 """kick_blue_ball for ROS 2: find the blue ball with both eyes and kick it.
 
-The node decodes each eye's JPEG itself, runs the detector on it, and on every
-control tick (node clock, so simulated time when use_sim_time is set) feeds the
-freshest detections and cliff reading to the chosen behaviour, publishing the
-resulting wheel speeds as a TwistStamped. Each eye's pinhole model comes from its
-camera_info (MiRo's simulated 120 deg eye until one arrives), so bearings stay
-right whatever field of view the camera has.
+The node runs any controller that implements the contract (contract.py), picked by
+the `mode` parameter (controllers.py). It decodes each eye's JPEG itself, runs the
+detectors the controller asks for on it (detectors.py), and on every control tick
+(node clock: simulated time unless use_sim_time is set false) gives the controller one
+Percepts value of the freshest frames, detections and readings, publishing each part
+of the Action it returns on its control topic (wheels as a TwistStamped). Each eye's
+pinhole model comes from its camera_info (MiRo's simulated 120 deg eye until one
+arrives), so bearings stay right whatever field of view the camera has.
 
 The node lives in its robot's namespace and uses relative names, so
 ``--ros-args -r __ns:=/miro02`` (or ``--robot miro02``, or $MIRO_ROBOT_NAME)
@@ -27,25 +29,30 @@ from rclpy.exceptions import NameValidationException, ParameterException
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
-from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
-from std_msgs.msg import Float32MultiArray
+from sensor_msgs.msg import CameraInfo, CompressedImage, JointState, Range
+from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32MultiArray
 
 from miro_ball.common.cli import user_args
 from miro_ball.common import params
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.qos import profile
+from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
-from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERAS, make_behaviour
-from miro_ball.controller.detection import annotate, BallDetector, DetectionParams
+from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERAS
+from miro_ball.controller.contract import Eye, Percepts
+from miro_ball.controller.controllers import make_controller
+from miro_ball.controller.debug_folder import DebugFolder
+from miro_ball.controller.detection import annotate, DetectionParams
+from miro_ball.controller.detectors import make_detectors
 from miro_ball.controller.names import DEBUG_TOPIC, NODE_NAME
 from miro_ball.controller.params import ControllerParams, GROUPS
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES
 from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYE_QOS, EYES, frame_id,
                                       robot_namespace, robot_of_namespace, RobotTopics,
-                                      SENSOR, TOPIC)
+                                      SENSOR, TOPIC, TOUCH_PARTS)
 from miro_ball.miro.kinematics import clamp_wheel_speeds, finite, wheel_speed2cmd_vel
 
 SIDES = ('left', 'right')  # of EYES, in order
@@ -71,8 +78,14 @@ def topics():
                  _uses('camera_info', '%s eye camera model, lens included (until one '
                        'arrives: %g deg pinhole)' % (side, CAM_HFOV_DEG_SIM), eye=eye)]
     used += [_uses('cliff', '[L, R], 1 floor, <0.7 drop'),
-             _uses('cmd_vel', 'every tick'),
-             _uses('kinematic_targets', 'head pose at start')]
+             _uses('sonar', 'percepts: range ahead'),
+             _uses('light', 'percepts: light')]
+    used += [_uses('touch', 'percepts: touch, ' + part, part=part) for part in TOUCH_PARTS]
+    used += [_uses('cmd_vel', "the action's wheels"),
+             _uses('kinematic_targets', "head pose at start, then the action's head"),
+             _uses('cosmetic_joints', "the action's cosmetic joints"),
+             _uses('illum', "the action's LEDs"),
+             _uses('tone', "the action's tone")]
     used += [(DEBUG_TOPIC.format(eye=eye), TOPIC['eye_compressed'].type, 'out',
               'annotated, only while subscribed') for eye in EYES]
     return used
@@ -100,40 +113,47 @@ class Latest:
 class KickBlueBall(Node):
     """The controller. Attributes for tests and embedding:
 
-    state             behaviour state name ('startup' while holding the head)
-    frames_processed  camera frames decoded and run through the detector
+    state             the controller's state name ('startup' while holding the head)
+    frames_processed  camera frames decoded and run through the detectors
     rejected          Counter of ignored inputs by kind (empty, corrupt, size, cliff,
                       camera_info)
     cameras           each eye's camera model (camera_model.CameraModel) from its latest
                       usable camera_info, at that camera_info's resolution
     last_command      (left, right) wheel speeds of the latest twist, m/s
+    last_action       the controller's latest Action (contract.Action)
     last_tick         node time (s) of the latest control tick, None before the first
     robot             the robot it drives: the last part of its namespace
-    detector, behaviour, config (ControllerParams), pub_twist
+    controller, detectors ({name: detect}), detection_params, config (ControllerParams),
+    pub_twist
 
     robot (a name) picks the namespace, as --robot does; a remapped __ns wins.
     """
 
-    def __init__(self, *, context=None, parameter_overrides=None, save_debug=None, robot=None):
+    def __init__(self, *, context=None, parameter_overrides=None, save_debug=None, robot=None,
+                 args=None):
+        # Simulated time unless args (the command line, default sys.argv) say otherwise.
         super().__init__(NODE_NAME, context=context, namespace=robot_namespace(robot),
-                         parameter_overrides=list(parameter_overrides or []))
+                         parameter_overrides=sim_time_overrides(parameter_overrides or (), args))
         self.robot = robot_of_namespace(self.get_namespace())
         self.config = params.declare(self, ControllerParams)
-        self.detector = BallDetector(params.declare(self, DetectionParams))
+        self.detection_params = params.declare(self, DetectionParams)
         self._behaviour_params = params.declare(self, BehaviourParams)
         # The topics and the timer are made once; every tunable applies at run time.
         self._live = params.LiveParams(
-            self, (self.config, self.detector.params, self._behaviour_params), self._apply,
+            self, (self.config, self.detection_params, self._behaviour_params), self._apply,
             fixed=('tick',))
         self.save_debug = save_debug
+        self._debug_folder = save_debug and DebugFolder(save_debug, self.config.save_debug_keep)
         self.frames_processed = 0
         self.rejected = Counter()
         self.last_command = None
+        self.last_action = None
         self.state = STARTUP
         self._warn = Throttled(self.get_logger().warning, WARN_EVERY_S)
         self._clock_watch = guard_clock(self, self._warn)
-        self.balls = [Latest() for _ in EYES]
+        self.eyes = [Latest() for _ in EYES]  # (frame, {detector: result}) of each eye
         self.cliff = Latest()
+        self.readings = {key: Latest() for key in ('sonar', 'light') + TOUCH_PARTS}
         self.cameras = list(DEFAULT_CAMERAS)
         # Each eye's pinhole at the size of the frame its latest detection came from.
         self._frame_cameras = list(DEFAULT_CAMERAS)
@@ -147,10 +167,22 @@ class KickBlueBall(Node):
                                      partial(self._on_camera_info, eye), eyes)
         self.create_subscription(Float32MultiArray, names.cliff, self._on_cliff,
                                  profile(TOPIC['cliff'].qos))
+        self.create_subscription(Range, names.sonar, self._on_sonar, profile(TOPIC['sonar'].qos))
+        self.create_subscription(Float32MultiArray, names.light, self._on_light,
+                                 profile(TOPIC['light'].qos))
+        for part in TOUCH_PARTS:
+            self.create_subscription(UInt16, names.touch(part), partial(self._on_touch, part),
+                                     profile(TOPIC['touch'].qos))
         self.pub_twist = self.create_publisher(TwistStamped, names.cmd_vel,
                                                profile(TOPIC['cmd_vel'].qos))
         self.pub_joints = self.create_publisher(JointState, names.kinematic_targets,
                                                 profile(TOPIC['kinematic_targets'].qos))
+        self.pub_cosmetic = self.create_publisher(Float32MultiArray, names.cosmetic_joints,
+                                                  profile(TOPIC['cosmetic_joints'].qos))
+        self.pub_illum = self.create_publisher(UInt32MultiArray, names.illum,
+                                               profile(TOPIC['illum'].qos))
+        self.pub_tone = self.create_publisher(UInt16MultiArray, names.tone,
+                                              profile(TOPIC['tone'].qos))
         self.pub_debug = [self.create_publisher(CompressedImage, DEBUG_TOPIC.format(eye=cam),
                                                 eyes)
                           for cam in EYES]
@@ -170,17 +202,24 @@ class KickBlueBall(Node):
 
     def _apply(self, values):
         """A set_parameters change that passed the checks: detection changes take effect
-        at the next frame; a behaviour or mode change starts the behaviour over."""
+        at the next frame; a behaviour or mode change starts the controller over."""
         if isinstance(values, DetectionParams):
-            self.detector = BallDetector(values)
+            self.detection_params = values
+            self.detectors = make_detectors(self.controller.detectors, values)
         elif isinstance(values, BehaviourParams):
             self._behaviour_params = values
-            self.behaviour = make_behaviour(self.config.mode, values)
+            self._new_controller()
         else:
             mode_changed = values.mode != self.config.mode
             self.config = values
+            if self._debug_folder:
+                self._debug_folder.keep = values.save_debug_keep
             if mode_changed:
-                self.behaviour = make_behaviour(values.mode, self._behaviour_params)
+                self._new_controller()
+
+    def _new_controller(self):
+        self.controller = make_controller(self.config.mode, self._behaviour_params)
+        self.detectors = make_detectors(self.controller.detectors, self.detection_params)
 
     def _on_no_clock(self):
         self._no_clock_timer.cancel()
@@ -191,11 +230,11 @@ class KickBlueBall(Node):
                     NO_CLOCK_NOTICE_S, CLOCK, self.context.get_domain_id()))
 
     def _restart(self):
-        """Start afresh: new behaviour, head hold, no percepts (also after time went back)."""
-        self.behaviour = make_behaviour(self.config.mode, self._behaviour_params)
+        """Start afresh: new controller, head hold, no percepts (also after time went back)."""
+        self._new_controller()
         self._started = None
         self._last_tick = None
-        for latest in self.balls + [self.cliff]:
+        for latest in self.eyes + [self.cliff] + list(self.readings.values()):
             latest.clear()
 
     @property
@@ -232,13 +271,13 @@ class KickBlueBall(Node):
         frame = self._decode(EYES[eye], msg)
         if frame is None:
             return
-        ball = self.detector.detect(frame)
-        self.frames_processed += 1
-        self.balls[eye].set(now, ball)
         # camera_info may describe another resolution than the frames (a resized stream).
         height, width = frame.shape[:2]
-        self._frame_cameras[eye] = self.cameras[eye].scaled_to(width, height)
-        self._debug_image(eye, msg.header, frame, ball)
+        camera = self._frame_cameras[eye] = self.cameras[eye].scaled_to(width, height)
+        found = {name: detect(frame, camera) for name, detect in self.detectors.items()}
+        self.frames_processed += 1
+        self.eyes[eye].set(now, (frame, found))
+        self._debug_image(eye, msg.header, frame, found.get('ball'))
 
     def _on_camera_info(self, eye, msg):
         """Adopt the eye's camera model; an unusable camera_info leaves the previous one."""
@@ -262,6 +301,20 @@ class KickBlueBall(Node):
                                 % (shown,))
         self.cliff.set(self._seconds(), data)
 
+    def _on_sonar(self, msg):
+        if not finite(msg.range):
+            return self._reject('sonar', 'sonar range %r is not a number' % msg.range)
+        self.readings['sonar'].set(self._seconds(), float(msg.range))
+
+    def _on_light(self, msg):
+        data = tuple(msg.data)
+        if not finite(*data):
+            return self._reject('light', 'light reading %s is not finite' % (data[:4],))
+        self.readings['light'].set(self._seconds(), data)
+
+    def _on_touch(self, part, msg):
+        self.readings[part].set(self._seconds(), int(msg.data))
+
     def _debug_image(self, eye, header, frame, ball):
         """Annotated frame to the debug topic (if anyone listens) and to --save-debug."""
         pub = self.pub_debug[eye]
@@ -273,12 +326,10 @@ class KickBlueBall(Node):
             return self._warn('debug', 'could not encode a debug image')
         if listened:
             pub.publish(CompressedImage(header=header, format='jpeg', data=jpeg.tobytes()))
-        if self.save_debug:
-            path = os.path.join(self.save_debug,
-                                '%s_%06d.jpg' % (EYES[eye], self.frames_processed))
+        if self._debug_folder:
             try:
-                with open(path, 'wb') as out:
-                    out.write(jpeg.tobytes())
+                self._debug_folder.save('%s_%06d.jpg' % (EYES[eye], self.frames_processed),
+                                        jpeg.tobytes())
             except OSError as err:
                 self._warn('save', 'cannot save debug image: %s' % err)
 
@@ -300,34 +351,59 @@ class KickBlueBall(Node):
                 self.get_logger().info('holding the head pose for %g s' % self.config.head_hold_s)
         if now - self._started < self.config.head_hold_s:
             self._publish_head()
-            if self.behaviour.waits_for_head:
+            if getattr(self.controller, 'waits_for_head', False):
                 self.state = STARTUP
                 self.drive(0.0, 0.0)
                 return
         self._check_silence(now)
-        stale = self.config.stale_s
-        left, right = (latest.fresh(now, stale) for latest in self.balls)
-        command = self.behaviour.step(now, left, right, self.cliff.fresh(now, stale),
-                                      self._frame_cameras)
-        for message in command.messages:
+        action = self.controller.act(self.percepts(now))
+        for message in action.messages:
             self.get_logger().info(message)
-        self.state = command.state
-        self.drive(command.left, command.right)
+        self.state = action.state
+        self.last_action = action
+        self.publish(action)
+
+    def percepts(self, now):
+        """The contract's input: the freshest of everything, None where stale or unknown."""
+        stale = self.config.stale_s
+        eyes = []
+        for latest, camera in zip(self.eyes, self._frame_cameras):
+            frame, found = latest.fresh(now, stale) or (None, {})
+            eyes.append(Eye(camera, frame, found))
+        reading = {key: latest.fresh(now, stale) for key, latest in self.readings.items()}
+        return Percepts(now, tuple(eyes), cliff=self.cliff.fresh(now, stale),
+                        sonar=reading['sonar'], touch_head=reading['head'],
+                        touch_body=reading['body'], light=reading['light'])
+
+    def publish(self, action):
+        """Each part of the action that is set, on its control topic."""
+        if action.wheels is not None:
+            self.drive(*action.wheels)
+        if action.head is not None:
+            self._publish_head(action.head)
+        if action.cosmetic is not None:
+            self.pub_cosmetic.publish(Float32MultiArray(data=[float(v) for v in action.cosmetic]))
+        if action.illum is not None:
+            self.pub_illum.publish(UInt32MultiArray(data=[int(v) for v in action.illum]))
+        if action.tone is not None:
+            self.pub_tone.publish(UInt16MultiArray(data=[int(v) for v in action.tone]))
 
     def _check_silence(self, now):
         """Warn about inputs that stopped (or never started) arriving."""
         stale = self.config.stale_s
         names = RobotTopics(self.robot)
         watched = [(names.eye_compressed(eye), latest)
-                   for eye, latest in zip(EYES, self.balls)] + [(names.cliff, self.cliff)]
+                   for eye, latest in zip(EYES, self.eyes)] + [(names.cliff, self.cliff)]
         for name, latest in watched:
             since = latest.stamp if latest.stamp is not None else self._started
             if now - since > stale:
                 self._warn('silent ' + name, 'nothing on %s for %.1f s' % (name, now - since))
 
-    def _publish_head(self):
-        msg = JointState(name=list(JOINT_NAMES),
-                         position=[0.0, math.radians(self.config.head_lift_deg), 0.0, 0.0])
+    def _publish_head(self, joints=None):
+        """Kinematic targets (tilt, lift, yaw, pitch, rad); the start pose by default."""
+        if joints is None:
+            joints = (0.0, math.radians(self.config.head_lift_deg), 0.0, 0.0)
+        msg = JointState(name=list(JOINT_NAMES), position=[float(v) for v in joints])
         msg.header.stamp = self.get_clock().now().to_msg()
         self.pub_joints.publish(msg)
 
@@ -367,7 +443,8 @@ def _topic_lines():
 
 def build_parser():
     lines = params.help_lines(*GROUPS) + [''] + _topic_lines()
-    lines += ['', 'With --ros-args -p use_sim_time:=true the control tick follows %s.' % CLOCK,
+    lines += ['', 'The control tick follows %s (simulated time); --ros-args -p '
+              'use_sim_time:=false puts it on the wall clock.' % CLOCK,
               'The robot: --ros-args -r __ns:=/NAME, as for any ROS 2 node; --robot NAME and '
               '$MIRO_ROBOT_NAME are shorthands (the node is then /NAME/%s).' % NODE_NAME]
     parser = _Parser(
@@ -379,7 +456,8 @@ def build_parser():
                         help='the robot to drive (its namespace); default $MIRO_ROBOT_NAME, '
                              'else miro; a remapped __ns wins')
     parser.add_argument('--save-debug', metavar='DIR',
-                        help='write every annotated camera frame to DIR as JPEG')
+                        help='write the annotated camera frames to DIR as JPEG, keeping '
+                             'the newest (-p save_debug_keep:=N)')
     return parser
 
 
@@ -406,7 +484,7 @@ def main(argv=None):
     stop = StopRequest()
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-        node = KickBlueBall(save_debug=options.save_debug, robot=options.robot)
+        node = KickBlueBall(save_debug=options.save_debug, robot=options.robot, args=argv)
     except (ValueError, ParameterException, NameValidationException) as err:
         # a bad parameter or name: say so in one line
         rclpy.try_shutdown()

@@ -3,14 +3,16 @@ import math
 from dataclasses import dataclass, field
 
 from miro_ball.common.params import check_ranges
-from miro_ball.controller.behaviour import BehaviourParams, MODES
+from miro_ball.controller.behaviour import BehaviourParams
+from miro_ball.controller.controllers import BUILT_IN, controller_class
 from miro_ball.controller.detection import DetectionParams
 from miro_ball.miro.constants import LIFT_RAD_CALIB, PLATFORM_TICK_S
 
 
 @dataclass(frozen=True)
 class ControllerParams:
-    mode: str = field(default='improved', metadata={'help': ' or '.join(MODES)})
+    mode: str = field(default='improved', metadata={
+        'help': ' or '.join(BUILT_IN) + ', or module:Class of your own (docs/controller.md)'})
     tick: float = field(default=PLATFORM_TICK_S,
                         metadata={'help': 'control period, s (node clock)', 'range': (0.001, 1.0)})
     stale_s: float = field(
@@ -20,14 +22,16 @@ class ControllerParams:
         default=1.0,
         metadata={'help': 'hold the head pose this long at start (tutorial: wheels still), s',
                   'range': (0.0, 60.0)})
+    save_debug_keep: int = field(
+        default=500, metadata={'help': '--save-debug keeps only the newest this many frames',
+                               'range': (1, 1000000)})
     head_lift_deg: float = field(
         default=round(math.degrees(LIFT_RAD_CALIB), 6),
         metadata={'help': 'lift joint of the start pose [tilt 0, lift, yaw 0, pitch 0], deg',
                   'range': (8.0, 60.0)})
 
     def __post_init__(self):
-        if self.mode not in MODES:
-            raise ValueError("mode must be one of %s, not '%s'" % (', '.join(MODES), self.mode))
+        controller_class(self.mode)  # ValueError when mode names no controller
         check_ranges(self)
 
 

@@ -18,11 +18,11 @@ from sensor_msgs.msg import CameraInfo, CompressedImage
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_guard import guard_clock
+from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
@@ -79,7 +79,7 @@ class Client(Node):
 
     def __init__(self, name, options, context=None):
         super().__init__(name, context=context, namespace=robot_namespace(options.robot),
-                         parameter_overrides=[Parameter('use_sim_time', value=True)])
+                         parameter_overrides=sim_time_overrides())
         self.options = options
         self.robot = robot_of_namespace(self.get_namespace())
         self.topics = RobotTopics()

@@ -13,9 +13,9 @@ import sys
 
 from geometry_msgs.msg import PoseStamped
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 
 from miro_ball.common.clock_guard import guard_clock
+from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.throttle import Throttled
 from miro_ball.examples._client import number, run
 from miro_ball.miro.interface import BALL_NAME, SimTopics
@@ -29,7 +29,7 @@ def ball_y(t, amplitude, period):
 class BallMover(Node):
     def __init__(self, options, context=None):
         super().__init__('ball_mover', context=context,
-                         parameter_overrides=[Parameter('use_sim_time', value=True)])
+                         parameter_overrides=sim_time_overrides())
         self.options = options
         guard_clock(self, Throttled(self.get_logger().warning))
         self.pub = self.create_publisher(PoseStamped, SimTopics().set_pose, 10)

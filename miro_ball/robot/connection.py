@@ -14,10 +14,10 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
 from miro_ball.common.clock_guard import guard_clock
+from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.qos import profile
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.interface import CONTROL_QOS
@@ -39,7 +39,7 @@ class Connection:
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.node = Node(node_name, context=self.context, namespace='/' + robot,
-                         parameter_overrides=[Parameter('use_sim_time', value=True)])
+                         parameter_overrides=sim_time_overrides())
         self.warn = Throttled(self.node.get_logger().warning)
         guard_clock(self.node, self.warn)
         self._changed = threading.Condition()
