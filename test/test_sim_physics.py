@@ -172,3 +172,26 @@ def test_sonar_sees_the_ball_ahead_and_nothing_beyond_range(empty):
     sonar = empty.robot.sensors.sonar
     nose_x = empty.robot.eye_pose(+1)[0][0]  # the sonar sits near the eyes, at the front
     assert sonar == pytest.approx(0.6 - 0.1 - nose_x, abs=0.06)
+
+
+def test_cosmetic_joints_move_the_model(empty):
+    from miro_sim_bullet.bullet import pybullet as pb
+    from miro_sim_bullet.physics.model import COSMETIC_LINKS
+
+    def angles():
+        return [s[0] for s in pb.getJointStates(empty.robot.body_id, COSMETIC_LINKS,
+                                                physicsClientId=empty.client)]
+    empty.run(0.5)
+    rest = angles()
+    empty.robot.set_cosmetic([1.0, 0.0, 1.0, 1.0, 0.0, 1.0])  # droop, wag right, eyes shut
+    empty.run(1.0)
+    moved = angles()
+    assert all(abs(a - b) > 0.2 for a, b in zip(moved, rest)), (rest, moved)
+    # The eyes and the world view draw the model's joints (joint_angles is their snapshot).
+    assert [empty.robot.joint_angles()[link] for link in COSMETIC_LINKS] == moved
+
+
+def test_illum_is_kept(empty):
+    empty.robot.set_illum([0xFF00FF00] * 6)
+    empty.run(0.1)
+    assert empty.robot.illum == [0xFF00FF00] * 6

@@ -40,6 +40,7 @@ ILLUM_X = (0.03, -0.04, -0.11)  # front, middle, rear (BODY frame)
 KIN_LINKS = {LIFT: NECK, YAW: GIMBAL, PITCH: HEAD}
 # Cosmetic order: droop, wag, eyelid l/r, ear l/r; value 0..1 -> angle range.
 COSMETIC_LINKS = (TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L, EAR_R)
+COSMETIC_RADIUS_M = 0.02  # about the size of a tail piece, an ear or an eyelid
 COSMETIC_RANGES = ((0.0, 0.6), (-0.6, 0.6), (0.0, 0.9), (0.0, 0.9), (-0.5, 0.5), (0.5, -0.5))
 
 
@@ -162,6 +163,13 @@ class MiroModel:
         for joint, link in KIN_LINKS.items():
             lo, hi = JOINT_LIMITS_RAD[joint]
             pb.changeDynamics(body, link, jointLowerLimit=lo, jointUpperLimit=hi, **kw)
+        # PyBullet takes a link's inertia from its collision shape; the cosmetic links have
+        # none (they touch nothing), and a link of zero inertia stays where its motor is
+        # told to move it. Each gets the inertia of a sphere of its mass.
+        for link in COSMETIC_LINKS:
+            mass = links[link].mass
+            inertia = 0.4 * mass * COSMETIC_RADIUS_M ** 2
+            pb.changeDynamics(body, link, localInertiaDiagonal=(inertia,) * 3, **kw)
         return body
 
     def set_collision_filter(self, group, mask):
