@@ -69,6 +69,9 @@ def test_show_prints_the_signal_as_it_arrives(signal, paused_sim, executor, ros_
         assert re.search(expected[signal], lines[-1]), lines[-1]
     times = [float(line.split()[0]) for line in lines]
     assert times == sorted(times) and times[-1] > 0  # simulated time
+    if signal in ('odom', 'sonar', 'imu', 'imu_head', 'kin', 'battery'):
+        # Stamped: each line says when its reading was taken, three ticks apart.
+        assert len(set(times)) == 3, times
 
 
 def test_show_cmd_vel_prints_what_someone_commands(paused_sim, executor, ros_context, capsys):
@@ -140,11 +143,12 @@ def test_bench_cos_and_illum_reach_the_robot(paused_sim, executor, ros_context):
 
 
 def test_video_writes_both_eyes_and_a_side_by_side_video(tmp_path, paused_sim, executor,
-                                                         ros_context):
+                                                         ros_context, capsys):
     video = tmp_path / 'eyes.avi'
     code = run_client(client_video, ['--out', str(tmp_path / 'eyes'), '--video', str(video),
                                      '--frames', '5'], paused_sim, executor, ros_context, 2.0)
     assert code == 0
+    assert ' 5 stereo frames ' in capsys.readouterr().out.splitlines()[-1]  # the count at the end
     for eye in ('caml', 'camr'):
         assert cv2.imread(str(tmp_path / 'eyes' / f'{eye}.jpg')).shape == (360, 640, 3)
     capture = cv2.VideoCapture(str(video))

@@ -13,6 +13,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import BatteryState, Imu, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt16, UInt32
 
+from miro_ball.common.stamps import seconds
 from miro_ball.examples._client import Client, heading, make_parser, run
 
 
@@ -69,7 +70,10 @@ class Show(Client):
         self.shown = 0
 
     def on_message(self, msg):
-        self.say(f'{self.now():8.2f}  {self.options.signal}  {self.line(msg)}')
+        # A stamped message says when it was measured; messages that came in one burst
+        # (a slow terminal, a busy machine) would all show the time they were read.
+        when = seconds(msg.header.stamp) if hasattr(msg, 'header') else self.now()
+        self.say(f'{when:8.2f}  {self.options.signal}  {self.line(msg)}')
         self.shown += 1
         if self.shown == self.options.count:
             raise SystemExit(0)

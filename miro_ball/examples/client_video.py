@@ -65,11 +65,12 @@ class Video(Client):
                     self.get_logger().error(f'can not write {self.options.video}')
                     raise SystemExit(1)
             self.writer.write(frame)
-        if self.pairs % 75 == 1:  # every 5 s at 15 Hz
+        last = self.pairs == self.options.frames
+        if self.pairs % 75 == 1 or last:  # every 5 s at 15 Hz, and the count at the end
             self.say(f'{self.now():7.2f} s  {self.pairs} stereo frames '
                      f'({left.shape[1]}x{left.shape[0]}) in {self.out}/'
                      + (f' and {self.options.video}' if self.options.video else ''))
-        if self.pairs == self.options.frames:
+        if last:
             raise SystemExit(0)
 
     def destroy_node(self):
