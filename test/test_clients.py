@@ -12,6 +12,7 @@ import pytest
 from geometry_msgs.msg import TwistStamped
 
 from miro_ball.common.isolation import isolated_env
+from miro_ball.common.robots import missing_robot
 from miro_ball.examples import client_follower, client_minimal, client_show, client_test, \
     client_video
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
@@ -46,6 +47,22 @@ def run_client(module, args, paused_sim, executor, context, limit_s, each_tick=N
 
 def robot(paused_sim):
     return paused_sim.sim.robots[T.name]
+
+
+def test_a_robot_that_is_not_there_is_named_with_the_robots_that_are(paused_sim, executor,
+                                                                       ros_context, capsys):
+    code = run_client(client_minimal, ['--robot', 'ghost'], paused_sim, executor, ros_context,
+                      limit_s=1.0)
+    assert code is None and 'driving' not in capsys.readouterr().out  # nothing to drive
+    client = client_show.Show(client_show.build_parser().parse_args(['odom', '--robot', 'ghost']),
+                              context=ros_context)
+    try:
+        assert spin_until(executor, lambda: T.odom in dict(client.get_topic_names_and_types()))
+        assert missing_robot(client, 'ghost', 5.0) == (
+            f"no robot 'ghost' on ROS domain {os.environ['ROS_DOMAIN_ID']} after 5 s: the "
+            f'robots there are {T.name} (--robot NAME)')
+    finally:
+        client.destroy_node()
 
 
 def test_minimal_drives_and_prints_the_battery(paused_sim, executor, ros_context, capsys):
@@ -205,15 +222,15 @@ def test_a_client_waiting_for_the_simulator_says_what_for_and_ends_on_ctrl_c():
                             stderr=subprocess.STDOUT, text=True)
     lines = []
     try:
-        for line in proc.stdout:  # the notice comes after 2 s of wall time with nothing
+        for line in proc.stdout:  # the notice comes after 5 s of wall time with nothing
             lines.append(line)
-            if 'waiting for robot' in line:
+            if 'waiting for it' in line:
                 break
         proc.send_signal(signal.SIGINT)
         output, _ = proc.communicate(timeout=10)
     finally:
         kill_if_running(proc)
     notice = lines[-1]
-    assert f'/{T.name}/sensors/odom' in notice and f'ROS domain {domain}' in notice, lines
-    assert f"robot '{T.name}'" in notice
+    assert f"no robot '{T.name}' on ROS domain {domain}" in notice, lines
+    assert 'no robot is there (is the simulator running' in notice
     assert proc.returncode == 0 and 'Traceback' not in output, output

@@ -11,6 +11,7 @@ wall time it says once what it waits for.
 import argparse
 import math
 import sys
+import time
 
 import rclpy
 from geometry_msgs.msg import TwistStamped
@@ -24,14 +25,16 @@ from miro_ball.common.cli import user_args
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.qos import profile
+from miro_ball.common.robots import missing_robot
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.interface import (CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES, frame_id,
-                                      robot_name, robot_namespace, robot_of_namespace,
-                                      RobotTopics, SENSOR_QOS)
+from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
+                                      frame_id, robot_name, robot_namespace,
+                                      robot_of_namespace, RobotTopics, SENSOR_QOS)
 
-SILENCE_NOTICE_S = 2.0  # wall seconds
+SILENCE_NOTICE_S = 5.0  # wall seconds without the robot before a client says so
+DISCOVERY_LOOK_S = 0.5  # wall seconds between looks at the graph meanwhile
 
 
 def make_parser(prog, doc):
@@ -87,7 +90,8 @@ class Client(Node):
         self.cameras = {}  # eye -> its CameraModel, once watch_eyes has heard camera_info
         guard_clock(self, self.warn)
         self._heard = False
-        self._silence_timer = self.create_timer(SILENCE_NOTICE_S, self._on_silence,
+        self._started = time.monotonic()
+        self._silence_timer = self.create_timer(DISCOVERY_LOOK_S, self._on_silence,
                                                 clock=Clock(clock_type=ClockType.STEADY_TIME))
 
     def subscribe(self, msg_type, topic, callback, qos=SENSOR_QOS):
@@ -126,14 +130,17 @@ class Client(Node):
         return self.create_publisher(msg_type, topic, profile(qos))
 
     def _on_silence(self):
+        """Once: no publisher matched on any of the robot's topics a while after the start
+        (discovery alone took up to 2.4 s here), so say which robots there are."""
+        mine = [sub for sub in self.subscriptions if sub.topic_name != CLOCK]
+        if self._heard or any(sub.get_publisher_count() for sub in mine):
+            self._silence_timer.cancel()  # found: what it says comes when it comes
+            return
+        if time.monotonic() - self._started < SILENCE_NOTICE_S:
+            return
         self._silence_timer.cancel()
-        if not self._heard:
-            topics = ', '.join(sub.topic_name for sub in self.subscriptions
-                               if sub.topic_name != '/clock')
-            self.get_logger().warning(
-                f'nothing on {topics} after {SILENCE_NOTICE_S:g} s: waiting for robot '
-                f'{self.robot!r} on ROS domain {self.context.get_domain_id()} (is the '
-                'simulator running, with the same ROS_DOMAIN_ID and robot name?)')
+        self.get_logger().warning(missing_robot(self, self.robot, SILENCE_NOTICE_S)
+                                  + '; waiting for it')
 
     def twist(self, linear, angular):
         """A TwistStamped for control/cmd_vel, stamped now in the robot's body frame."""

@@ -34,8 +34,8 @@ class Minimal(Client):
         self.cmd_vel.publish(self.twist(linear, angular))
 
     def tick(self):
-        if self.now() == 0.0:
-            return  # no /clock yet: the simulator is not running
+        if self.now() == 0.0 or not self.cmd_vel.get_subscription_count():
+            return  # no /clock yet, or no robot of this name listens: nothing to drive
         if self.start is None:
             self.start = self.now()
             self.say(f'driving at {self.options.linear} m/s, {self.options.angular} rad/s '

@@ -44,6 +44,7 @@ from visualization_msgs.msg import MarkerArray
 from miro_ball.common.clock_watch import clock_publishers, ClockWatch, shared_domain_line
 from miro_ball.common.jpeg import MAX_SIDE, ImageRejected, jpeg_size
 from miro_ball.common.qos import profile
+from miro_ball.common.robots import robots_running
 from miro_ball.common.stamps import seconds
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.names import debug_topic
@@ -53,7 +54,7 @@ from miro_ball.gui.scene import SceneState
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_NAMES, PLATFORM_TICK_S
 from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
-                                      frame_id, RobotTopics, SENSOR_QOS, SimTopics, robots_in)
+                                      frame_id, RobotTopics, SENSOR_QOS, SimTopics)
 from miro_ball.miro.touch import pads_at
 
 NODE_NAME = 'miro_gui'
@@ -698,9 +699,7 @@ class GuiBridge(Node):
         return True
 
     def _discover(self):
-        # The graph lists topics that only have subscribers too, like our own watch's.
-        robots = [name for name in robots_in(n for n, _ in self.get_topic_names_and_types())
-                  if self.count_publishers(RobotTopics(name).odom)]
+        robots = robots_running(self)
         changed = robots != self.robots
         self.robots = robots
         if self.fixed_robot is None and robots:

@@ -5,6 +5,7 @@ import math
 from geometry_msgs.msg import TwistStamped
 from sensor_msgs.msg import JointState
 
+from miro_ball.common.robots import missing_robot
 from miro_ball.miro.constants import JOINT_NAMES, PLATFORM_TICK_S
 from miro_ball.miro.gaze import look_at
 from miro_ball.miro.interface import check_name, frame_id, robot_name, RobotTopics
@@ -48,11 +49,9 @@ class Robot:
         heard = self._readings.latest
         if not self._ros.wait_until(lambda: heard.keys() >= READINGS.keys() and self.now > 0,
                                     'the robot', wall_timeout=timeout):
-            domain = self._ros.domain
+            said = missing_robot(self._ros.node, self.name, timeout)
             self._ros.close()
-            raise TimeoutError(
-                f'no robot {self.name!r} on ROS domain {domain} after {timeout:g} s: is the '
-                'simulator running, with the same ROS_DOMAIN_ID and robot name?')
+            raise TimeoutError(said)
         atexit.register(self.close)
 
     def __repr__(self):
