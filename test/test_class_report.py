@@ -3,6 +3,7 @@ Pure Python: no ROS, no simulator."""
 import csv
 import json
 import os
+from pathlib import Path
 from datetime import datetime
 from html.parser import HTMLParser
 
@@ -79,6 +80,17 @@ def test_discover_finds_each_kind_and_says_why_others_are_skipped(tmp_path):
     assert 'not a folder' in reasons['README.txt']
     assert 'no executable run' in reasons['carol']
     assert 'not executable' in reasons['grace']
+
+
+def test_a_class_given_by_a_relative_path_is_the_same_class(tmp_path, monkeypatch):
+    """Each command runs in its own folder: a relative path there meant another place, and
+    every student of `--class students/` was scored crashed."""
+    make_class(tmp_path)
+    monkeypatch.chdir(tmp_path.parent)
+    relative, _ = discover(tmp_path.name, python='/usr/bin/python3')
+    absolute, _ = discover(tmp_path, python='/usr/bin/python3')
+    assert relative == absolute
+    assert all(s.folder.is_absolute() and Path(s.command[-1]).is_absolute() for s in relative)
 
 
 def test_discover_refuses_what_is_no_class(tmp_path):

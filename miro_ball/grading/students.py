@@ -85,9 +85,12 @@ def _student(folder, python):
 def discover(class_dir, python=sys.executable):
     """(students sorted by name, [(name, reason), ...] skipped) of class_dir. ValueError, in
     one line, when class_dir is not a folder or holds no student."""
-    class_dir = Path(class_dir)
+    given = class_dir
+    # Resolved once, here: each command runs in its student's folder (a sandbox's chdir, a
+    # command's cwd), where a relative path means something else.
+    class_dir = Path(class_dir).resolve()
     if not class_dir.is_dir():
-        raise ValueError(f'--class {class_dir}: not a folder')
+        raise ValueError(f'--class {given}: not a folder')
     students, skipped = [], []
     for entry in sorted(class_dir.iterdir(), key=lambda p: p.name):
         name = entry.name
@@ -105,6 +108,6 @@ def discover(class_dir, python=sys.executable):
             else:
                 skipped.append((name, reason))
     if not students:
-        raise ValueError(f'--class {class_dir}: no student in it (one folder per student, with '
+        raise ValueError(f'--class {given}: no student in it (one folder per student, with '
                          f'an executable run or a controller.py; {len(skipped)} entries skipped)')
     return students, skipped
