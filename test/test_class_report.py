@@ -82,6 +82,18 @@ def test_discover_finds_each_kind_and_says_why_others_are_skipped(tmp_path):
     assert 'not executable' in reasons['grace']
 
 
+def test_a_student_whose_every_episode_crashed_the_same_way_is_told_why_in_one_line():
+    said = "bwrap: Can't chdir to students/alice"
+    crashed = [episode('alice', i, crashed=True, ended='command exited', exit_code=1,
+                       output_tail=['starting', said]) for i in (1, 2)]
+    alice, = summaries(['alice'], crashed, 2)
+    assert summary_line(alice).endswith(f'crashed 2 (every episode: {said})')
+    # Not when one episode did not crash, nor when they crashed in different ways.
+    assert summaries(['alice'], crashed[:1] + [episode('alice', 2)], 2)[0]['why'] is None
+    other = dict(crashed[1], output_tail=['ImportError: no module named cv3'])
+    assert summaries(['alice'], [crashed[0], other], 2)[0]['why'] is None
+
+
 def test_a_class_given_by_a_relative_path_is_the_same_class(tmp_path, monkeypatch):
     """Each command runs in its own folder: a relative path there meant another place, and
     every student of `--class students/` was scored crashed."""

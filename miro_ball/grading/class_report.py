@@ -85,8 +85,19 @@ def summaries(students, episodes, count):
             'cheated': sum(bool(e.get('cheated')) for e in ran),
             'cheated_reasons': list(dict.fromkeys(e['cheated'] for e in ran if e.get('cheated'))),
             'crashed': sum(bool(e['crashed']) for e in ran),
+            'why': _same_crash(ran),
             'marks': [mark(mine[i]) if i in mine else 'not run' for i in range(1, count + 1)]})
     return found
+
+
+def _same_crash(ran):
+    """The last line its command printed when every episode of a student crashed with the
+    same one (a path the student's run can not reach, an import error), else None: a
+    teacher reads why in one line instead of opening each episode's log."""
+    last = {(e.get('output_tail') or [''])[-1].strip() for e in ran if e['crashed']}
+    if ran and all(e['crashed'] for e in ran) and len(last) == 1 and '' not in last:
+        return last.pop()
+    return None
 
 
 def _number(value, form, missing=''):
@@ -109,9 +120,11 @@ def _cheated(summary):
 def summary_line(summary, width=11):
     """alice       3/5 kicked, median 4.2 s, fell 0, cheated 1 (published on /clock), crashed 0
     """
+    why = summary.get('why')
     return (f'{_who(summary["student"]):<{width}} {summary["score"]}/{summary["episodes"]} '
             f'kicked, median {_median(summary)}, fell {summary["fell"]}, cheated '
-            f'{_cheated(summary)}, crashed {summary["crashed"]}')
+            f'{_cheated(summary)}, crashed {summary["crashed"]}'
+            + (f' (every episode: {why})' if why else ''))
 
 
 def write_report(folder, meta, students, episodes):
