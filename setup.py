@@ -26,9 +26,11 @@ setup(
         'moderngl',  # the eye renderer (OpenGL on a headless EGL context)
         'numpy',
         'opencv-python-headless',
+        'psutil',  # process trees: the grader's commands, the soak, memory figures
         'pybullet',
         'rosbags',  # rosbag2 (MCAP) recording without a ROS install
         'ruamel.yaml',  # rosbag2 metadata (rosbags uses it too)
+        'scipy',  # rotations (scipy.spatial.transform)
     ],
     extras_require={
         # Left out for users whose ROS 2 Jazzy is installed and sourced.

@@ -1,7 +1,6 @@
 """The controller contract without ROS: its values, detectors and controllers by name, the
 example wag controller, the sim-time rule and --save-debug's bound."""
 import dataclasses
-import math
 import random
 from pathlib import Path
 

@@ -181,7 +181,6 @@ def test_readouts_in_the_mdk_guis_units():
     assert r.wheels_mm_s([0.4, -0.1]) == [400.0, -100.0]
     assert r.head_degrees([TILT_RAD, math.radians(34), 0.0, math.radians(-10)]) == \
         pytest.approx([34.0, 0.0, -10.0])
-    assert r.yaw_of(math.sin(0.5), math.cos(0.5)) == pytest.approx(1.0)
     assert r.jsonable({'a': [1.0, math.inf], 'b': math.nan, 'c': 'x'}) == \
         {'a': [1.0, None], 'b': None, 'c': 'x'}
 

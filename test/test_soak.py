@@ -5,8 +5,9 @@ import sys
 
 import pytest
 
-from miro_ball.bench.soak import (descendants, growth, process_tree, RSS_TARGET_PCT, rss_mb,
+from miro_ball.bench.soak import (growth, process_tree, RSS_TARGET_PCT, rss_mb,
                                 Sample, SimulatedTime, trend_pct, verdict)
+from miro_ball.common.proc_tree import descendants
 from miro_ball.miro.interface import default_robot_name
 from rostools import run_command
 

@@ -6,25 +6,13 @@ summed resident sizes would count libLLVM (~100 MB, mapped by every EGL process)
 """
 from pathlib import Path
 
-
-def descendants(pid):
-    """pid and the pids of all its children, their children..., as far as /proc says."""
-    found, todo = [], [pid]
-    while todo:
-        current = todo.pop()
-        found.append(current)
-        for task in Path(f'/proc/{current}/task').glob('*'):
-            try:
-                todo += [int(child) for child in (task / 'children').read_text().split()]
-            except OSError:
-                pass
-    return found
+from miro_ball.common.proc_tree import descendants
 
 
 def tree_memory_mb(pid):
     """(PSS, RSS) in MB of process pid and its descendants now; (0, 0) if it is gone."""
     pss = rss = 0
-    for process in descendants(pid):
+    for process in [pid] + descendants(pid):
         try:
             for line in Path(f'/proc/{process}/smaps_rollup').read_text().splitlines():
                 if line.startswith('Pss:'):

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from miro_ball.common.isolation import isolated_env, limit_discovery, private_domain
+from miro_ball.common.proc_tree import descendants
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
 from miro_ball.miro.interface import CLOCK
@@ -50,28 +51,6 @@ def fd_count(pid):
         return len(os.listdir(f'/proc/{pid}/fd'))
     except OSError:
         return None
-
-
-def _parent(pid):
-    try:
-        with open(f'/proc/{pid}/stat') as stat:
-            return int(stat.read().rsplit(')', 1)[1].split()[1])
-    except (OSError, ValueError, IndexError):
-        return None
-
-
-def descendants(pid):
-    """Process ids of every live descendant of pid (children, their children, ...)."""
-    children = {}
-    for entry in os.listdir('/proc'):
-        if entry.isdigit():
-            children.setdefault(_parent(entry), []).append(int(entry))
-    found, todo = [], [pid]
-    while todo:
-        kids = sorted(children.get(todo.pop(), []))
-        found += kids
-        todo += kids
-    return found
 
 
 def process_tree(named):

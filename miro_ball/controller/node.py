@@ -36,6 +36,7 @@ from miro_ball.common.cli import user_args
 from miro_ball.common import params
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
+from miro_ball.common.messages import drive_command
 from miro_ball.common.qos import profile
 from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
@@ -50,7 +51,7 @@ from miro_ball.controller.names import DEBUG_TOPIC, NODE_NAME
 from miro_ball.controller.params import ControllerParams, GROUPS
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES
-from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYE_QOS, EYES, frame_id,
+from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
                                       robot_namespace, robot_of_namespace, RobotTopics,
                                       SENSOR, TOPIC, TOUCH_PARTS)
 from miro_ball.miro.kinematics import clamp_wheel_speeds, finite, wheel_speed2cmd_vel
@@ -411,12 +412,7 @@ class KickBlueBall(Node):
         """Publish wheel speeds (m/s) as a TwistStamped through the MDK's formula."""
         left, right = clamp_wheel_speeds(left, right)
         linear, angular = wheel_speed2cmd_vel((left, right))
-        msg = TwistStamped()
-        msg.header.stamp = self.get_clock().now().to_msg()
-        msg.header.frame_id = frame_id(self.robot, 'base_link')
-        msg.twist.linear.x = float(linear)
-        msg.twist.angular.z = float(angular)
-        self.pub_twist.publish(msg)
+        self.pub_twist.publish(drive_command(self, self.robot, linear, angular))
         self.last_command = (left, right)
 
     def stop(self, timeout_s=0.5):

@@ -14,7 +14,6 @@ import sys
 import time
 
 import rclpy
-from geometry_msgs.msg import TwistStamped
 from sensor_msgs.msg import CameraInfo, CompressedImage
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import SingleThreadedExecutor
@@ -23,15 +22,17 @@ from rclpy.signals import SignalHandlerOptions
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_guard import guard_clock
-from miro_ball.common.sim_time import sim_time_overrides
+from miro_ball.common.messages import drive_command
 from miro_ball.common.qos import profile
 from miro_ball.common.robots import missing_robot
+from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
-                                      frame_id, robot_name, robot_namespace,
-                                      robot_of_namespace, RobotTopics, SENSOR_QOS)
+                                      robot_name, robot_namespace, robot_of_namespace,
+                                      RobotTopics, SENSOR_QOS)
+from miro_ball.miro.rotations import yaw_of
 
 SILENCE_NOTICE_S = 5.0  # wall seconds without the robot before a client says so
 DISCOVERY_LOOK_S = 0.5  # wall seconds between looks at the graph meanwhile
@@ -62,7 +63,7 @@ def number(low, high):
 
 def heading(q):
     """Heading (yaw, rad) of a geometry_msgs Quaternion, e.g. odometry's orientation."""
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return yaw_of(q.x, q.y, q.z, q.w)
 
 
 def parse(parser, argv):
@@ -144,11 +145,7 @@ class Client(Node):
 
     def twist(self, linear, angular):
         """A TwistStamped for control/cmd_vel, stamped now in the robot's body frame."""
-        msg = TwistStamped()
-        msg.header.stamp = self.get_clock().now().to_msg()
-        msg.header.frame_id = frame_id(self.robot, 'base_link')
-        msg.twist.linear.x, msg.twist.angular.z = float(linear), float(angular)
-        return msg
+        return drive_command(self, self.robot, linear, angular)
 
     def now(self):
         """Simulated seconds (0 until the first /clock)."""

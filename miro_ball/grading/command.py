@@ -15,6 +15,7 @@ import subprocess
 import threading
 import time
 
+from miro_ball.common.proc_tree import descendants
 from miro_ball.run.processes import stop_group
 
 TAIL_LINES = 5
@@ -33,25 +34,6 @@ def printable_tail(raw, lines=TAIL_LINES, width=TAIL_WIDTH):
                for line in text.replace('\r', '\n').split('\n')]
     return [line[:width] + ('...' if len(line) > width else '')
             for line in cleaned if line][-lines:]
-
-
-def descendants(pid):
-    """Pids of every process under pid (children, theirs, ...), from /proc."""
-    children = collections.defaultdict(list)
-    for entry in os.listdir('/proc'):
-        if entry.isdigit():
-            try:
-                with open(f'/proc/{entry}/stat') as stat:
-                    parent = int(stat.read().rsplit(')', 1)[1].split()[1])
-            except (OSError, ValueError, IndexError):  # gone meanwhile
-                continue
-            children[parent].append(int(entry))
-    found, todo = [], [pid]
-    while todo:
-        for child in children.get(todo.pop(), ()):
-            found.append(child)
-            todo.append(child)
-    return found
 
 
 def _signal(pids, signum):

@@ -22,7 +22,6 @@ Stdin closing ends the host; so does the grader's end (its pipe closes).
 """
 import argparse
 import json
-import math
 import os
 import shutil
 import sys
@@ -36,6 +35,7 @@ from miro_ball.grading.kick_judge import KickJudge
 from miro_ball.grading.warm_start import python_args
 from miro_ball.grading.watch import GraphWatch, verdict
 from miro_ball.miro.interface import RobotTopics
+from miro_ball.miro.rotations import yaw_quaternion
 from miro_ball.run.episode import SETTLE_S
 
 SCRATCH = 'scratch'  # a command's $HOME, in the host's folder: made anew for each command
@@ -76,7 +76,7 @@ def place(sim, name, robot, ball):
     """Robot ``name`` at robot (x, y, yaw) on its floor, the ball at rest at ball (x, y)."""
     x, y, yaw = robot
     sim.set_object_pose(name, (x, y, sim.description.robots[0].floor),
-                        (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)))
+                        yaw_quaternion(yaw))
     sim.place_ball(*ball)
 
 

@@ -43,6 +43,7 @@ from visualization_msgs.msg import MarkerArray
 
 from miro_ball.common.clock_watch import clock_publishers, ClockWatch, shared_domain_line
 from miro_ball.common.jpeg import MAX_SIDE, ImageRejected, jpeg_size
+from miro_ball.common.messages import drive_command
 from miro_ball.common.qos import profile
 from miro_ball.common.robots import robots_running
 from miro_ball.common.stamps import seconds
@@ -54,7 +55,8 @@ from miro_ball.gui.scene import SceneState
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_NAMES, PLATFORM_TICK_S
 from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
-                                      frame_id, RobotTopics, SENSOR_QOS, SimTopics)
+                                      RobotTopics, SENSOR_QOS, SimTopics)
+from miro_ball.miro.rotations import yaw_of
 from miro_ball.miro.touch import pads_at
 
 NODE_NAME = 'miro_gui'
@@ -236,7 +238,8 @@ def _odometry(msg):
     pose, twist = msg.pose.pose, msg.twist.twist
     return {'odom': [twist.linear.x, twist.angular.z],
             'pose': [pose.position.x, pose.position.y,
-                     r.yaw_of(pose.orientation.z, pose.orientation.w)]}
+                     yaw_of(pose.orientation.x, pose.orientation.y, pose.orientation.z,
+                            pose.orientation.w)]}
 
 
 class GuiBridge(Node):
@@ -556,11 +559,8 @@ class GuiBridge(Node):
             return
         out.sent_this_tick = True
         out.stop_pending = False
-        msg = TwistStamped()
-        msg.header.stamp = self.get_clock().now().to_msg()
-        msg.header.frame_id = frame_id(watch.robot, 'base_link')
-        msg.twist.linear.x, msg.twist.angular.z = float(linear), float(angular)
-        watch.publisher(TwistStamped, watch.topics.cmd_vel).publish(msg)
+        watch.publisher(TwistStamped, watch.topics.cmd_vel).publish(
+            drive_command(self, watch.robot, linear, angular))
 
     def _stop(self, watch, why):
         watch.out.drive = None

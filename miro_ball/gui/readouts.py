@@ -48,11 +48,6 @@ def head_degrees(positions):
     return [math.degrees(v) for v in positions[1:4]]
 
 
-def yaw_of(z, w):
-    """Heading (rad) of a quaternion that turns about z only."""
-    return 2.0 * math.atan2(z, w)
-
-
 def finite_or_none(value):
     """JSON has no NaN or inf: those become None (shown as '-')."""
     return value if isinstance(value, (int, float)) and math.isfinite(value) else None

@@ -5,10 +5,11 @@ import math
 from geometry_msgs.msg import TwistStamped
 from sensor_msgs.msg import JointState
 
+from miro_ball.common.messages import drive_command
 from miro_ball.common.robots import missing_robot
 from miro_ball.miro.constants import JOINT_NAMES, PLATFORM_TICK_S
 from miro_ball.miro.gaze import look_at
-from miro_ball.miro.interface import check_name, frame_id, robot_name, RobotTopics
+from miro_ball.miro.interface import check_name, robot_name, RobotTopics
 from miro_ball.miro.kc import clamp_joints, EYE_FRAMES, FOOT, KinematicChain, WORLD
 from miro_ball.miro.pose_controller import PoseController
 from miro_ball.robot.connection import Connection, node_name
@@ -191,8 +192,4 @@ class Robot:
             self.stop()
 
     def _send(self, forward, turn):
-        msg = TwistStamped()
-        msg.header.stamp = self._ros.node.get_clock().now().to_msg()
-        msg.header.frame_id = frame_id(self.name, 'base_link')
-        msg.twist.linear.x, msg.twist.angular.z = forward, turn
-        self._cmd_vel.publish(msg)
+        self._cmd_vel.publish(drive_command(self._ros.node, self.name, forward, turn))

@@ -15,6 +15,8 @@ import subprocess
 import time
 from dataclasses import dataclass
 
+import psutil
+
 GROUP_POLL_S = 0.05
 KILL_WAIT_S = 1.0  # at most, for a killed group to be gone
 
@@ -113,18 +115,13 @@ def _group_alive(pgid):
     """Whether a member of the process group still runs. Zombies do not count: whoever
     adopts a dead shell's children may take its time to reap them (the container's first
     process here does), and a zombie still answers kill(0)."""
-    try:
-        stats = [path for path in os.listdir('/proc') if path.isdigit()]
-    except OSError:  # no /proc: a zombie is then taken for a live member
-        return _signal_group(pgid, 0)
-    for pid in stats:
+    for process in psutil.process_iter(['status']):
         try:
-            with open(f'/proc/{pid}/stat') as stat:
-                fields = stat.read().rsplit(')', 1)[1].split()
-        except OSError:  # gone meanwhile
+            if process.info['status'] != psutil.STATUS_ZOMBIE and \
+                    os.getpgid(process.pid) == pgid:
+                return True
+        except (ProcessLookupError, psutil.Error):  # gone meanwhile
             continue
-        if fields[0] != 'Z' and int(fields[2]) == pgid:
-            return True
     return False
 
 

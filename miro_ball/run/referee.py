@@ -6,12 +6,12 @@ The simulator of a run starts paused. Free-running, it was seconds into the run
 before a slow controller or the observer had matched its topics: the observer
 reported 0.0 s simulated while the robots were already at the ball.
 """
-import math
 import time
 from contextlib import contextmanager
 
 from miro_ball.controller.names import NODE_NAME as CONTROLLER
 from miro_ball.miro.interface import BALL_NAME, EYES, RobotTopics, SimTopics
+from miro_ball.miro.rotations import yaw_quaternion
 from miro_ball.run.monitor import Monitor, unmatched
 
 SERVICE_TIMEOUT_S = 10.0
@@ -47,7 +47,7 @@ def set_pose_request(name, position, yaw=0.0):
     msg.header.frame_id = name
     p, o = msg.pose.position, msg.pose.orientation
     p.x, p.y, p.z = (float(v) for v in position)
-    o.z, o.w = math.sin(yaw / 2), math.cos(yaw / 2)
+    o.x, o.y, o.z, o.w = yaw_quaternion(yaw)
     return msg
 
 

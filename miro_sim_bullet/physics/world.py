@@ -9,6 +9,7 @@ import math
 
 from miro_ball.miro.constants import PLATFORM_TICK_S
 from miro_ball.miro.interface import default_robot_name
+from miro_ball.miro.rotations import yaw_of
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.robot import MiroRobot
 from miro_sim_bullet.physics.sensors import GRAVITY
@@ -188,8 +189,7 @@ class SimWorld:
             if orientation is None:
                 yaw = robot.pose()[2]
             else:
-                qx, qy, qz, qw = orientation
-                yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+                yaw = yaw_of(*orientation)
             robot.place(x, y, yaw, floor=z)
             return
         body = self.objects[name]

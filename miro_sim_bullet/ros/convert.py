@@ -11,6 +11,7 @@ from std_msgs.msg import Float32MultiArray
 
 from miro_ball.miro.constants import JOINT_NAMES
 from miro_ball.miro.interface import frame_id, WORLD_FRAME
+from miro_ball.miro.rotations import yaw_quaternion
 from miro_sim_bullet.physics import model as rb
 from miro_sim_bullet.render.eye_images import JPEG_FORMAT
 
@@ -20,11 +21,6 @@ MAX_COORDINATE_M = 1000.0  # where set_pose may put things: far beyond any bundl
 def stamp(seconds):
     nanoseconds = int(round(seconds * 1e9))
     return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
-
-
-def _yaw_quaternion(q, yaw):
-    q.z, q.w = math.sin(yaw / 2), math.cos(yaw / 2)
-    return q
 
 
 def kinematic_joints(s, when, robot):
@@ -42,7 +38,8 @@ def odometry(s, when, robot):
     msg = Odometry(child_frame_id=frame_id(robot, 'base_link'))
     msg.header.stamp, msg.header.frame_id = when, frame_id(robot, 'odom')
     msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
-    _yaw_quaternion(msg.pose.pose.orientation, yaw)
+    o = msg.pose.pose.orientation
+    o.x, o.y, o.z, o.w = yaw_quaternion(yaw)
     msg.twist.twist.linear.x, msg.twist.twist.angular.z = forward, turn
     return msg
 
@@ -121,7 +118,7 @@ def pose(position, orientation, when):
 
 def robot_pose(x, y, z, yaw, when):
     """A robot's ground truth: the point on its floor under the axle, heading only."""
-    return pose((x, y, z), (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)), when)
+    return pose((x, y, z), yaw_quaternion(yaw), when)
 
 
 def pose_request(msg):

@@ -11,6 +11,7 @@ from geometry_msgs.msg import Pose, PoseArray
 
 from miro_ball.miro.interface import EYE_SIDE, EYES, WORLD_FRAME
 from miro_ball.miro.kc import camera_in_head
+from miro_ball.miro.rotations import matrix_quaternions
 from miro_sim_bullet.physics import model as rb
 from miro_sim_bullet.bullet import pybullet as pb
 
@@ -19,20 +20,9 @@ from miro_sim_bullet.bullet import pybullet as pb
 _OPTICAL_IN_CAMERA = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
 
 
-def quaternions(rotations):
-    """(n, 4) quaternions x, y, z, w (w >= 0) of (n, 3, 3) rotation matrices."""
-    m = np.asarray(rotations, float).reshape(-1, 3, 3)
-    d0, d1, d2 = m[:, 0, 0], m[:, 1, 1], m[:, 2, 2]
-    q = np.sqrt(np.maximum(0.0, np.stack([1 + d0 - d1 - d2, 1 - d0 + d1 - d2,
-                                          1 - d0 - d1 + d2, 1 + d0 + d1 + d2], axis=1))) / 2
-    q[:, :3] = np.copysign(q[:, :3], np.stack([m[:, 2, 1] - m[:, 1, 2], m[:, 0, 2] - m[:, 2, 0],
-                                               m[:, 1, 0] - m[:, 0, 1]], axis=1))
-    return q / np.linalg.norm(q, axis=1, keepdims=True)
-
-
 def quaternion(rotation):
     """(x, y, z, w) of one 3x3 rotation matrix, w >= 0."""
-    return tuple(quaternions(rotation)[0].tolist())
+    return tuple(matrix_quaternions(rotation)[0].tolist())
 
 
 _EYES_IN_HEAD = [(tuple(position), quaternion(rotation @ _OPTICAL_IN_CAMERA))
