@@ -24,7 +24,8 @@ def test_the_heading_of_a_tilted_body_is_its_turn_about_z(yaw, pitch, roll):
     assert yaw_of(*q) == pytest.approx(yaw, abs=1e-6)
 
 
-@pytest.mark.parametrize('q', [(0, 0, 0, 0), (math.nan, 0, 0, 1), (0, 0, math.inf, 1)])
+@pytest.mark.parametrize('q', [(0, 0, 0, 0), (math.nan, 0, 0, 1), (0, 0, math.inf, 1),
+                               (1e-300, 0, 0, 1e-300), (1e300, 1e300, 0, 1e300)])
 def test_what_is_no_rotation_has_no_heading(q):
     assert math.isnan(yaw_of(*q))
 

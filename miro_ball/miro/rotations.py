@@ -7,6 +7,8 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+MIN_NORM = 1e-9  # a quaternion shorter than this is taken for none (a zeroed message)
+
 
 def yaw_quaternion(yaw):
     """(x, y, z, w) of a turn of ``yaw`` rad about z."""
@@ -14,12 +16,15 @@ def yaw_quaternion(yaw):
 
 
 def yaw_of(x, y, z, w):
-    """Heading (rad, -pi..pi) of a quaternion: its turn about z (the first of z-y-x Euler
-    angles); nan when it is no rotation (not finite, or all zero), as from a garbage message."""
+    """Heading (rad, -pi..pi) of a quaternion: where it turns the x axis, seen from above
+    (the first of z-y-x Euler angles); nan when it is no rotation (not finite, or of no
+    length), as from a garbage message."""
     q = np.array([x, y, z, w], float)
-    if not np.isfinite(q).all() or not q.any():
+    length = np.linalg.norm(q) if np.isfinite(q).all() else math.nan
+    if not MIN_NORM < length < math.inf:
         return math.nan
-    return float(Rotation.from_quat(q).as_euler('ZYX')[0])
+    m = Rotation.from_quat(q / length).as_matrix()
+    return math.atan2(m[1, 0], m[0, 0])
 
 
 def matrix_quaternions(matrices):
