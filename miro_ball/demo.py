@@ -16,7 +16,6 @@ from miro_ball.common.isolation import isolated_env, private_domain
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
 from miro_ball.recording.node import NODE_NAME as RECORDER
-from miro_ball.run.episode import over
 from miro_ball.run.nodes import robot_names, run_nodes
 from miro_ball.run.processes import Processes
 from miro_ball.run.video import VIDEO_FPS
@@ -49,27 +48,26 @@ def xy(point):
 
 def start_line(referee):
     """Where the robots and the ball are at the start, as the observer first saw them."""
-    monitor = referee.monitor
-    robots = ', '.join(f'{name} at {xy(w.start)}' for name, w in monitor.robots.items())
+    judge = referee.judge
+    robots = ', '.join(f'{name} at {xy(track.start)}' for name, track in judge.robots.items())
     return f'  started at t = {referee.elapsed:.1f} s: {robots}; the ball at ' \
-           f'{xy(monitor.ball_start)}'
+           f'{xy(judge.ball_start)}'
 
 
 def follow(args, procs, referee, stop):
-    """Follow the run until it is over (episode.over: kicked, a robot fell, the limit) or a
-    node dies; returns (outcome, real-time factor)."""
-    monitor = referee.monitor
+    """Follow the run until it is over (the judge says: kicked, a robot fell, the limit) or
+    a node dies; returns (outcome, real-time factor)."""
+    monitor, judge = referee.monitor, referee.judge
     said_start, last_report, first_clock, outcome = False, 0.0, None, 'limit'
     while not stop.requested:
         referee.spin_once(0.05)
         now = time.monotonic()
         if first_clock is None and monitor.sim_time > referee.start_time:
             first_clock = (now, monitor.sim_time)
-        if not said_start and monitor.ball_start and all(
-                w.start for w in monitor.robots.values()):
+        if not said_start and judge.ball_start and len(judge.robots) == len(monitor.robots):
             said_start = True
             print(start_line(referee), flush=True)
-        finished = over(referee, args.limit)
+        finished = judge.over(args.limit)
         if finished and not args.gui:
             outcome = finished
             break
@@ -82,7 +80,7 @@ def follow(args, procs, referee, stop):
         if said_start and now - last_report >= PROGRESS_EVERY_S:
             last_report = now
             print(f'  t = {referee.elapsed:5.1f} s simulated, ball moved '
-                  f'{monitor.moved:4.2f} m, {monitor.frames} frames processed', flush=True)
+                  f'{judge.moved:4.2f} m, {monitor.frames} frames processed', flush=True)
     else:
         outcome = 'interrupted'
     wall = time.monotonic() - first_clock[0] if first_clock else 0.0
@@ -126,17 +124,19 @@ def gui_url(log, procs, wait_s=20.0):
 
 
 def summary(outcome, monitor, rtf, video, killed, record=None):
+    judge = monitor.judge
     lines = ['', 'summary',
-             f'  kicked:               {"yes" if monitor.kicked else "no"} ({outcome})']
-    if monitor.kicked:
-        by = f' by {monitor.kicker}' if monitor.kicker and len(monitor.robots) > 1 else ''
-        lines.append(f'  time to kick:         {monitor.kick_time:.1f} s simulated{by}')
-    lines += [f'  simulated time:       {monitor.sim_time:.1f} s',
+             f'  kicked:               {"yes" if judge.kicked else "no"} ({outcome})']
+    if judge.kicked:
+        by = f' by {judge.kicker}' if judge.kicker and len(monitor.robots) > 1 else ''
+        lines.append(f'  time to kick:         {judge.kick_time:.1f} s simulated{by}')
+    lines += [f'  simulated time:       {judge.elapsed:.1f} s',
               f'  real-time factor:     {rtf:.2f}',
               f'  frames processed:     {monitor.frames}']
     for name, w in monitor.robots.items():
+        track = judge.robots.get(name)
         lines.append(f'  robot {name + ":":<14} {w.frames} frames, '
-                     f'{"FELL" if w.fell else "stayed up"}')
+                     f'{"FELL" if track and track.fell else "stayed up"}')
     if video and video.frames:
         first, last = video.times
         lines.append(f'  video:                {video.path} ({video.frames} frames, t = '
@@ -209,7 +209,7 @@ def main(argv=None):
         janitor.clean()
     print(summary(outcome, monitor, rtf, video, killed, args.record))
     # A node that had to be killed did not stop as it should: that is a failure too.
-    sys.exit(0 if monitor.kicked and not killed else 1)
+    sys.exit(0 if monitor.judge.kicked and not killed else 1)
 
 
 if __name__ == '__main__':

@@ -20,7 +20,7 @@ TIERS = {
               'test_world_fuzz', 'test_kc', 'test_camera_model', 'test_gaze', 'test_class_report',
               'test_pose_controller', 'test_floor_map', 'test_scene_markers', 'test_touch',
               'test_pictures', 'test_gui_scene', 'test_eye_pipeline', 'test_held_command',
-              'test_kick_judge', 'test_sandbox_args', 'test_param_overrides',
+              'test_judge', 'test_sandbox_args', 'test_param_overrides',
               'test_speaker', 'test_contract', 'test_rotations')),
     'ros': ('nodes in-process on executors of their own, a process or two beside them',
             ('test_clients', 'test_controller_node', 'test_fuzz_params', 'test_fuzz_topics',

@@ -3,9 +3,10 @@ world reset between episodes that runs as a fresh simulator's would."""
 import pytest
 
 from miro_ball.grading.host import observe, place
-from miro_ball.grading.kick_judge import KickJudge
 from miro_ball.miro.interface import CLOCK, default_robot_name, RobotTopics, SENSOR
-from rostools import Probe, drain
+from miro_ball.run.judge import Judge
+from miro_ball.run.monitor import Monitor, unmatched
+from rostools import drain, Probe, spin_until
 
 NAME = default_robot_name()
 ROBOT, BALL = (0.0, 0.0, 0.0), (0.5, 0.02)  # the ball straight ahead, a little off-centre
@@ -37,26 +38,52 @@ def test_the_unprivileged_simulator_offers_miros_interface_only(make_sim, ros_co
     assert CLOCK in published and RobotTopics(NAME).odom in published
 
 
-def episode(node, steps=1500):
-    """Drive straight at the ball for ``steps`` physics steps; what the judge saw and where
-    the ball ended."""
+def verdict(judge):
+    return (judge.kicked, judge.kick_time, judge.touch_time, judge.kicker, judge.fell,
+            round(judge.distance, 9))
+
+
+def episode(node, steps=1500, started=lambda t: None, each_tick=lambda: None):
+    """Drive straight at the ball for ``steps`` physics steps, judged as the grading host
+    judges; (the judge, where the ball ended). started(t) when judging starts, each_tick()
+    after each platform tick."""
     sim = node.sim
     node.reset()
     place(sim, NAME, ROBOT, BALL)
-    judge = KickJudge()
-    judge.start(sim.time)
+    judge = Judge(sim.time)
+    started(sim.time)
     node.step_observers[:] = [lambda world: observe(judge, world, NAME)]
     for _ in range(steps // sim.ticks_per_platform_tick):
         sim.robots[NAME].set_cmd_vel(0.3, 0.0)
         node.advance(sim.ticks_per_platform_tick)
-    return (judge.kicked, judge.kick_time, judge.touch_time, round(judge.distance, 9),
-            tuple(round(v, 9) for v in sim.ball_position()))
+        each_tick()
+    return judge, tuple(round(v, 9) for v in sim.ball_position())
 
 
 def test_a_reset_simulator_runs_an_episode_as_a_fresh_one(make_sim):
-    fresh = episode(make_sim(privileged=False))
+    judge, ball = episode(make_sim(privileged=False))
+    fresh = verdict(judge), ball
     reused = make_sim(privileged=False)
     episode(reused, steps=123)  # an episode before: the next one must not know of it
-    assert episode(reused) == fresh
-    kicked, kick_time, touch_time, *_ = fresh
-    assert kicked and 0 < touch_time < kick_time
+    judge, ball = episode(reused)
+    assert (verdict(judge), ball) == fresh
+    assert judge.kicked and 0 < judge.touch_time < judge.kick_time
+
+
+def test_the_grader_and_the_demo_judge_an_episode_alike(make_sim, ros_context, executor):
+    """The host's judge fed in-process and a Monitor's fed the simulator's ground truth
+    topics (as the demo, the scenario bench and the closed-loop tests are) say the same."""
+    node = make_sim()
+    probe = Probe(ros_context, executor)
+    monitor = Monitor(probe.node, [NAME], debug_frames=False)
+    spin_until(executor, lambda: not unmatched(monitor.truth) and
+               node.sim_interface.pub_touches.get_subscription_count())
+
+    def deliver():
+        spin_until(executor, lambda: monitor.caught_up(node.sim.time))
+        drain(executor)  # the tick's touch, published before its ball and its robot
+
+    grader, _ = episode(node, started=monitor.restart, each_tick=deliver)
+    demo = monitor.judge
+    assert grader.kicked and grader.kicker == NAME
+    assert verdict(demo) == pytest.approx(verdict(grader), abs=1e-9)

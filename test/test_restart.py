@@ -60,11 +60,12 @@ def watch_until_kicked(executor, probe, what):
     drain(executor)  # what a previous run left queued is not this run's
     monitor = Monitor(probe.node, [ROBOT])
     commands = probe.watch(TwistStamped, TOPICS.cmd_vel)
-    assert spin_until(executor, lambda: monitor.kicked or (
+    assert spin_until(executor, lambda: monitor.judge.kicked or (
         commands and monitor.sim_time > seconds(commands[0].header.stamp) + KICK_WITHIN_S),
         HANG_GUARD_S), \
         f'{what}: hung (simulated time {monitor.sim_time:.1f} s, {len(commands)} commands)'
-    assert monitor.kicked, f'{what}: not kicked {KICK_WITHIN_S} s after the first command'
+    assert monitor.judge.kicked, \
+        f'{what}: not kicked {KICK_WITHIN_S} s after the first command'
     return monitor
 
 
@@ -121,7 +122,7 @@ def test_wheels_stop_after_the_command_timeout_when_the_controller_is_killed(
     assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True)).success
     controller.kill()
     controller.wait()
-    assert not monitor.kicked, 'kicked before it was killed: nothing left to test'
+    assert not monitor.judge.kicked, 'kicked before it was killed: nothing left to test'
     stepped = probe.call(executor, Trigger, SIM.step, Trigger.Request())
     paused_at = float(re.search(r'time ([0-9.]+) s', stepped.message).group(1)) - TICK_S
     assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=False)).success

@@ -139,7 +139,10 @@ def test_drive_moves_it_until_stop(sim):
         miro.stop()
         miro.sleep(0.3)
         x, y, _ = miro.pose
-        assert x == pytest.approx(0.3, abs=0.05) and abs(y) < 0.02
+        # 0.3 m at 0.2 m/s for 1.5 s; a drive that lapsed with MiRo's timeout would end near
+        # 0.1 m. Above: the stop reaches a simulator running in real time as late as this
+        # thread is kept from a core (0.35 m beside other test files).
+        assert 0.25 <= x <= 0.45 and abs(y) < 0.02, (x, y)
         assert (x, y) == pytest.approx(sim.robot().pose()[:2], abs=0.01)
         miro.sleep(0.5)
         assert miro.pose.x == pytest.approx(x, abs=0.005)  # stopped

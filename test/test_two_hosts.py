@@ -173,18 +173,19 @@ def observe(limit_s):
         SetBool.Request(data=False))
     while resumed and not resumed.done() and waiting():
         pass
-    while not monitor.kicked and monitor.sim_time < limit_s and waiting():
+    while not monitor.judge.kicked and monitor.sim_time < limit_s and waiting():
         pass
     frames = sum(w.frames for w in monitor.robots.values())
-    if monitor.kicked:
-        print(f'{KICKED} {monitor.kick_time:.1f} s simulated; {frames} controller frames seen',
+    if monitor.judge.kicked:
+        print(f'{KICKED} {monitor.judge.kick_time:.1f} s simulated; {frames} controller '
+              'frames seen',
               flush=True)
     else:
         print(f'observer: not kicked (simulated time {monitor.sim_time:.1f} s, {frames} '
               'controller frames seen)', flush=True)
     node.destroy_node()
     rclpy.try_shutdown(context=context)
-    return 0 if monitor.kicked else 1
+    return 0 if monitor.judge.kicked else 1
 
 
 if __name__ == '__main__' and sys.argv[1:2] == ['--observe']:

@@ -8,10 +8,10 @@ a fresh simulator (test_grade_host).
 
 The simulator is unprivileged (SimNode(privileged=False)): on the ROS graph it is MiRo's
 interface and /clock, nothing else. The host places robot and ball, runs and pauses the
-clock and judges the episode in-process, after every physics step, from the world
-itself (KickJudge). The command under test runs in its sandbox (sandbox.py) beside it
-and is watched on the graph (watch.py): a breach of MiRo's interface ends the episode
-as cheated.
+clock and has the episode judged in-process, after every physics step, from the world
+itself (by the one judge, run/judge.py, fed as the demo's is over ROS). The command under
+test runs in its sandbox (sandbox.py) beside it and is watched on the graph (watch.py): a
+breach of MiRo's interface ends the episode as cheated.
 
 A request: {"episode": {index, command, workdir, robot: [x, y, yaw], ball: [x, y],
 limit_s, grace_s, command_wait_s, out (a folder for command.log and video.mp4), video,
@@ -31,12 +31,11 @@ from pathlib import Path
 
 from miro_ball.grading import dds_profiles, sandbox
 from miro_ball.grading.command import Command
-from miro_ball.grading.kick_judge import KickJudge
 from miro_ball.grading.warm_start import python_args
 from miro_ball.grading.watch import GraphWatch, verdict
 from miro_ball.miro.interface import RobotTopics
 from miro_ball.miro.rotations import yaw_quaternion
-from miro_ball.run.episode import SETTLE_S
+from miro_ball.run.judge import Judge, SETTLE_S
 
 SCRATCH = 'scratch'  # a command's $HOME, in the host's folder: made anew for each command
 WARM_START = 'miro_ball.grading.warm_start'
@@ -63,15 +62,6 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def over(judge, limit_s, settle_s):
-    """Why the episode is over by the world's own account, or None."""
-    if judge.fell:
-        return 'fell'
-    if judge.kicked and judge.elapsed >= min(judge.kick_time + settle_s, limit_s):
-        return 'kicked'
-    return 'limit' if judge.elapsed >= limit_s else None
-
-
 def place(sim, name, robot, ball):
     """Robot ``name`` at robot (x, y, yaw) on its floor, the ball at rest at ball (x, y)."""
     x, y, yaw = robot
@@ -81,13 +71,14 @@ def place(sim, name, robot, ball):
 
 
 def observe(judge, sim, name):
-    """What the world says now, to the judge: after each physics step. The robot's pose,
-    the dearest to read, is read on platform ticks only (50 Hz): enough for the distance
-    driven and a fall, and the simulator's steps go about a fifth faster."""
-    foot = None
+    """What the world says now, to the judge (run/judge.py), after each physics step: what
+    the simulator's ground truth topics say to the demo's, on the same instants (a touch
+    after any step, the ball and the robot on platform ticks)."""
+    if sim.touching(name):
+        judge.touch(name, sim.time, sim.ball_position())
     if sim.step_index % sim.ticks_per_platform_tick == 0:
-        foot = sim.robots[name].ground_truth()[:3]
-    judge.observe(sim.time, sim.ball_position(), foot, sim.touching(name))
+        judge.ball(sim.time, sim.ball_position())
+        judge.robot(name, sim.time, sim.robots[name].ground_truth()[:3])
 
 
 def _key(spec):
@@ -160,7 +151,7 @@ class Host:
     # -- the world, each physics step -----------------------------------------------------
     def _observe(self, sim):
         judge = self.judge
-        if judge is None or not judge.started:
+        if judge is None:
             return
         observe(judge, sim, self.args.robot)
         if self.video is not None and sim.time >= self.next_frame:
@@ -192,7 +183,7 @@ class Host:
         node.reset()
         place(sim, self.args.robot, spec['robot'], spec['ball'])
         node.advance(1)  # the placed world's first readings go out before anyone listens
-        self.judge = judge = KickJudge()
+        self.judge = None  # until the clock starts
         self.video = Video(out / 'video.mp4', []) if spec.get('video') else None
         self.next_frame = sim.time
         result = dict(ended='', cheated=None, exit_code=None, killed=False, commands=0)
@@ -209,7 +200,7 @@ class Host:
             self._spin_until(lambda: command.exited() is not None
                              or counted.get_publisher_count() > 0, spec['command_wait_s'])
             lap('command start')
-            judge.start(sim.time)
+            self.judge = judge = Judge(sim.time)
             node.pause(False)
             self._prepare(spec.get('next'))
             result['ended'] = self._run_clock(spec, command)
@@ -289,7 +280,7 @@ class Host:
         next_watch = time.monotonic() + WATCH_EVERY_S
         while True:
             self.executor.spin_once(timeout_sec=SPIN_S)
-            ended = over(self.judge, limit_s, settle_s)
+            ended = self.judge.over(limit_s, settle_s)
             if ended:
                 return ended
             if command.exited() is not None:

@@ -260,6 +260,13 @@ class SimTopics:
         return self.topic(f'objects/{name}')
 
     @property
+    def touches(self):
+        """geometry_msgs/PointStamped: a robot (header.frame_id) touches the ball (point:
+        where the ball was), at the first contact of each platform tick it touched in;
+        looked for only while someone subscribes."""
+        return self.topic('touches')
+
+    @property
     def set_pose(self):
         """geometry_msgs/PoseStamped in: move the object or robot named in header.frame_id."""
         return self.topic('set_pose')

@@ -1,12 +1,12 @@
 """One episode of our controllers, the one way the scenario benchmark and the closed-loop
-tests run one (the grader, which runs any program, has its own: miro_ball/grading/host.py).
+tests run one (the grader, which runs any program, has its own rig, miro_ball/grading/host.py, and the
+same judge).
 
 An episode: the nodes come up with the simulator paused; robot and ball are put at
 the placement (or stay at the world's start); the clock starts once the controllers
-are there, so a slow start costs no simulated time; the episode ends SETTLE_S after
-the ball has moved KICK_DISTANCE_M (a fall in that time still counts), when a robot
-fell, when the limit of simulated time passed, or early (a node exited, Ctrl+C).
-It is judged on the simulator's ground truth by the rig's referee (Monitor).
+are there, so a slow start costs no simulated time; it ends when the one judge
+(run/judge.py, fed the simulator's ground truth by the rig's referee) says it is over, or
+early (a node exited, Ctrl+C).
 
 The rig says where the nodes run: SteppedRig (stepped_rig.py), the simulator and our
 controllers in this process on one executor, stepped one platform tick at a time, each
@@ -21,9 +21,9 @@ not go on.
 import time
 from dataclasses import dataclass
 
+from miro_ball.run.judge import SETTLE_S
 from miro_ball.run.referee import RunError
 
-SETTLE_S = 1.0  # simulated s an episode goes on after the kick
 PROGRESS_EVERY_S = 10.0  # wall
 
 
@@ -79,26 +79,13 @@ def run_episode(rig, placement=None, index=1, limit_s=60.0, settle_s=SETTLE_S,
     return result
 
 
-def over(referee, limit_s, settle_s=SETTLE_S):
-    """Why a run watched by referee is over, or None: 'fell' (a robot), 'kicked' (settle_s
-    after the kick, or at the limit), 'limit' (limit_s simulated s after the start)."""
-    monitor = referee.monitor
-    elapsed = referee.elapsed
-    if any(watch.fell for watch in monitor.robots.values()):
-        return 'fell'
-    if monitor.kicked and (elapsed >= monitor.kick_time - referee.start_time + settle_s
-                           or elapsed >= limit_s):
-        return 'kicked'
-    return 'limit' if elapsed >= limit_s else None
-
-
 def _run(rig, limit_s, settle_s, progress):
     """Advance until the episode ends; returns why."""
     referee = rig.referee
     next_progress = time.monotonic() + PROGRESS_EVERY_S
     while True:
         rig.advance()
-        ended = over(referee, limit_s, settle_s)
+        ended = referee.judge.over(limit_s, settle_s)
         if ended:
             return ended
         early = rig.ended_early()
@@ -110,10 +97,10 @@ def _run(rig, limit_s, settle_s, progress):
 
 
 def _judge(result, referee):
-    monitor = referee.monitor
-    result.kicked = monitor.kicked
-    if monitor.kicked:
-        result.time_to_kick = round(monitor.kick_time - referee.start_time, 3)
-    result.fell = any(watch.fell for watch in monitor.robots.values())
-    result.distance_m = round(sum(watch.distance for watch in monitor.robots.values()), 3)
-    result.sim_time = round(referee.elapsed, 3)
+    judge = referee.judge
+    result.kicked = judge.kicked
+    if judge.kicked:
+        result.time_to_kick = round(judge.kick_time, 3)
+    result.fell = judge.fell
+    result.distance_m = round(judge.distance, 3)
+    result.sim_time = round(judge.elapsed, 3)

@@ -1,18 +1,17 @@
 """An observer of a run over ROS: simulated time, the ball, the robots, the controllers.
 
-It only subscribes (to /clock, the simulator's ground truth and the controllers'
-annotated frames), so it can watch any run: the demo's, a grader's, a user's.
-Times are simulated seconds, the kick's from the stamp of the ball reading that
-showed it. Image callbacks are optional; they get each frame decoded to BGR.
+It only subscribes (to /clock, the simulator's ground truth, its touches and the
+controllers' annotated frames), so it can watch any run: the demo's, a user's. What
+happened is the one judge's to say (run/judge.py): Monitor.judge. Image callbacks are
+optional; they get each frame decoded to BGR.
 """
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.stamps import seconds
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.names import debug_topic
-from miro_ball.miro.constants import WHEEL_RADIUS_M
 from miro_ball.miro.interface import CLOCK, CLOCK_QOS, EYE_QOS, EYES, SimTopics
-from miro_ball.run.judge import FELL_BELOW_M, KICK_DISTANCE_M, ball_moved
+from miro_ball.run.judge import Judge
 
 TRUTH_DEPTH = 10  # the simulator's ground truth topics keep ROS's default depth
 
@@ -37,20 +36,18 @@ def unmatched(subscriptions):
 
 
 class RobotWatch:
-    """What the monitor knows about one robot."""
+    """What the monitor saw of one robot (its judging is the judge's)."""
 
     def __init__(self):
         self.frames = 0  # annotated frames its controller published
-        self.start_z = None  # floor height when first seen
-        self.start = None  # x, y, z when first seen
-        self.position = None  # x, y, z of the point under its axle
+        self.position = None  # x, y, z of the point under its axle, the latest seen
         self.stamp = None  # simulated s of the latest position
-        self.fell = False
-        self.distance = 0.0  # m driven over the floor since the start
 
 
 class Monitor:
-    """Subscribes on ``node`` for the given robot names.
+    """Subscribes on ``node`` for the given robot names and feeds what the simulator says to
+    ``judge`` (run/judge.py), which judges from the first simulated time it hears of, or from
+    restart().
 
     truth, debug, overhead: its subscriptions to the simulator (/clock and the ground
     truth), to the controllers' annotated frames and to the overhead view, for asking
@@ -67,18 +64,18 @@ class Monitor:
         from miro_ball.common.qos import profile
 
         self.sim_time = 0.0
-        self.ball_start = None
-        self.ball = None
+        self.ball = None  # x, y of the latest seen
         self.ball_stamp = None
-        self.kick_time = None
-        self.kicker = None  # the robot nearest the ball when it was kicked
+        self.judge = Judge()
         self.robots = {name: RobotWatch() for name in robots}
         sim = SimTopics()
         # The node is on sim time: a negative /clock from anyone must not end it.
         guard_clock(node, Throttled(node.get_logger().warning))
         self.truth = [
             node.create_subscription(Clock, CLOCK, self._on_clock, profile(CLOCK_QOS)),
-            node.create_subscription(PointStamped, sim.ball, self._on_ball, TRUTH_DEPTH)]
+            node.create_subscription(PointStamped, sim.ball, self._on_ball, TRUTH_DEPTH),
+            node.create_subscription(PointStamped, sim.touches, self._on_touch,
+                                     TRUTH_DEPTH * len(robots))]
         self.truth += [node.create_subscription(PoseStamped, sim.object_pose(name),
                                                 lambda msg, n=name: self._on_robot(n, msg),
                                                 TRUTH_DEPTH)
@@ -94,21 +91,9 @@ class Monitor:
             CompressedImage, sim.overhead, lambda msg: self._on_overhead(msg, on_overhead),
             OVERHEAD_QUEUE)
 
-    def restart(self):
-        """Judge from here on: the ball's and the robots' next positions are the start."""
-        self.ball_start = self.ball = self.kick_time = self.kicker = None
-        for watch in self.robots.values():
-            watch.start_z = watch.start = None
-            watch.fell, watch.distance = False, 0.0
-
-    @property
-    def kicked(self):
-        return self.kick_time is not None
-
-    @property
-    def moved(self):
-        """How far the ball is from where it was first seen (m)."""
-        return 0.0 if self.ball is None else ball_moved(self.ball_start, self.ball)
+    def restart(self, t=None):
+        """Judge from simulated time t (s) on; None: from the latest /clock."""
+        self.judge.start(self.sim_time if t is None else t)
 
     @property
     def frames(self):
@@ -123,31 +108,24 @@ class Monitor:
 
     def _on_clock(self, msg):
         self.sim_time = seconds(msg.clock)
+        self.judge.clock(self.sim_time)
 
     def _on_ball(self, msg):
         self.ball = (msg.point.x, msg.point.y)
         self.ball_stamp = seconds(msg.header.stamp)
-        self.ball_start = self.ball_start or self.ball
-        if not self.kicked and self.moved >= KICK_DISTANCE_M:
-            self.kick_time = self.ball_stamp
-            self.kicker = self._nearest_robot(self.ball)
+        self.judge.ball(self.ball_stamp, self.ball)
 
-    def _nearest_robot(self, point):
-        placed = [(ball_moved(point, w.position), name)
-                  for name, w in self.robots.items() if w.position is not None]
-        return min(placed)[1] if placed else None
+    def _on_touch(self, msg):
+        if msg.header.frame_id in self.robots:
+            self.judge.touch(msg.header.frame_id, seconds(msg.header.stamp),
+                             (msg.point.x, msg.point.y))
 
     def _on_robot(self, name, msg):
         watch = self.robots[name]
         p = msg.pose.position
-        if watch.position is not None and watch.start_z is not None:
-            watch.distance += ball_moved(watch.position, (p.x, p.y))
         watch.position = (p.x, p.y, p.z)
         watch.stamp = seconds(msg.header.stamp)
-        if watch.start_z is None:
-            watch.start_z, watch.start = p.z, watch.position
-        # The pose is of the point under the axle: the axle is WHEEL_RADIUS_M above it.
-        watch.fell = watch.fell or p.z + WHEEL_RADIUS_M - watch.start_z < FELL_BELOW_M
+        self.judge.robot(name, watch.stamp, watch.position)
 
     def _on_debug(self, name, index, side, msg, on_eye):
         self.robots[name].frames += 1

@@ -80,13 +80,17 @@ class Referee:
         self.start_time = None  # simulated s when the clock was started
 
     @property
+    def judge(self):
+        """The run's judge (run/judge.py), judging from the clock's start."""
+        return self.monitor.judge
+
+    @property
     def elapsed(self):
         """Simulated seconds since the clock was started."""
-        start = self.start_time or 0.0
-        return max(0.0, self.monitor.sim_time - start)
+        return self.judge.elapsed
 
     def _on_overhead(self, bgr, stamp):
-        note = 'KICKED' if self.monitor.kicked else self.video_note
+        note = 'KICKED' if self.judge.kicked else self.video_note
         self.video.overhead(bgr, stamp - (self.start_time or 0.0), note)
 
     def spin_once(self, timeout_s):

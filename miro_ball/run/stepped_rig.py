@@ -85,7 +85,7 @@ class SteppedRig:
                                          'each other')
 
     def start(self):
-        self.referee.monitor.restart()
+        self.referee.monitor.restart(self.sim.time)
         self.referee.start_time = self.sim.time
 
     def frames_seen(self):

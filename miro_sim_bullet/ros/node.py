@@ -174,6 +174,8 @@ class SimNode(Node):
         """The world back to its initial state, time and schedule from zero."""
         self._publish_eyes(wait=True)  # the instants before the reset come first
         self.sim.reset()
+        if self.sim_interface is not None:
+            self.sim_interface.forget_touches()
         self._restart_schedule()
         self.get_logger().info('world reset')
 
@@ -250,6 +252,8 @@ class SimNode(Node):
             started = clock()
             sim.step()
             spent['physics'] += clock() - started
+            if self.sim_interface is not None:
+                self.sim_interface.look_for_touches()
             for observe in self.step_observers:
                 observe(sim)
             # Images of an instant go out before its /clock when drawn here, so a controller

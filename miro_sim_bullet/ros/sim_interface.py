@@ -35,6 +35,9 @@ class SimInterface:
         self.overhead = overhead_camera(world.description)
         t = SimTopics()
         self.pub_ball = ros.publisher(PointStamped, t.ball, 10)
+        # A robot's every touch of a tick would be 10 messages; its first is what counts.
+        self.pub_touches = ros.publisher(PointStamped, t.touches, 10 * len(world.robots))
+        self._touches = {}  # robot name -> (simulated s, ball x, y, z) of this tick's first
         self.pub_objects = {name: ros.publisher(PoseStamped, t.object_pose(name), 10)
                             for name in (*world.objects, *world.robots)}
         self.pub_overhead = ros.publisher(CompressedImage, t.overhead, 2)
@@ -72,9 +75,29 @@ class SimInterface:
         return response
 
     # -- publishing ---------------------------------------------------------------------------
-    def publish_ground_truth(self, when):
-        """Every movable object's and robot's pose, and the ball's centre, stamped when."""
+    def look_for_touches(self):
+        """After each physics step: which robots touch the ball (only while the touches are
+        listened to: a contact query per robot and step)."""
         world = self.world
+        if world.ball_id is None or not self.pub_touches.get_subscription_count():
+            return
+        for name in world.robots:
+            if name not in self._touches and world.touching(name):
+                self._touches[name] = (world.time, world.ball_position())
+
+    def forget_touches(self):
+        """The world was reset: the touches before it are not of the new one."""
+        self._touches.clear()
+
+    def publish_ground_truth(self, when):
+        """Every movable object's and robot's pose, and the ball's centre, stamped when;
+        first the touches of the tick that ends now."""
+        world = self.world
+        for name, (t, ball) in self._touches.items():
+            msg = convert.point(ball, convert.stamp(t))
+            msg.header.frame_id = name
+            self.pub_touches.publish(msg)
+        self._touches.clear()
         for name, (position, orientation) in world.object_poses().items():
             send_if_listened(self.pub_objects[name],
                              lambda: convert.pose(position, orientation, when))
