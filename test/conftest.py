@@ -21,7 +21,7 @@ TIERS = {
               'test_pose_controller', 'test_floor_map', 'test_scene_markers', 'test_touch',
               'test_pictures', 'test_gui_scene', 'test_eye_pipeline', 'test_held_command',
               'test_judge', 'test_sandbox_args', 'test_param_overrides',
-              'test_speaker', 'test_contract', 'test_rotations')),
+              'test_speaker', 'test_contract', 'test_rotations', 'test_checks')),
     'ros': ('nodes in-process on executors of their own, a process or two beside them',
             ('test_clients', 'test_controller_node', 'test_fuzz_params', 'test_fuzz_topics',
              'test_gui_bridge', 'test_multi_robot', 'test_sim_executor', 'test_sim_node',

@@ -32,6 +32,7 @@ from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import CameraInfo, CompressedImage, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32MultiArray
 
+from miro_ball.common.checks import finite
 from miro_ball.common.cli import user_args
 from miro_ball.common import params
 from miro_ball.common.clock_guard import guard_clock
@@ -54,7 +55,7 @@ from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES
 from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
                                       robot_namespace, robot_of_namespace, RobotTopics,
                                       SENSOR, TOPIC, TOUCH_PARTS)
-from miro_ball.miro.kinematics import clamp_wheel_speeds, finite, wheel_speed2cmd_vel
+from miro_ball.miro.kinematics import clamp_wheel_speeds, wheel_speed2cmd_vel
 
 SIDES = ('left', 'right')  # of EYES, in order
 STARTUP = 'startup'

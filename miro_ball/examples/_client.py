@@ -20,6 +20,7 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
+from miro_ball.common.checks import finite_values
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.messages import drive_command
@@ -29,6 +30,7 @@ from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
+from miro_ball.miro.constants import JOINT_POSITIONS
 from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
                                       robot_name, robot_namespace, robot_of_namespace,
                                       RobotTopics, SENSOR_QOS)
@@ -120,12 +122,11 @@ class Client(Node):
     def checked_joints(self, msg):
         """sensors/kinematic_joints' (tilt, lift, yaw, pitch), or None (with a warning)
         when the message does not hold four finite positions."""
-        joints = tuple(msg.position)
-        if len(joints) != 4 or not all(math.isfinite(j) for j in joints):
-            self.warn('joints', f'{self.topics.kinematic_joints} ignored: need 4 finite '
-                      f'positions [tilt, lift, yaw, pitch], got {list(joints)[:8]}')
+        try:
+            return finite_values(msg.position, 4, JOINT_POSITIONS)
+        except ValueError as err:
+            self.warn('joints', f'{self.topics.kinematic_joints} ignored: {err}')
             return None
-        return joints
 
     def advertise(self, msg_type, topic, qos=CONTROL_QOS):
         return self.create_publisher(msg_type, topic, profile(qos))

@@ -13,6 +13,8 @@ PLATFORM_TICK_S = 0.02  # 50 Hz sensor and control tick
 
 # Kinematic chain (section 1.4); index order of every kinematic_joints message.
 JOINT_NAMES = ('tilt', 'lift', 'yaw', 'pitch')
+# What a reader of a JointState of the neck wants, in words.
+JOINT_POSITIONS = f'positions [{", ".join(JOINT_NAMES)}]'
 # The simulated MiRo's links, as the scene draws them: the body (the base, at the wheel
 # axle), then each link; then the eyes' optical frames (REP 103: z along the optical axis,
 # x right, y down). /miro_sim/links/<robot> gives their world poses in this order, and a

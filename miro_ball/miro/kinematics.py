@@ -26,9 +26,3 @@ def wrap(angle):
     return math.atan2(math.sin(angle), math.cos(angle))
 
 
-def finite(*values):
-    """True when every value is a finite real number."""
-    try:
-        return all(math.isfinite(v) for v in values)
-    except TypeError:
-        return False

@@ -13,8 +13,10 @@ from geometry_msgs.msg import Pose2D
 from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt16
 
+from miro_ball.common.checks import finite_values
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.miro.camera_model import CameraModel
+from miro_ball.miro.constants import JOINT_POSITIONS
 from miro_ball.miro.interface import EYE_QOS, EYES, RobotTopics, SENSOR_QOS
 
 
@@ -46,13 +48,6 @@ class Sensors:
     battery: Optional[float] = None
 
 
-def _finite(values, count, what):
-    values = tuple(float(v) for v in values)
-    if len(values) != count or not all(math.isfinite(v) for v in values):
-        raise ValueError(f'need {count} finite {what}, got {list(values)[:8]}')
-    return values
-
-
 def _sonar(msg):
     distance = float(msg.range)
     if math.isnan(distance) or distance < 0:
@@ -64,16 +59,16 @@ def _sonar(msg):
 _T = RobotTopics()  # relative names: the node lives in the robot's namespace
 READINGS = {
     'pose': (Pose2D, _T.body_pose, SENSOR_QOS,
-             lambda m: Pose(*_finite((m.x, m.y, m.theta), 3, 'x, y, theta'))),
+             lambda m: Pose(*finite_values((m.x, m.y, m.theta), 3, 'x, y, theta'))),
     'joints': (JointState, _T.kinematic_joints, SENSOR_QOS,
-               lambda m: _finite(m.position, 4, 'positions [tilt, lift, yaw, pitch]')),
-    'cliff': (Float32MultiArray, _T.cliff, SENSOR_QOS, lambda m: _finite(m.data, 2, 'values')),
+               lambda m: finite_values(m.position, 4, JOINT_POSITIONS)),
+    'cliff': (Float32MultiArray, _T.cliff, SENSOR_QOS, lambda m: finite_values(m.data, 2, 'values')),
     'sonar': (Range, _T.sonar, SENSOR_QOS, _sonar),
-    'light': (Float32MultiArray, _T.light, SENSOR_QOS, lambda m: _finite(m.data, 4, 'values')),
+    'light': (Float32MultiArray, _T.light, SENSOR_QOS, lambda m: finite_values(m.data, 4, 'values')),
     'touch_head': (UInt16, _T.touch('head'), SENSOR_QOS, lambda m: int(m.data)),
     'touch_body': (UInt16, _T.touch('body'), SENSOR_QOS, lambda m: int(m.data)),
     'battery': (BatteryState, _T.battery, SENSOR_QOS,
-                lambda m: _finite((m.voltage,), 1, 'voltage')[0]),
+                lambda m: finite_values((m.voltage,), 1, 'voltage')[0]),
 }
 
 

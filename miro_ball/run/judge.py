@@ -21,6 +21,7 @@ import collections
 import math
 from dataclasses import dataclass
 
+from miro_ball.common.checks import finite
 from miro_ball.miro.constants import WHEEL_RADIUS_M
 
 KICK_DISTANCE_M = 0.3  # the ball has moved this far from where it was first touched
@@ -34,10 +35,6 @@ BALL_HISTORY = 50
 def ball_moved(start, now):
     """Horizontal distance (m) between two positions (x, y[, z])."""
     return math.dist(start[:2], now[:2])
-
-
-def _finite(*values):
-    return all(math.isfinite(v) for v in values)
 
 
 @dataclass
@@ -74,7 +71,7 @@ class Judge:
 
     def ball(self, t, position):
         t, position = float(t), tuple(float(v) for v in position[:2])
-        if not _finite(t, *position) or t < self.start_time:
+        if not finite(t, *position) or t < self.start_time:
             return
         self.clock(t)
         self.ball_position, self.ball_time = position, t
@@ -84,7 +81,7 @@ class Judge:
 
     def robot(self, name, t, foot):
         t, foot = float(t), tuple(float(v) for v in foot[:3])
-        if not _finite(t, *foot) or t < self.start_time:
+        if not finite(t, *foot) or t < self.start_time:
             return
         self.clock(t)
         track = self.robots.setdefault(name, RobotTrack())
@@ -99,7 +96,7 @@ class Judge:
     def touch(self, name, t, ball):
         t, ball = float(t), tuple(float(v) for v in ball[:2])
         # A touch at the start's own instant happened before it (the step that ended there).
-        if not _finite(t, *ball) or t <= self.start_time or self.touched_at is not None:
+        if not finite(t, *ball) or t <= self.start_time or self.touched_at is not None:
             return
         self.clock(t)
         self.touched_at, self.touch_time, self.kicker = ball, t - self.start_time, name

@@ -10,13 +10,13 @@ import math
 
 from std_msgs.msg import UInt16
 
+from miro_ball.common.checks import finite, finite_values
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
-from miro_ball.miro.constants import JOINT_NAMES
+from miro_ball.miro.constants import JOINT_NAMES, JOINT_POSITIONS
 from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id,
                                       ROBOT_INTERFACE, RobotTopics, SimTopics, TOPIC,
                                       TOUCH_PARTS)
-from miro_ball.miro.kinematics import finite
 from miro_ball.miro.touch import ALL_PADS
 from miro_sim_bullet.render.eye_images import EyeWants
 from miro_sim_bullet.ros import convert
@@ -92,10 +92,10 @@ class RobotInterface:
                        f'{angular:g} rad/s) asks more than 0.4 m/s of a wheel: clamped')
 
     def _on_kinematic(self, msg):
-        positions = list(msg.position)
-        if len(positions) != 4 or not finite(*positions):
-            self._warn('kin', f'{self.topics.kinematic_targets} ignored: need 4 finite '
-                       f'positions [tilt, lift, yaw, pitch], got {positions[:8]}')
+        try:
+            positions = finite_values(msg.position, 4, JOINT_POSITIONS)
+        except ValueError as err:
+            self._warn('kin', f'{self.topics.kinematic_targets} ignored: {err}')
             return
         applied = self.robot.set_kinematic_targets(positions)
         if any(abs(a - b) > 1e-9 for a, b in zip(applied[1:], positions[1:])):
@@ -104,10 +104,10 @@ class RobotInterface:
                                               zip(JOINT_NAMES[1:], applied[1:])))
 
     def _on_cosmetic(self, msg):
-        values = list(msg.data)
-        if len(values) != 6 or not finite(*values):
-            self._warn('cos', f'{self.topics.cosmetic_joints} ignored: need 6 finite values, '
-                       f'got {values[:8]}')
+        try:
+            values = finite_values(msg.data, 6, 'values')
+        except ValueError as err:
+            self._warn('cos', f'{self.topics.cosmetic_joints} ignored: {err}')
             return
         if any(not 0.0 <= v <= 1.0 for v in values):
             self._warn('cos_clamp', f'{self.topics.cosmetic_joints} clamped to 0..1')
