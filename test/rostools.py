@@ -35,7 +35,9 @@ def _source(predicate):
 
 
 def drain(executor, rounds=50):
-    """Deliver what is already queued (no waiting beyond a few empty spins)."""
+    """Deliver what is already queued (no waiting beyond a few empty spins), between the
+    ticks of a world a test steps. It says nothing of what arrived: a test that relies on a
+    message's arrival waits for it with spin_until."""
     for _ in range(rounds):
         executor.spin_once(timeout_sec=0)
 

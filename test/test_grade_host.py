@@ -12,9 +12,14 @@ NAME = default_robot_name()
 ROBOT, BALL = (0.0, 0.0, 0.0), (0.5, 0.02)  # the ball straight ahead, a little off-centre
 
 
-def graph(probe, executor):
-    drain(executor, rounds=100)
+def graph(probe, executor, privileged):
+    """(services, topics the simulator publishes) once what both kinds offer is seen."""
     node = probe.node
+    spin_until(executor, lambda: all(node.get_publishers_info_by_topic(topic) for topic in
+                                     (CLOCK, RobotTopics(NAME).odom)))
+    if privileged:
+        spin_until(executor, lambda: node.get_service_names_and_types_by_node(
+            'miro_sim', '/'), what="the simulator's services")
     services = {name for name, _ in node.get_service_names_and_types()}
     published = {topic for topic, _ in node.get_topic_names_and_types()
                  if any(info.node_name == 'miro_sim'
@@ -27,7 +32,7 @@ def test_the_unprivileged_simulator_offers_miros_interface_only(make_sim, ros_co
                                                                 executor, privileged):
     make_sim(privileged=privileged)
     probe = Probe(ros_context, executor)
-    services, published = graph(probe, executor)
+    services, published = graph(probe, executor, privileged)
     sim_services = {s for s in services if s.startswith('/miro_sim/')}
     if privileged:  # the simulator of the lab: its services and ground truth
         assert '/miro_sim/reset' in sim_services and '/miro_sim/set_parameters' in services

@@ -5,6 +5,11 @@ The world is stepped here, one platform tick (20 ms) at a time, and the executor
 runs until every robot has taken this tick's command and the referee has this
 tick's ground truth, so outcomes depend on simulated time, not on how fast the
 machine is. Used by the closed-loop tests and the scenario benchmark.
+
+The rig builds its nodes in this process and reads their own counters (the simulator's
+robots' last command time, the controllers' frames and publishers): the ROS graph has no
+message that says "every controller has taken tick t", and waiting on the wall clock for it
+would make outcomes depend on the machine's load.
 """
 import time
 
