@@ -1,5 +1,6 @@
 """The GUI's ROS node in-process, without a browser: what it publishes and subscribes to,
 for which page, and its deadman."""
+import dataclasses
 import json
 import math
 import time
@@ -15,7 +16,8 @@ from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, UI
 from visualization_msgs.msg import Marker, MarkerArray
 
 from miro_ball.gui import protocol as p
-from miro_ball.gui.bridge import DEADMAN_S, GuiBridge, NODE_NAME
+from miro_ball.gui.bridge import GuiBridge, handled_commands
+from miro_ball.gui.robot_part import DEADMAN_S, NODE_NAME
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import (DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, LINK_FRAMES,
                                       PLATFORM_TICK_S)
@@ -51,6 +53,14 @@ def bridge(ros_context, executor, events):
     yield node
     executor.remove_node(node)
     node.destroy_node()
+
+
+def test_every_command_a_page_can_send_has_a_handler():
+    made = {cls for cls in vars(p).values()
+            if dataclasses.is_dataclass(cls) and cls.__module__ == p.__name__}
+    # The web server answers an acknowledgement itself; everything else reaches the bridge.
+    assert made - {p.Ack} <= handled_commands()
+    assert p.Drive in made and p.Touch in made  # the protocol's commands were found
 
 
 def opened(bridge, executor, owner=1):
@@ -252,7 +262,7 @@ def test_the_real_time_factor_is_set_on_the_simulator_and_read_back(
     sim.node.create_service(SetParameters, SIM.topic('set_parameters'), set_parameters)
     sim.node.create_service(GetParameters, SIM.topic('get_parameters'), get_parameters)
     assert spin_until(executor, lambda: json.loads(bridge.state(1))['rtf_set'] == 1.0)
-    assert spin_until(executor, lambda: bridge.sim_clients['set_parameters'].service_is_ready())
+    assert spin_until(executor, lambda: bridge.sim.clients['set_parameters'].service_is_ready())
     bridge.submit(p.SetRtf(0.0), owner=1)
     assert spin_until(executor, lambda: json.loads(bridge.state(1))['rtf_set'] == 0.0)
     assert asked[0].name == 'real_time_factor'

@@ -1,0 +1,71 @@
+"""The images the pages show: newest-only, one slot per robot and channel, kept as the JPEG
+bytes that arrived (checked for size first) and handed to the web server's thread."""
+import threading
+from dataclasses import dataclass
+
+from sensor_msgs.msg import CompressedImage
+
+from miro_ball.common.jpeg import MAX_SIDE, ImageRejected, jpeg_size
+from miro_ball.common.qos import profile
+from miro_ball.common.stamps import seconds
+from miro_ball.gui.protocol import MAX_FRAME_BYTES
+from miro_ball.miro.interface import EYE_QOS
+
+
+@dataclass(frozen=True)
+class Frame:
+    seq: int
+    stamp: float
+    jpeg: bytes
+
+
+def _problem(data):
+    """Why a JPEG is not shown, or None."""
+    if len(data) > MAX_FRAME_BYTES:
+        return f'{len(data)} bytes'
+    try:
+        width, height = jpeg_size(data)
+    except ImageRejected as err:
+        return str(err)
+    if not (0 < width <= MAX_SIDE and 0 < height <= MAX_SIDE):
+        return f'{width}x{height} pixels'
+    return None
+
+
+class FrameStore:
+    """The newest frame of each (robot, channel); robot None for the simulator's own views.
+    warn(key, text): a rate-limited warning; on_frame(channel): a frame has arrived."""
+
+    def __init__(self, warn, on_frame):
+        self.warn = warn
+        self.on_frame = on_frame
+        self._lock = threading.Lock()
+        self._frames = {}
+        self._seq = 0
+
+    def subscribe(self, node, topic, channel, robot=None):
+        """Subscribe on ``node`` to a JPEG topic shown on ``channel`` of ``robot``'s pages."""
+        def on_image(msg):
+            data = bytes(msg.data)
+            problem = _problem(data)
+            if problem:
+                self.warn(f'image:{topic}', f'{topic}: image not shown: {problem}')
+                return
+            stamp = seconds(msg.header.stamp)
+            with self._lock:
+                self._seq += 1
+                self._frames[(robot, channel)] = Frame(self._seq, stamp, data)
+            self.on_frame(channel)
+        return node.create_subscription(CompressedImage, topic, on_image, profile(EYE_QOS))
+
+    def shown_with(self, robot):
+        """{channel: Frame} that a page watching ``robot`` may show (thread-safe)."""
+        with self._lock:
+            return {ch: f for (who, ch), f in self._frames.items() if who in (robot, None)}
+
+    def forget(self, robot, channel=None):
+        """No page shows it any more (every channel of ``robot`` when channel is None): a
+        page that shows it again waits for a new frame."""
+        with self._lock:
+            self._frames = {key: f for key, f in self._frames.items()
+                            if not (key[0] == robot and channel in (None, key[1]))}

@@ -1,0 +1,246 @@
+"""The GUI's robot part: a node in one robot's namespace (``/<robot>/miro_gui``) that reads
+its sensors and eyes while some page watches it, keeps what they last said, and drives it.
+
+A drive command lasts DEADMAN_S unless refreshed: a page that stops talking (closed,
+hidden, frozen, cut off) stops the robot. cmd_vel goes out once per platform tick at most,
+the newest command winning, however fast a page sends.
+"""
+import time
+from dataclasses import dataclass, field
+
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from sensor_msgs.msg import BatteryState, CameraInfo, Imu, JointState, Range
+from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, \
+    UInt32MultiArray
+
+from miro_ball.common.messages import drive_command
+from miro_ball.common.qos import profile
+from miro_ball.controller.names import debug_topic
+from miro_ball.gui import protocol as p
+from miro_ball.gui import readouts as r
+from miro_ball.miro.camera_model import CameraModel
+from miro_ball.miro.constants import JOINT_NAMES
+from miro_ball.miro.interface import CONTROL_QOS, EYE_QOS, EYES, RobotTopics, SENSOR_QOS
+from miro_ball.miro.rotations import yaw_of
+
+NODE_NAME = 'miro_gui'
+DEADMAN_S = 0.3  # a drive command not refreshed for this long becomes a stop
+
+
+@dataclass
+class Drive:
+    linear: float
+    angular: float
+    owner: int
+    refreshed: float  # time.monotonic() of the last command
+
+
+@dataclass
+class Outbox:
+    """What goes to cmd_vel and the simulator's touch inputs, at most once a tick."""
+    drive: Drive = None
+    sent_this_tick: bool = False
+    stop_pending: bool = False
+    touch: dict = field(default_factory=dict)  # part: pads touched since the last tick
+
+
+def _xyz(imu):
+    a = imu.linear_acceleration
+    return (a.x, a.y, a.z)
+
+
+def _odometry(msg):
+    pose, twist = msg.pose.pose, msg.twist.twist
+    o = pose.orientation
+    return {'odom': [twist.linear.x, twist.angular.z],
+            'pose': [pose.position.x, pose.position.y, yaw_of(o.x, o.y, o.z, o.w)]}
+
+
+def _head(msg):
+    return {'head': r.head_degrees(msg.position)} if len(msg.position) >= 4 else None
+
+
+# The readouts: (type, RobotTopics attribute or (method, argument), message -> readouts).
+READOUTS = (
+    (BatteryState, 'battery', lambda m: {'battery': m.voltage}),
+    (Range, 'sonar', lambda m: {'sonar': m.range, 'sonar_text': r.sonar_text(m.range)}),
+    (Float32MultiArray, 'light', lambda m: {'light': r.light(m.data)}),
+    (UInt16, ('touch', 'head'), lambda m: {'touch_head': m.data}),
+    (UInt16, ('touch', 'body'), lambda m: {'touch_body': m.data}),
+    (Imu, ('imu', 'body'), lambda m: {'accel_body': r.accel(_xyz(m))}),
+    (Imu, ('imu', 'head'), lambda m: {'accel_head': r.accel(_xyz(m))}),
+    (Float32MultiArray, 'cliff', lambda m: {'cliff': r.cliff(m.data)}),
+    (Float32MultiArray, 'wheel_speed_opto', lambda m: {'wheel_opto': r.wheels_mm_s(m.data)}),
+    (Float32MultiArray, 'wheel_speed_cmd', lambda m: {'wheel_cmd': r.wheels_mm_s(m.data)}),
+    (Odometry, 'odom', _odometry),
+    (JointState, 'kinematic_joints', _head),
+    (UInt32, 'sensor_flags', lambda m: {'flags': m.data}),
+)
+
+# The page's commands that become one message on one of MiRo's control topics:
+# command type: (message type, RobotTopics attribute, command -> message).
+PUBLISHED = {
+    p.Head: (JointState, 'kinematic_targets',
+             lambda c: JointState(name=list(JOINT_NAMES), position=list(c.positions))),
+    p.Cosmetic: (Float32MultiArray, 'cosmetic_joints',
+                 lambda c: Float32MultiArray(data=list(c.values))),
+    p.Illum: (UInt32MultiArray, 'illum', lambda c: UInt32MultiArray(data=list(c.leds))),
+    p.Tone: (UInt16MultiArray, 'tone', lambda c: UInt16MultiArray(data=list(c.values))),
+    p.Flags: (UInt32, 'control_flags', lambda c: UInt32(data=c.data)),
+}
+
+
+def _topic(topics, where):
+    if isinstance(where, tuple):
+        method, argument = where
+        return getattr(topics, method)(argument)
+    return getattr(topics, where)
+
+
+class RobotPart(Node):
+    """See the module docstring. frames: the FrameStore its eyes go to; warn(key, text): a
+    rate-limited warning; tell_pages(robot, text): a JSON message to the pages watching it."""
+
+    def __init__(self, name, *, context, frames, warn, tell_pages):
+        super().__init__(NODE_NAME, namespace='/' + name, context=context)
+        self.robot = name
+        self.topics = RobotTopics()
+        self.frames = frames
+        self.warn = warn
+        self.tell_pages = tell_pages
+        self.values = {}
+        self.last_heard = None
+        self.fov = None  # [h, v] deg of the eyes, from camera_info (kept when not shown)
+        self.out = Outbox()
+        self._control_pubs = {}
+        self._sensor_subs = []
+        self._image_subs = {}  # channel number: its subscriptions
+
+    # -- what it reads ------------------------------------------------------------------------
+    def watch_sensors(self, on):
+        """Subscribe to the readouts and tones, or drop them all."""
+        if on == bool(self._sensor_subs):
+            return
+        if not on:
+            for sub in self._sensor_subs:
+                self.destroy_subscription(sub)
+            self._sensor_subs = []
+            return
+        self._sensor_subs = [
+            self.create_subscription(msg_type, _topic(self.topics, where), self._wrap(handler),
+                                     profile(SENSOR_QOS))
+            for msg_type, where, handler in READOUTS]
+        # A tone anyone asks MiRo for (this GUI's pages too) is heard in the pages.
+        self._sensor_subs.append(self.create_subscription(
+            UInt16MultiArray, self.topics.tone, self._on_tone, profile(CONTROL_QOS)))
+
+    def show(self, channels):
+        """Subscribe to exactly these image channels (numbers) of the robot."""
+        for channel in set(self._image_subs) - channels:
+            for sub in self._image_subs.pop(channel):
+                self.destroy_subscription(sub)
+            self.frames.forget(self.robot, channel)
+        for channel in channels - set(self._image_subs):
+            name = p.CHANNELS[channel]
+            eye = name.removeprefix('debug_')
+            if name in EYES:
+                # The eye's camera_info too: the simulator renders an eye for anyone who
+                # subscribes to any of its topics, so it is read only while the eye is shown
+                # (its field of view is kept).
+                self._image_subs[channel] = (
+                    self.frames.subscribe(self, self.topics.eye_compressed(eye), channel,
+                                          self.robot),
+                    self.create_subscription(CameraInfo, self.topics.camera_info(eye),
+                                             self._on_camera_info, profile(EYE_QOS)))
+            else:
+                self._image_subs[channel] = (self.frames.subscribe(
+                    self, debug_topic(self.robot, eye), channel, self.robot),)
+
+    def _on_camera_info(self, msg):
+        try:
+            self.fov = r.eye_fov_deg(CameraModel.from_camera_info(msg))
+        except (TypeError, ValueError, ZeroDivisionError, IndexError) as err:
+            self.warn(f'camera_info:{self.robot}',
+                      f'{self.robot}: camera_info not understood: {err}')
+
+    def _on_tone(self, msg):
+        values = list(msg.data)
+        if len(values) != 3:
+            self.warn(f'tone:{self.robot}', f'{self.robot}: a tone of {len(values)} '
+                      'values not played (frequency, volume, ticks)')
+            return
+        self.tell_pages(self.robot, p.tone_message(values))
+
+    def _wrap(self, handler):
+        def on_message(msg):
+            try:
+                values = handler(msg)
+            except (TypeError, ValueError, IndexError) as err:  # garbage from the graph
+                self.warn('sensor', f'a malformed sensor message ignored: {err}')
+                return
+            if values:
+                self.values.update(values)
+                self.last_heard = time.monotonic()
+        return on_message
+
+    # -- what it sends ------------------------------------------------------------------------
+    def publish(self, command):
+        """Send a page's command (one of PUBLISHED) to its control topic."""
+        msg_type, attribute, make = PUBLISHED[type(command)]
+        self._publisher(msg_type, getattr(self.topics, attribute)).publish(make(command))
+
+    def touch(self, part, pads):
+        """Pads of ``part`` a page touched: they go to the simulator at the next tick."""
+        self.out.touch[part] = self.out.touch.get(part, 0) | pads
+
+    def drive(self, linear, angular, owner):
+        if self.out.drive is None:
+            self.get_logger().info(f'driving {self.robot}')
+        self.out.drive = Drive(linear, angular, owner, time.monotonic())
+        self._send_twist(linear, angular)
+
+    def stop(self, why):
+        self.out.drive = None
+        self.out.stop_pending = True  # until a zero has gone out
+        self._send_twist(0.0, 0.0)
+        self.get_logger().info(f'{self.robot} stopped: {why}')
+
+    def let_go(self, owner, why):
+        """Stop if page ``owner`` is the one driving."""
+        if self.out.drive is not None and self.out.drive.owner == owner:
+            self.stop(why)
+
+    def tick(self, now):
+        """Once per platform tick: keep a held drive going until its deadman runs out, send
+        a stop that waited for the tick; returns {part: pads} touched since the last."""
+        out = self.out
+        out.sent_this_tick = False
+        if out.drive is not None:
+            if now - out.drive.refreshed > DEADMAN_S:
+                self.stop(f'no drive command from the page for {DEADMAN_S} s')
+            else:
+                self._send_twist(out.drive.linear, out.drive.angular)
+        elif out.stop_pending:
+            self._send_twist(0.0, 0.0)
+        touched, out.touch = out.touch, {}
+        return touched
+
+    def _send_twist(self, linear, angular):
+        """Publish now if nothing went to cmd_vel this tick, else leave it to the tick
+        (which sends the newest): a flood of commands reaches MiRo at 50 Hz."""
+        out = self.out
+        if out.sent_this_tick:
+            return
+        out.sent_this_tick = True
+        out.stop_pending = False
+        self._publisher(TwistStamped, self.topics.cmd_vel).publish(
+            drive_command(self, self.robot, linear, angular))
+
+    def _publisher(self, msg_type, topic):
+        """The robot's control topic, made on first use."""
+        if topic not in self._control_pubs:
+            self._control_pubs[topic] = self.create_publisher(msg_type, topic,
+                                                              profile(CONTROL_QOS))
+        return self._control_pubs[topic]
