@@ -50,7 +50,7 @@ def start_line(referee):
     """Where the robots and the ball are at the start, as the observer first saw them."""
     judge = referee.judge
     robots = ', '.join(f'{name} at {xy(track.start)}' for name, track in judge.robots.items())
-    return f'  started at t = {referee.elapsed:.1f} s: {robots}; the ball at ' \
+    return f'  started at t = {judge.first_seen:.1f} s: {robots}; the ball at ' \
            f'{xy(judge.ball_start)}'
 
 

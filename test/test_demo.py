@@ -127,7 +127,9 @@ def test_the_demo_is_watched_from_its_first_instant(tmp_path):
     first_frame = re.search(r'^  video: .*\(\d+ frames, t = ([0-9.]+) to', output, re.M)
     assert first_frame and float(first_frame.group(1)) == 0.0, output
     progress = [(float(t), int(frames)) for t, frames in PROGRESS.findall(output)]
-    assert progress and progress[0][0] == 0.0, output
     slack_s = 0.5  # the observer hears /clock and the annotated frames on their own topics
+    # The first progress line is printed as soon as the start is seen: a busy machine may
+    # let the clock run on a tick or two before the observer has heard everything.
+    assert progress and progress[0][0] <= slack_s, output
     assert all(frames <= (t + slack_s) * FRAMES_PER_ROBOT_S * len(world.robots)
                for t, frames in progress), output

@@ -2,6 +2,7 @@
 which uses of the ROS graph are beyond MiRo's interface."""
 import math
 
+import pytest
 from hypothesis import given, strategies as st
 
 from miro_ball.grading.watch import breaches, CLIENT, Endpoint, PUBLISHER, SUBSCRIPTION
@@ -75,6 +76,18 @@ def test_what_came_before_the_start_and_garbage_are_ignored():
     judge.clock(math.nan)
     assert judge.touched_at is None and not judge.kicked and judge.robots == {}
     assert judge.elapsed == 0.0
+
+
+def test_the_start_is_when_everything_was_first_seen_however_late_it_was_heard():
+    judge = Judge(2.0)
+    assert judge.first_seen is None
+    judge.ball(2.02, (0.5, 0.0))
+    judge.robot('a', 2.02, (0.0, 0.0, 0.0))
+    judge.clock(2.3)  # heard later, behind a busy machine
+    judge.robot('b', 2.04, (1.0, 0.0, 0.0))
+    judge.robot('b', 2.3, (1.1, 0.0, 0.0))
+    assert judge.first_seen == pytest.approx(0.04) and judge.elapsed == pytest.approx(0.3)
+    assert judge.robots['b'].start == (1.0, 0.0, 0.0)
 
 
 def test_start_forgets_the_episode_before():

@@ -41,6 +41,7 @@ def ball_moved(start, now):
 class RobotTrack:
     """What the judge knows of one robot since the start."""
     start: tuple | None = None  # x, y, z of its foot frame when first seen
+    seen: float | None = None  # simulated s when first seen
     position: tuple | None = None  # the latest
     fell: bool = False
     distance: float = 0.0  # m driven over the floor
@@ -58,6 +59,7 @@ class Judge:
         self.start_time = self.now = float(t)
         self.ball_start = self.ball_position = None
         self.ball_time = None  # simulated s of the latest ball position
+        self.ball_seen = None  # simulated s of the first
         self.ball_history = collections.deque(maxlen=BALL_HISTORY)  # (t, (x, y))
         self.touched_at = self.touch_time = self.kicker = None
         self.kick_time = None
@@ -75,7 +77,8 @@ class Judge:
             return
         self.clock(t)
         self.ball_position, self.ball_time = position, t
-        self.ball_start = self.ball_start or position
+        if self.ball_start is None:
+            self.ball_start, self.ball_seen = position, t
         self.ball_history.append((t, position))
         self._judge_kick(t, position)
 
@@ -86,7 +89,7 @@ class Judge:
         self.clock(t)
         track = self.robots.setdefault(name, RobotTrack())
         if track.start is None:
-            track.start = foot
+            track.start, track.seen = foot, t
         else:
             track.distance += ball_moved(track.position, foot)
         track.position = foot
@@ -114,6 +117,15 @@ class Judge:
     def elapsed(self):
         """Simulated s since the start."""
         return max(0.0, self.now - self.start_time)
+
+    @property
+    def first_seen(self):
+        """Simulated s from the start to the first positions of the ball and every robot
+        seen (on the instants they were published, however late they were heard); None
+        before any."""
+        seen = [t for t in (self.ball_seen, *(r.seen for r in self.robots.values()))
+                if t is not None]
+        return max(0.0, max(seen) - self.start_time) if seen else None
 
     @property
     def kicked(self):
