@@ -58,6 +58,7 @@ class Rig:
         self.joints = probe.watch(JointState, T.kinematic_joints)
         self.wheels = probe.watch(Float32MultiArray, T.wheel_speed_cmd)
         self.errors = []
+        self.pages = []  # every page opened, closed after each test
 
     def _tick(self):
         from rostools import drain
@@ -93,12 +94,19 @@ class Rig:
 
     def open_page(self):
         page = self.browser.new_page(viewport={'width': 1400, 'height': 900})
+        self.pages.append(page)
         page.on('pageerror', lambda err: self.errors.append(str(err)))
         page.on('console', lambda msg: msg.type == 'error' and self.errors.append(msg.text))
         page.goto(self.url)
         assert self.until(lambda: frames(page, 'caml') > 0 and frames(page, 'camr') > 0), \
             'no eye images reached the page'
         return page
+
+    def close_pages(self):
+        for page in self.pages:
+            if not page.is_closed():
+                page.close()
+        self.pages.clear()
 
     @property
     def wheel_cmd(self):
@@ -152,6 +160,13 @@ def rig():
     assert code == 0 and 'Traceback' not in output, output
 
 
+@pytest.fixture(autouse=True)
+def pages_closed(rig):
+    """A test that failed with a key held leaves no page driving the robot in the next."""
+    yield
+    rig.close_pages()
+
+
 def test_page_shows_both_eyes_live_the_ball_and_the_readouts(rig, tmp_path):
     page, other = rig.open_page(), rig.open_page()  # two pages at once both work
     before = {(p, eye): frames(p, eye) for p in (page, other) for eye in ('caml', 'camr')}
@@ -175,7 +190,10 @@ def test_arrow_key_drives_forward_and_release_stops_within_half_a_second(rig):
     page.keyboard.down('ArrowUp')
     assert rig.until(rig.moving), 'holding ArrowUp did not drive the wheels'
     rig.run(1.0)  # longer than the GUI's deadman: the page renews the command
-    assert rig.moving(), 'the drive did not last while the key was held'
+    # A page kept from a core for longer than the deadman is stopped by it, as it should be,
+    # and drives on with its next renewal: a drive that was not renewed never would.
+    assert rig.until(rig.moving, wall_guard_s=5.0), \
+        'the drive did not last while the key was held'
     assert rig.odom[-1].pose.pose.position.x > start_x + 0.05
     page.keyboard.up('ArrowUp')
     stopped_after = rig.run(1.0, rig.stopped)
