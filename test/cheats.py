@@ -102,14 +102,15 @@ def other_domains(node):
     """Looks for simulators on other ROS domains (other episodes), as --jobs 2 allowed."""
     lock_dir = '/tmp/miro_ball_domains'
     say('lock files', sorted(os.listdir(lock_dir)) if os.path.isdir(lock_dir) else 'none')
-    found = []
-    for domain in range(0, 12):
-        probe, executor, context = probe_of(domain)
-        end = time.monotonic() + 0.6
-        while time.monotonic() < end:
-            executor.spin_once(timeout_sec=0.05)
-        if probe.get_publishers_info_by_topic('/clock'):
-            found.append(domain)
+    # All domains at once: probed one after another they outlasted a short episode.
+    probes = {domain: probe_of(domain) for domain in range(0, 12)}
+    end = time.monotonic() + 1.5
+    while time.monotonic() < end:
+        for _, executor, _ in probes.values():
+            executor.spin_once(timeout_sec=0.01)
+    found = [domain for domain, (probe, _, _) in probes.items()
+             if probe.get_publishers_info_by_topic('/clock')]
+    for probe, executor, context in probes.values():
         executor.shutdown()
         probe.destroy_node()
         context.try_shutdown()

@@ -3,13 +3,18 @@ scores 0 or is impossible and is named; the honest controller kicks; a flood or 
 of children costs only its own episode; nothing outlives the grading."""
 import csv
 import json
+import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
+import psutil
 import pytest
 
 from cheats import CHEATS
+from miro_ball.grading import sandbox
+from miro_ball.grading.command import Command
 from miro_ball.miro.interface import SimTopics
 
 PY = sys.executable
@@ -120,6 +125,57 @@ def test_a_flood_or_a_swarm_of_children_costs_only_that_episode(graded):
     assert flood['log_bytes'] > (report / 'flood' / 'episode_01' / 'command.log').stat().st_size
     assert (report / 'flood' / 'episode_01' / 'command.log').stat().st_size < 2 << 20
     assert episodes['honest']['success']
+
+
+SWARM = ('import os, time\n'
+         'n = 0\n'
+         'try:\n'
+         '    while n < 100000:\n'
+         '        if os.fork() == 0:\n'
+         '            time.sleep(600)\n'
+         '            os._exit(0)\n'
+         '        n += 1\n'
+         'except OSError:\n'
+         '    print("full", n, flush=True)\n'
+         'time.sleep(600)\n')
+
+
+def sandboxed(tmp_path, name, code, uid):
+    scratch = tmp_path / f'scratch_{name}'
+    scratch.mkdir()
+    os.chown(scratch, uid, uid)
+    argv = sandbox.command_line([PY, '-c', code], workdir=tmp_path, scratch=scratch,
+                                env={'HOME': str(scratch)}, uid=uid)
+    return Command(argv, env={}, cwd='/', log_path=tmp_path / f'{name}.log', sandboxed=True,
+                   preexec_fn=lambda: sandbox.limit_resources(True))
+
+
+def until_said(command, words, wall_s=30.0):
+    """Whether the command said words (wall time: a sandboxed process has no ROS clock)."""
+    deadline = time.monotonic() + wall_s
+    while not any(words in line for line in command.output_tail()):
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(0.05)
+    return True
+
+
+def test_a_swarm_that_filled_its_users_process_limit_is_gone_when_stop_returns(tmp_path):
+    """The next episode of a host runs as the same user: it must find the limit free."""
+    uid = sandbox.sandbox_uid()
+    if uid is None:
+        pytest.skip('a sandbox user of its own needs root')
+    swarm = sandboxed(tmp_path, 'swarm', SWARM, uid)
+    assert until_said(swarm, 'full')
+    swarm.stop(0.0)
+    assert not [p for p in psutil.process_iter(['uids', 'status'])
+                if p.info['uids'] and p.info['uids'].real == uid
+                and p.info['status'] != psutil.STATUS_ZOMBIE]
+    after = sandboxed(tmp_path, 'after', 'import threading\n'
+                      'ts = [threading.Thread(target=lambda: None) for _ in range(50)]\n'
+                      '[t.start() for t in ts]\nprint("started", len(ts), flush=True)\n', uid)
+    assert until_said(after, 'started 50')
+    after.stop(1.0)
 
 
 def test_the_report_has_a_row_per_student(graded):

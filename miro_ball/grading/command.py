@@ -15,7 +15,7 @@ import subprocess
 import threading
 import time
 
-from miro_ball.common.proc_tree import descendants
+from miro_ball.common.proc_tree import descendants, wait_gone
 from miro_ball.run.processes import stop_group
 
 TAIL_LINES = 5
@@ -23,7 +23,7 @@ TAIL_WIDTH = 160
 LOG_BYTES = 1 << 20  # kept from the start of the output
 TAIL_BYTES = 1 << 16  # kept from its end
 CHUNK = 1 << 16
-POLL_S = 0.05
+GONE_S = 10.0  # wall: for the kernel to take a killed sandbox's last processes
 
 
 def printable_tail(raw, lines=TAIL_LINES, width=TAIL_WIDTH):
@@ -114,9 +114,14 @@ class Command:
             killed = False
         except subprocess.TimeoutExpired:
             killed = True
-        # Its PID namespace ends with bubblewrap: the kernel kills all that is left in it.
-        _signal([self.proc.pid], signal.SIGKILL)
+        # Its PID namespace ends with bubblewrap: the kernel kills all that is left in it,
+        # but after bubblewrap has gone. The next command of this host runs as the same user,
+        # whose process limit a swarm of children not yet taken would fill (a measured
+        # failure: the next command could not start a thread), so wait until they are gone.
+        tree = [self.proc.pid, *descendants(self.proc.pid)]
+        _signal(tree, signal.SIGKILL)
         self.proc.wait()
+        wait_gone(tree[1:], GONE_S)
         return killed
 
     def _close_log(self):
