@@ -12,7 +12,7 @@ os.environ['ROS_DOMAIN_ID'] = str(private_domain())
 
 # Every test module is in one tier, so a contributor can run one: pytest -m unit.
 TIERS = {
-    'unit': ('pure logic, PyBullet and the renderers in-process; no ROS graph (under a minute)',
+    'unit': ('pure logic, PyBullet and the renderers in-process; no ROS graph (about a minute)',
              ('test_behaviour', 'test_convert', 'test_detection', 'test_eye_geometry',
               'test_gui_protocol', 'test_interface', 'test_isolation', 'test_jpeg',
               'test_layering', 'test_param_bounds', 'test_processes', 'test_rendering',
