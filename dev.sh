@@ -22,6 +22,11 @@ system_packages() {
   have_egl || want+=(libegl1 libgl1-mesa-dri)
   command -v chromium >/dev/null || want+=(chromium)  # the GUI's browser tests
   command -v bwrap >/dev/null || want+=(bubblewrap)  # the grader's sandbox
+  # miro2_msg and tf2_msgs are compiled at set-up (python -m miro_ball.build_interfaces)
+  local tool
+  for tool in gcc g++ cmake make; do command -v $tool >/dev/null || want+=($tool); done
+  python3 -c 'import sysconfig, os, sys; sys.exit(not os.path.isfile(os.path.join(sysconfig.get_paths()["include"], "Python.h")))' \
+    || want+=(python3-dev)
   [ ${#want[@]} -eq 0 ] && return 0
   local sudo=""
   if [ "$(id -u)" -ne 0 ]; then
@@ -31,6 +36,7 @@ system_packages() {
       say "(without libegl1/libgl1-mesa-dri the simulator falls back to the slower TinyRenderer)"
       say "(without chromium the browser tests of miro_gui are skipped)"
       say "(without bubblewrap the grader runs only trusted code, with --unsandboxed)"
+      say "(without gcc, g++, cmake, make, python3-dev there is no miro2_msg and no tf2_msgs)"
       return 0
     fi
   fi
@@ -44,7 +50,7 @@ system_packages() {
 # full venv's size.
 setup() {
   system_packages
-  local extras="ros${1:+,$1}"
+  local extras="ros,msgs${1:+,$1}"
   local stamp="$VENV/.installed-${extras//,/-}"
   if [ ! -f "$stamp" ] || [ setup.py -nt "$stamp" ]; then
     say "installing miro_ball[$extras] with ROS 2 Jazzy wheels into $VENV"
@@ -53,6 +59,9 @@ setup() {
     "$PY" -m pip install -q -e ".[$extras]"
     touch "$stamp"
   fi
+  # MiRo's messages: built once, again only when their sources change (a second or less
+  # otherwise); without a compiler it says what is missing and the rest runs.
+  "$PY" -m miro_ball.build_interfaces || say "going on without miro2_msg/tf2_msgs"
 }
 
 cmd=${1:-help}
