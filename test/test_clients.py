@@ -13,19 +13,20 @@ from geometry_msgs.msg import TwistStamped
 
 from miro_ball.common.isolation import isolated_env
 from miro_ball.common.robots import missing_robot
-from miro_ball.examples import client_follower, client_minimal, client_show, client_test, \
-    client_video
+from miro_ball.examples import client_follower, client_minimal, client_read_battery, \
+    client_show, client_test, client_video
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
 from miro_ball.miro.interface import RobotTopics, default_robot_name
 from rostools import Probe, advance_ticks, advance_until, kill_if_running, spin_until
 
 T = RobotTopics(default_robot_name())
-CLIENTS = ('client_minimal', 'client_video', 'client_show', 'client_follower', 'client_test')
+CLIENTS = ('client_minimal', 'client_video', 'client_show', 'client_follower', 'client_test',
+           'client_read_battery')
 
 
 CLASSES = {client_minimal: client_minimal.Minimal, client_show: client_show.Show,
            client_follower: client_follower.Follower, client_test: client_test.Bench,
-           client_video: client_video.Video}
+           client_video: client_video.Video, client_read_battery: client_read_battery.ReadBattery}
 
 
 def run_client(module, args, paused_sim, executor, context, limit_s, each_tick=None):
@@ -71,6 +72,16 @@ def test_minimal_drives_and_prints_the_battery(paused_sim, executor, ros_context
     out = capsys.readouterr().out
     assert code == 0 and 'battery: 4.80 V' in out
     assert math.hypot(x, y) > 0.1 and yaw > 0.3  # 0.2 m/s and 0.5 rad/s for 1 s
+
+
+def test_read_battery_prints_the_voltage_from_the_package_each_interval(paused_sim, executor,
+                                                                         ros_context, capsys):
+    code = run_client(client_read_battery, ['--count', '3', '--every', '0.5'], paused_sim,
+                      executor, ros_context, limit_s=3.0)
+    lines = [line for line in capsys.readouterr().out.splitlines() if 'battery' in line]
+    assert code == 0 and len(lines) == 3 and all('battery 4.80 V' in line for line in lines)
+    times = [float(line.split('t = ')[1].split(' s')[0]) for line in lines]
+    assert [b - a for a, b in zip(times, times[1:])] == pytest.approx([0.5, 0.5])
 
 
 @pytest.mark.parametrize('signal', sorted(set(client_show.SIGNALS) - {'cmd_vel'}))

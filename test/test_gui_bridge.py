@@ -167,13 +167,13 @@ def test_eyes_are_subscribed_only_while_a_page_shows_them(bridge, executor):
     def settles(expected):
         return spin_until(executor, lambda: eye_subscribers(bridge) == expected)
 
-    # No page: the simulator renders nothing for the GUI; nor is any sensor read. (The
+    # No page: the simulator renders nothing for the GUI; nor is any sensor read (sensors/package holds them all). (The
     # bridge's own subscriptions are in its graph at once: nothing to wait for.)
     assert eye_subscribers(bridge) == {'caml': 0, 'camr': 0}
-    assert bridge.count_subscribers(T.odom) == 0 and not bridge.watches
+    assert bridge.count_subscribers(T.package) == 0 and not bridge.watches
     opened(bridge, executor, 1)  # a page shows both eyes until it says otherwise
     assert settles({'caml': 1, 'camr': 1})
-    assert spin_until(executor, lambda: bridge.count_subscribers(T.odom) == 1)
+    assert spin_until(executor, lambda: bridge.count_subscribers(T.package) == 1)
     bridge.submit(p.View(frozenset(), True), owner=1)  # the world only
     assert settles({'caml': 0, 'camr': 0})
     opened(bridge, executor, 2)
@@ -182,7 +182,7 @@ def test_eyes_are_subscribed_only_while_a_page_shows_them(bridge, executor):
     bridge.release(2)
     assert settles({'caml': 0, 'camr': 0})
     bridge.release(1)
-    assert spin_until(executor, lambda: bridge.count_subscribers(T.odom) == 0)
+    assert spin_until(executor, lambda: bridge.count_subscribers(T.package) == 0)
     assert eye_subscribers(bridge) == {'caml': 0, 'camr': 0}
 
 

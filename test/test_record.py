@@ -14,6 +14,7 @@ from geometry_msgs.msg import TwistStamped
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 from rosbags.rosbag2 import Reader
+from rosbags.typesys import get_types_from_msg, get_typestore, Stores
 from ruamel.yaml import YAML
 from std_msgs.msg import String
 
@@ -47,6 +48,7 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
     interface = paused_sim.robots[ROBOT.name]
     assert spin_until(executor, lambda: interface.publisher('odom').get_subscription_count()
                       and interface.publisher('cliff').get_subscription_count()
+                      and interface.publisher('package').get_subscription_count()
                       and interface.pub_eyes['caml'][0].get_subscription_count()
                       and latched.get_subscription_count())
     advance_ticks(paused_sim, executor)  # the first /clock starts the recording
@@ -72,6 +74,9 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
     # Every tick after the first, nothing lost, at the message's own stamp.
     odom = [(t, m) for t, m in recorded[ROBOT.odom][1] if t > first_clock]
     assert len(odom) == 50
+    odom_ns = [t for t, _ in odom]
+    assert recorded[ROBOT.package][0] == 'miro2_msg/msg/SensorsPackage'
+    assert [t for t, _ in recorded[ROBOT.package][1] if t > first_clock] == odom_ns
     assert [t for t, _ in odom] == [ns(m.header.stamp) for _, m in odom]
     assert [t for t, _ in odom] == [round((start + 0.02 * (i + 1)) * 1e9) for i in range(50)]
     # Without a stamp: the /clock of the tick that carried it.
@@ -96,6 +101,17 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
         assert schemas[odom.schema_id].encoding == 'ros2msg'
         counted = sum(1 for _, channel, _ in reader.iter_messages(topics=[ROBOT.odom]))
         assert counted == len(recorded[ROBOT.odom][1])
+        # MiRo's own type, decoded by a reader that knows nothing but the bag's definitions.
+        package = channels[ROBOT.package]
+        schema = schemas[package.schema_id]
+        assert schema.name == 'miro2_msg/msg/SensorsPackage'
+        store = get_typestore(Stores.EMPTY)
+        store.register(get_types_from_msg(schema.data.decode(), schema.name))
+        last = [data for _, _, data in reader.iter_messages(topics=[ROBOT.package])][-1].data
+        decoded = store.deserialize_cdr(last, schema.name)
+        assert ns(decoded.header.stamp) == odom_ns[-1]
+        assert decoded.battery.voltage == pytest.approx(4.8)
+        assert list(decoded.cliff.data) == [1.0, 1.0]
 
 
 def test_a_full_disk_ends_the_recording_and_keeps_the_finished_files(

@@ -6,7 +6,7 @@ from nav_msgs.msg import Odometry
 from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
 from rosbags.rosbag2 import Reader
-from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys import get_types_from_msg, get_typestore, Stores
 from ruamel.yaml import YAML
 
 from miro_ball.recording.bag import SplitBag, describe, offered_qos
@@ -20,9 +20,13 @@ TICK_NS = 20_000_000
 
 
 def read_bag(path):
-    """{topic: (type, [(log time, message)])} of a bag."""
+    """{topic: (type, [(log time, message)])} of a bag; a type that is not ROS 2's own
+    (miro2_msg) is read with the definition the bag holds, as an independent reader would."""
     with Reader(path) as reader:
         out = {c.topic: (c.msgtype, []) for c in reader.connections}
+        for c in reader.connections:
+            if c.msgtype not in TYPES.fielddefs:
+                TYPES.register(get_types_from_msg(c.msgdef.data, c.msgtype))
         for connection, log_time, data in reader.messages():
             out[connection.topic][1].append(
                 (log_time, TYPES.deserialize_cdr(data, connection.msgtype)))

@@ -13,8 +13,10 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import BatteryState, Imu, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt16, UInt32
 
+from miro_ball.common.messages import message_class
 from miro_ball.common.stamps import seconds
 from miro_ball.examples._client import Client, heading, make_parser, run
+from miro_ball.miro.interface import TOPIC
 
 
 def pair(values, unit=''):
@@ -41,7 +43,15 @@ def show_kin(m):
     return '  '.join(f'{n} {math.degrees(p):+.1f}' for n, p in zip(m.name, m.position)) + ' deg'
 
 
-# signal: (message type, its topic given the robot's topics, one line of a message)
+def show_package(m):
+    p = m.odom.pose.pose.position
+    return (f'x {p.x:+.3f} m  y {p.y:+.3f} m  cliff {pair(m.cliff.data)}  sonar '
+            f'{show_sonar(m.sonar)}  battery {m.battery.voltage:.2f} V  touch '
+            f'head {m.touch_head.data:#06x} body {m.touch_body.data:#06x}')
+
+
+# signal: (message type, its topic given the robot's topics, one line of a message); a type
+# by name is one this project builds (miro2_msg), imported only when it is shown.
 SIGNALS = {
     'cliff': (Float32MultiArray, lambda t: t.cliff, lambda m: pair(m.data)),
     'wheels': (Float32MultiArray, lambda t: t.wheel_speed_opto, lambda m: pair(m.data, ' m/s')),
@@ -57,6 +67,7 @@ SIGNALS = {
               lambda m: '  '.join(f'{v:.2f}' for v in m.data)),
     'touch': (UInt16, lambda t: t.touch('body'), lambda m: f'body {m.data:014b}'),
     'flags': (UInt32, lambda t: t.sensor_flags, lambda m: f'0x{m.data:08x}'),
+    'package': (TOPIC['package'].type, lambda t: t.package, show_package),
     'cmd_vel': (TwistStamped, lambda t: t.cmd_vel,
                 lambda m: f'{m.twist.linear.x:+.3f} m/s  {m.twist.angular.z:+.3f} rad/s'),
 }
@@ -66,6 +77,8 @@ class Show(Client):
     def __init__(self, options, context=None):
         super().__init__('client_show', options, context)
         msg_type, topic, self.line = SIGNALS[options.signal]
+        if isinstance(msg_type, str):
+            msg_type = message_class(msg_type)
         self.subscribe(msg_type, topic(self.topics), self.on_message)
         self.shown = 0
 

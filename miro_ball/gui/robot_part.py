@@ -15,14 +15,14 @@ from sensor_msgs.msg import BatteryState, CameraInfo, Imu, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, \
     UInt32MultiArray
 
-from miro_ball.common.messages import drive_command
+from miro_ball.common.messages import drive_command, message_class
 from miro_ball.common.qos import profile
 from miro_ball.controller.names import debug_topic
 from miro_ball.gui import protocol as p
 from miro_ball.gui import readouts as r
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_NAMES
-from miro_ball.miro.interface import CONTROL_QOS, EYE_QOS, EYES, RobotTopics, SENSOR_QOS
+from miro_ball.miro.interface import CONTROL_QOS, EYE_QOS, EYES, RobotTopics, SENSOR_QOS, TOPIC
 from miro_ball.miro.rotations import yaw_of
 
 NODE_NAME = 'miro_gui'
@@ -79,6 +79,16 @@ READOUTS = (
     (UInt32, 'sensor_flags', lambda m: {'flags': m.data}),
 )
 
+
+def _from_package(msg):
+    """Every readout from a sensors/package: each READOUTS row reads the field named as its
+    topic (sensors/battery -> battery)."""
+    values = {}
+    for _, where, handler in READOUTS:
+        values.update(handler(getattr(msg, _topic(RobotTopics(), where).split('/', 1)[1])) or {})
+    return values
+
+
 # The page's commands that become one message on one of MiRo's control topics:
 # command type: (message type, RobotTopics attribute, command -> message).
 PUBLISHED = {
@@ -128,10 +138,15 @@ class RobotPart(Node):
                 self.destroy_subscription(sub)
             self._sensor_subs = []
             return
-        self._sensor_subs = [
-            self.create_subscription(msg_type, _topic(self.topics, where), self._wrap(handler),
-                                     profile(SENSOR_QOS))
-            for msg_type, where, handler in READOUTS]
+        try:  # sensors/package holds every readout of a tick: one subscription, as the MDK's
+            package = message_class(TOPIC['package'].type)  # GUI does
+            self._sensor_subs = [self.create_subscription(
+                package, self.topics.package, self._wrap(_from_package), profile(SENSOR_QOS))]
+        except ValueError:  # miro2_msg is not built: the separate topics
+            self._sensor_subs = [
+                self.create_subscription(msg_type, _topic(self.topics, where),
+                                         self._wrap(handler), profile(SENSOR_QOS))
+                for msg_type, where, handler in READOUTS]
         # A tone anyone asks MiRo for (this GUI's pages too) is heard in the pages.
         self._sensor_subs.append(self.create_subscription(
             UInt16MultiArray, self.topics.tone, self._on_tone, profile(CONTROL_QOS)))

@@ -118,6 +118,8 @@ ROBOT_INTERFACE = tuple(Topic(*row[:6], *(row[6:] or (None,))) for row in (
      'part head or body: a bit per touch sensor', PLATFORM_HZ),
     ('sensor_flags', 'sensors/flags', 'std_msgs/msg/UInt32', SENSOR, SENSOR_QOS,
      'platform flags (bit 15: simulator)', PLATFORM_HZ),
+    ('package', 'sensors/package', 'miro2_msg/msg/SensorsPackage', SENSOR, SENSOR_QOS,
+     "every 50 Hz reading of one tick, stamped (miro2_msg: built at set-up)", PLATFORM_HZ),
     ('cmd_vel', 'control/cmd_vel', 'geometry_msgs/msg/TwistStamped', CONTROL, CONTROL_QOS,
      'body velocity, 0.4 m/s a wheel at most'),
     ('kinematic_targets', 'control/kinematic_joints', 'sensor_msgs/msg/JointState', CONTROL,

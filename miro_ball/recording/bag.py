@@ -29,7 +29,10 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 from ruamel.yaml import YAML
 
+from miro_ball.common.definitions import register_own_types
+
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+register_own_types(TYPESTORE)  # miro2_msg, when it is built: rosbags knows only ROS 2's own
 METADATA = 'metadata.yaml'
 INFO = 'rosbag2_bagfile_information'
 UNFINISHED = '.unfinished'  # the split being written: hidden, never listed

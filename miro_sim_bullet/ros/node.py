@@ -116,6 +116,10 @@ class SimNode(Node):
             f'world {self.sim.description.source}; robots {", ".join(self.robots)}; renderer '
             f'{self.cameras.renderer.name}; cameras {p.frame_width}x{p.frame_height} @ '
             f'{p.camera_rate:g} Hz; real-time factor {p.real_time_factor:g}')
+        for row in next(iter(self.robots.values())).missing_types:
+            self.get_logger().warning(
+                f'{row.name} not published: its type {row.type} is not installed (build it: '
+                'python -m miro_ball.build_interfaces)')
         # The rates of the robots' sensor streams (the interface table's); /clock and the
         # ground truth go with the platform tick.
         self._stream_rates = sorted({PLATFORM_HZ}.union(*(i.streams for i in

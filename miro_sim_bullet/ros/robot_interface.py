@@ -49,8 +49,13 @@ class RobotInterface:
         self._publishers = {}  # (row key, its placeholder's value if any) -> publisher
         self.subs = []
         self.controls = []  # (topic, the type it takes)
+        self.missing_types = []  # rows whose message type is not installed (miro2_msg)
         for row in ROBOT_INTERFACE:
-            msg_type, qos = message_class(row.type), profile(row.qos)
+            try:
+                msg_type, qos = message_class(row.type), profile(row.qos)
+            except ValueError:
+                self.missing_types.append(row)
+                continue
             for fields, relative in row.names():
                 topic = t.topic(relative)
                 if row.direction == CONTROL:

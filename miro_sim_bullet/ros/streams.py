@@ -8,10 +8,14 @@ every SENSOR row of the table that has a producer, at the row's rate, for every 
 eyes (rate CAMERA) are drawn by the eye pipeline instead. Adding a stream is a row in the
 table and a producer here (docs/development.md).
 """
+import functools
+
+import numpy as np
 from std_msgs.msg import UInt16, UInt32
 
-from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR
-from miro_ball.miro.interface import frame_id
+from miro_ball.common.messages import message_class
+from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR, WHEEL_MAX_SPEED_M_PER_S
+from miro_ball.miro.interface import frame_id, PLATFORM_HZ, ROBOT_INTERFACE, SENSOR, TOPIC
 from miro_sim_bullet.ros import convert
 
 PRODUCERS = {
@@ -30,3 +34,33 @@ PRODUCERS = {
     'touch': lambda r, when, name, part: UInt16(data=getattr(r.sensors, f'touch_{part}')),
     'sensor_flags': lambda r, when, name: UInt32(data=UPSTREAM_FLAG_SIMULATOR),
 }
+
+
+@functools.cache  # on first use: miro2_msg may not be built, and then it is never called
+def _package_parts():
+    """[(field of SensorsPackage, producer, placeholder fields)]: every 50 Hz row whose topic
+    is sensors/<field> fills that field, so the package holds what the separate topics of
+    the tick hold, by construction."""
+    fields = message_class(TOPIC['package'].type).get_fields_and_field_types()
+    return [(relative.split('/', 1)[1], PRODUCERS[row.key], holes)
+            for row in ROBOT_INTERFACE if row.direction == SENSOR and row.rate == PLATFORM_HZ
+            and row.key in PRODUCERS for holes, relative in row.names()
+            if relative.split('/', 1)[1] in fields]
+
+
+def sensors_package(r, when, name):
+    """sensors/package: the tick's readings in one stamped message. The simulator models no
+    motor electronics, so the two motor fields are ideal: the back-EMF estimate is the
+    measured wheel speed, the PWM effort the commanded speed as a fraction of full speed.
+    No DIP switch is set; the speaker's stream state is not reported yet (empty)."""
+    msg = message_class(TOPIC['package'].type)()
+    msg.header.stamp, msg.header.frame_id = when, frame_id(name, 'base_link')
+    for field, make, holes in _package_parts():
+        setattr(msg, field, make(r, when, name, **holes))
+    msg.wheel_speed_back_emf = convert.floats(r.sensors.wheel_speed_opto)
+    msg.wheel_effort_pwm = convert.floats(
+        np.clip(np.asarray(r.sensors.wheel_speed_cmd) / WHEEL_MAX_SPEED_M_PER_S, -1.0, 1.0))
+    return msg
+
+
+PRODUCERS['package'] = sensors_package

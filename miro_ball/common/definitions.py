@@ -1,0 +1,67 @@
+"""Message definitions (.msg files) as ROS 2 installs them: share/<package>/msg/<Name>.msg
+under each prefix of $AMENT_PREFIX_PATH and, for a pip install with no ROS sourced, this
+Python environment's own prefix (where the ROS wheels and build_interfaces put them).
+
+Used where a definition is shown (``ros2 interface show``) or stored (a bag's types, which
+rosbags knows for ROS 2's own packages but not for miro2_msg).
+"""
+import os
+import sys
+from pathlib import Path
+
+# The packages this project builds itself (python -m miro_ball.build_interfaces).
+OWN_PACKAGES = ('miro2_msg',)
+
+
+def prefixes():
+    """Where installed packages are looked for, first wins."""
+    listed = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
+    return [Path(p) for p in dict.fromkeys(listed + [sys.prefix])]
+
+
+def split_type(type_name):
+    """('sensor_msgs', 'msg', 'Range') for 'sensor_msgs/msg/Range' (or 'sensor_msgs/Range');
+    ValueError in one line if it is not a type name."""
+    parts = type_name.split('/') if isinstance(type_name, str) else []
+    if len(parts) == 2:
+        parts.insert(1, 'msg')
+    if len(parts) != 3 or not all(p.isidentifier() for p in parts) \
+            or parts[1] not in ('msg', 'srv', 'action'):
+        raise ValueError(f'{type_name!r} is not a type name (package/msg/Name, as '
+                         'geometry_msgs/msg/Twist)')
+    return tuple(parts)
+
+
+def definition_file(type_name):
+    """The installed .msg/.srv file of a type; ValueError if none is installed."""
+    package, kind, name = split_type(type_name)
+    for prefix in prefixes():
+        path = prefix / 'share' / package / kind / f'{name}.{kind}'
+        if path.is_file():
+            return path
+    raise ValueError(f'no interface {package}/{kind}/{name} is installed')
+
+
+def package_messages(package):
+    """{'pkg/msg/Name': definition text} of every message an installed package holds
+    ({} if it is not installed)."""
+    for prefix in prefixes():
+        folder = prefix / 'share' / package / 'msg'
+        if folder.is_dir():
+            return {f'{package}/msg/{path.stem}': path.read_text()
+                    for path in sorted(folder.glob('*.msg'))}
+    return {}
+
+
+def register_own_types(typestore):
+    """Teach a rosbags typestore the messages of our own packages that are installed, so a
+    bag stores their definitions as for any ROS 2 type; returns the type names added."""
+    from rosbags.typesys import get_types_from_msg
+
+    added = {}
+    for package in OWN_PACKAGES:
+        for type_name, text in package_messages(package).items():
+            if type_name not in typestore.fielddefs:
+                added.update(get_types_from_msg(text, type_name))
+    typestore.register(added)
+    return sorted(added)
