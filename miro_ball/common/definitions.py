@@ -65,3 +65,40 @@ def register_own_types(typestore):
                 added.update(get_types_from_msg(text, type_name))
     typestore.register(added)
     return sorted(added)
+
+
+PRIMITIVES = {'bool', 'byte', 'char', 'float32', 'float64', 'int8', 'uint8', 'int16', 'uint16',
+              'int32', 'uint32', 'int64', 'uint64', 'string', 'wstring'}
+
+
+def _nested_type(line, package):
+    """The message type a field line names ('pkg/msg/Name'), or None for a primitive field,
+    a constant, a comment or a blank line."""
+    words = line.split('#', 1)[0].split()
+    if len(words) < 2 or '=' in line.split('#', 1)[0]:
+        return None
+    base = words[0].split('[', 1)[0].split('<=', 1)[0]
+    if base in PRIMITIVES:
+        return None
+    if '/' in base:
+        owner, name = base.split('/', 1)
+        return f'{owner}/msg/{name.rsplit("/", 1)[-1]}'
+    return f'{package}/msg/{base}'
+
+
+def expanded(type_name, indent=''):
+    """A definition as ``ros2 interface show`` prints it: the type's own file, and under each
+    field of a message type that type's fields, a tab further in (their comments left out);
+    ValueError if a type is not installed."""
+    package = split_type(type_name)[0]
+    lines = []
+    for line in definition_file(type_name).read_text().splitlines():
+        if indent:  # a nested type: its fields only
+            line = line.split('#', 1)[0].rstrip()
+            if not line.strip():
+                continue
+        lines.append(indent + line)
+        nested = _nested_type(line, package)
+        if nested is not None:
+            lines.extend(expanded(nested, indent + '\t'))
+    return lines

@@ -1,0 +1,243 @@
+"""What each ``python -m miro_ball.ros2`` command does, in the output shape of ``ros2``'s.
+
+Each verb takes the parsed arguments and a Graph, prints its answer and returns the exit
+status; bad input is a CliError (or ValueError) with one line, printed by __main__.
+"""
+import importlib
+import statistics
+import time
+
+from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
+from rcl_interfaces.srv import GetParameters, ListParameters, SetParameters
+
+from miro_ball.common.definitions import expanded, split_type
+from miro_ball.ros2 import convert
+from miro_ball.ros2.graph import CliError
+
+PARAMETER_VALUE = {  # ParameterType: (field of ParameterValue, how ros2 param get names it)
+    ParameterType.PARAMETER_BOOL: ('bool_value', 'Boolean'),
+    ParameterType.PARAMETER_INTEGER: ('integer_value', 'Integer'),
+    ParameterType.PARAMETER_DOUBLE: ('double_value', 'Double'),
+    ParameterType.PARAMETER_STRING: ('string_value', 'String'),
+    ParameterType.PARAMETER_BYTE_ARRAY: ('byte_array_value', 'Byte values'),
+    ParameterType.PARAMETER_BOOL_ARRAY: ('bool_array_value', 'Boolean values'),
+    ParameterType.PARAMETER_INTEGER_ARRAY: ('integer_array_value', 'Integer values'),
+    ParameterType.PARAMETER_DOUBLE_ARRAY: ('double_array_value', 'Double values'),
+    ParameterType.PARAMETER_STRING_ARRAY: ('string_array_value', 'String values'),
+}
+
+
+def interface_class(type_name):
+    """The class of 'pkg/msg/Name' or 'pkg/srv/Name' ('pkg/Name' is a message); CliError."""
+    package, kind, name = split_type(type_name)
+    try:
+        return getattr(importlib.import_module(f'{package}.{kind}'), name)
+    except (ImportError, AttributeError):
+        raise CliError(f'no interface {package}/{kind}/{name} is installed (is it built? '
+                       'python -m miro_ball.build_interfaces)') from None
+
+
+def absolute(name):
+    return name if name.startswith('/') else '/' + name
+
+
+# -- topic ------------------------------------------------------------------------------------
+def topic_list(args, graph):
+    for name, types in sorted(graph.settle(graph.topics).items()):
+        print(f'{name} [{", ".join(types)}]' if args.show_types else name)
+    return 0
+
+
+def topic_info(args, graph):
+    topic = absolute(args.topic)
+    type_name = graph.topic_type(topic)
+    node = graph.node
+    publishers = [i for i in node.get_publishers_info_by_topic(topic)
+                  if i.node_name != node.get_name()]
+    subscribers = [i for i in node.get_subscriptions_info_by_topic(topic)
+                   if i.node_name != node.get_name()]
+    print(f'Type: {type_name}')
+    for kind, endpoints in (('Publisher', publishers), ('Subscription', subscribers)):
+        print(f'{kind} count: {len(endpoints)}')
+        if args.verbose:
+            print()
+            for info in endpoints:
+                qos = info.qos_profile
+                print(f'Node name: {info.node_name}\nNode namespace: {info.node_namespace}\n'
+                      f'Topic type: {info.topic_type}\nEndpoint type: {info.endpoint_type.name}\n'
+                      f'QoS profile:\n  Reliability: {qos.reliability.name}\n'
+                      f'  History (Depth): {qos.history.name} ({qos.depth})\n'
+                      f'  Durability: {qos.durability.name}\n')
+    return 0
+
+
+def topic_echo(args, graph):
+    topic = absolute(args.topic)
+    msg_class = interface_class(graph.topic_type(topic))
+    if args.field:
+        convert.field(msg_class(), args.field)  # a field that does not exist: said now
+    received = []
+    graph.node.create_subscription(msg_class, topic, received.append, graph.qos_for(topic))
+    shown = 0
+    while True:
+        graph.spin(0.05)
+        for msg in received:
+            value = convert.field(msg, args.field) if args.field else msg
+            data = convert.to_data(value, args.truncate_length)
+            print(convert.to_yaml(data).rstrip('\n') if isinstance(data, (dict, list))
+                  else data, flush=False)
+            print('---', flush=True)
+            shown += 1
+            if args.once:
+                return 0
+        received.clear()
+
+
+def topic_hz(args, graph):
+    topic = absolute(args.topic)
+    msg_class = interface_class(graph.topic_type(topic))
+    arrivals = []  # receive times, s: simulated when a /clock runs, else wall
+
+    def heard(msg):
+        arrivals.append(now())
+        del arrivals[:-args.window - 1]
+
+    sim = '/clock' in graph.topics()
+    if sim:
+        from rclpy.parameter import Parameter as RclpyParameter
+        graph.node.set_parameters([RclpyParameter('use_sim_time', value=True)])
+
+    def now():
+        return graph.node.get_clock().now().nanoseconds * 1e-9 if sim else time.monotonic()
+
+    graph.node.create_subscription(msg_class, topic, heard, graph.qos_for(topic))
+    while True:
+        graph.spin(1.0)
+        gaps = [b - a for a, b in zip(arrivals, arrivals[1:]) if b > a]
+        if not gaps:
+            print('no new messages')
+            continue
+        mean = statistics.fmean(gaps)
+        print(f'average rate: {1.0 / mean:.3f}\n\tmin: {min(gaps):.3f}s max: {max(gaps):.3f}s '
+              f'std dev: {statistics.pstdev(gaps):.5f}s window: {len(gaps) + 1}', flush=True)
+
+
+def topic_pub(args, graph):
+    topic = absolute(args.topic)
+    msg_class = interface_class(args.type)
+    msg = convert.fill(msg_class(), convert.parse_yaml(args.values))
+    publisher = graph.node.create_publisher(msg_class, topic, 10)
+    times = 1 if args.once else args.times
+    if times:  # a few messages: wait until someone listens, or they are lost
+        graph.wait(lambda: publisher.get_subscription_count() > 0)
+    print('publisher: beginning loop', flush=True)
+    count = 0
+    while not times or count < times:
+        count += 1
+        print(f'publishing #{count}: {msg!r}\n', flush=True)
+        publisher.publish(msg)
+        graph.spin(1.0 / args.rate if not args.once else 0.5)
+    return 0
+
+
+# -- node -------------------------------------------------------------------------------------
+def node_list(args, graph):
+    print('\n'.join(graph.settle(graph.nodes)))
+    return 0
+
+
+def node_info(args, graph):
+    name, namespace = graph.find_node(args.node)
+    node = graph.node
+    sections = (('Subscribers', node.get_subscriber_names_and_types_by_node),
+                ('Publishers', node.get_publisher_names_and_types_by_node),
+                ('Service Servers', node.get_service_names_and_types_by_node),
+                ('Service Clients', node.get_client_names_and_types_by_node))
+    print(f'{namespace.rstrip("/")}/{name}')
+    for title, listing in sections:
+        print(f'  {title}:')
+        for topic, types in sorted(listing(name, namespace)):
+            print(f'    {topic}: {", ".join(types)}')
+    print('  Action Servers:\n\n  Action Clients:\n')
+    return 0
+
+
+# -- param ------------------------------------------------------------------------------------
+def _parameter_service(graph, node, service):
+    name, namespace = graph.find_node(node)
+    return f'{namespace.rstrip("/")}/{name}/{service}'
+
+
+def param_list(args, graph):
+    service = _parameter_service(graph, args.node, 'list_parameters')
+    result = graph.call(service, ListParameters, ListParameters.Request())
+    for name in sorted(result.result.names):
+        print(f'  {name}')
+    return 0
+
+
+def param_get(args, graph):
+    service = _parameter_service(graph, args.node, 'get_parameters')
+    values = graph.call(service, GetParameters, GetParameters.Request(names=[args.name])).values
+    if not values or values[0].type not in PARAMETER_VALUE:
+        print('Parameter not set.')
+        return 1
+    field, word = PARAMETER_VALUE[values[0].type]
+    value = getattr(values[0], field)
+    print(f'{word} value is: {list(value) if word.endswith("values") else value}')
+    return 0
+
+
+def parameter_value(text):
+    """A ParameterValue from the command line's text, typed as YAML reads it (ros2's rule)."""
+    import yaml
+
+    try:
+        value = yaml.safe_load(text)
+    except yaml.YAMLError:
+        value = text
+    kinds = ((bool, ParameterType.PARAMETER_BOOL), (int, ParameterType.PARAMETER_INTEGER),
+             (float, ParameterType.PARAMETER_DOUBLE), (str, ParameterType.PARAMETER_STRING))
+    for kind, code in kinds:
+        if isinstance(value, kind):
+            field = PARAMETER_VALUE[code][0]
+            return ParameterValue(type=code, **{field: value})
+    raise CliError(f'{text!r} is not a parameter value (a bool, integer, number or string)')
+
+
+def param_set(args, graph):
+    service = _parameter_service(graph, args.node, 'set_parameters')
+    request = SetParameters.Request(parameters=[Parameter(name=args.name,
+                                                          value=parameter_value(args.value))])
+    result = graph.call(service, SetParameters, request).results[0]
+    if result.successful:
+        print('Set parameter successful')
+        return 0
+    print(f'Setting parameter failed: {result.reason}')
+    return 1
+
+
+# -- service, interface -----------------------------------------------------------------------
+def service_list(args, graph):
+    for name, types in sorted(graph.settle(graph.services).items()):
+        print(f'{name} [{", ".join(types)}]' if args.show_types else name)
+    return 0
+
+
+def service_call(args, graph):
+    srv_class = interface_class(args.type)
+    if not hasattr(srv_class, 'Request'):
+        raise CliError(f'{args.type} is not a service type (package/srv/Name)')
+    request = convert.fill(srv_class.Request(), convert.parse_yaml(args.values))
+    print(f'requester: making request: {request!r}\n')
+    response = graph.call(absolute(args.service), srv_class, request)
+    print(f'response:\n{response!r}\n')
+    return 0
+
+
+def interface_show(args, graph=None):
+    try:
+        print('\n'.join(expanded(args.type)))
+    except ValueError as err:
+        raise CliError(str(err)) from None
+    return 0

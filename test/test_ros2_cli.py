@@ -1,0 +1,126 @@
+"""python -m miro_ball.ros2: ros2's everyday verbs against a running simulator, as a student
+types them (each a process; the world is stepped by the test while it runs)."""
+import os
+import subprocess
+import sys
+import threading
+
+import pytest
+import yaml
+
+from miro_ball.common.isolation import isolated_env
+from miro_ball.miro.interface import default_robot_name, RobotTopics, SIM_NODE_NAME
+from rostools import advance_until, kill_if_running
+
+T = RobotTopics(default_robot_name())
+SIM = '/' + SIM_NODE_NAME
+
+
+def ros2(args, paused_sim, executor, until=None):
+    """(exit code, stdout, stderr) of one command; the world runs until it ends (or, with
+    until(stdout so far), until that holds, when it is stopped)."""
+    proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.ros2', *args],
+                            env=isolated_env(int(os.environ['ROS_DOMAIN_ID'])),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        advance_until(paused_sim, executor, lambda: proc.poll() is not None)
+        out, err = proc.communicate(timeout=10)
+    finally:
+        kill_if_running(proc)
+    return proc.returncode, out, err
+
+
+def test_topic_list_names_every_topic_of_the_robot_with_its_type(paused_sim, executor):
+    code, out, _ = ros2(['topic', 'list', '-t'], paused_sim, executor)
+    listed = dict(line.rsplit(' ', 1) for line in out.splitlines())
+    assert code == 0
+    assert set(T.all()) <= set(listed)
+    assert listed[T.package] == '[miro2_msg/msg/SensorsPackage]'
+    assert listed[T.cmd_vel] == '[geometry_msgs/msg/TwistStamped]'
+
+
+def test_echo_once_prints_a_message_as_yaml_and_a_field_alone(paused_sim, executor):
+    code, out, _ = ros2(['topic', 'echo', T.battery, '--once'], paused_sim, executor)
+    assert code == 0 and out.endswith('---\n')
+    battery = yaml.safe_load(out.split('---')[0])
+    assert battery['voltage'] == pytest.approx(4.8)
+    assert battery['header']['frame_id'] == f'{T.name}/base_link'
+    code, out, _ = ros2(['topic', 'echo', T.package, '--once', '--field', 'cliff.data'],
+                        paused_sim, executor)
+    assert code == 0 and yaml.safe_load(out.split('---')[0]) == [1.0, 1.0]
+
+
+def test_pub_at_a_rate_drives_miro(paused_sim, executor):
+    code, out, _ = ros2(['topic', 'pub', T.cmd_vel, 'geometry_msgs/msg/TwistStamped',
+                         '{twist: {linear: {x: 0.2}}}', '-r', '10', '-t', '10'],
+                        paused_sim, executor)
+    x, _, _ = paused_sim.sim.robots[T.name].pose()
+    assert code == 0 and 'publishing #10' in out
+    assert x > 0.05
+
+
+def test_hz_is_fifty_in_simulated_time(paused_sim, executor):
+    proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.ros2', 'topic', 'hz', T.package],
+                            env=isolated_env(int(os.environ['ROS_DOMAIN_ID'])),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    lines = []
+    reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
+    reader.start()
+    try:
+        advance_until(paused_sim, executor, lambda: proc.poll() is not None
+                      or any('average rate' in line for line in lines))
+    finally:
+        kill_if_running(proc)
+    rate = next(line for line in lines if 'average rate' in line)
+    assert float(rate.split(':')[1]) == pytest.approx(50.0, abs=2.0)
+
+
+def test_interface_show_lists_miros_own_fields():
+    out = subprocess.run([sys.executable, '-m', 'miro_ball.ros2', 'interface', 'show',
+                          'miro2_msg/msg/SensorsPackage'], capture_output=True, text=True,
+                         timeout=60)
+    assert out.returncode == 0
+    top = [line.split()[1] for line in out.stdout.splitlines()
+           if line and not line.startswith(('#', '\t'))]
+    assert top[:3] == ['header', 'battery', 'cliff'] and top[-1] == 'body_pose'
+    assert '\tfloat32 voltage' in out.stdout  # BatteryState expanded under battery
+
+
+def test_params_and_services_of_the_simulator(paused_sim, executor):
+    code, out, _ = ros2(['param', 'get', SIM, 'camera_rate'], paused_sim, executor)
+    assert code == 0 and out.strip() == 'Double value is: 15.0'
+    code, out, _ = ros2(['param', 'list', SIM], paused_sim, executor)
+    assert code == 0 and '  camera_rate' in out.splitlines()
+    code, out, _ = ros2(['param', 'set', SIM, 'camera_rate', '10'], paused_sim, executor)
+    assert code == 1 and 'Setting parameter failed' in out  # read at start only: said so
+    paused_sim.robots[T.name].robot.set_cmd_vel(0.3, 0.0)
+    advance_until(paused_sim, executor, lambda: paused_sim.sim.robots[T.name].pose()[0] > 0.05)
+    code, out, _ = ros2(['service', 'call', f'{SIM}/reset', 'std_srvs/srv/Trigger'],
+                        paused_sim, executor)
+    assert code == 0 and 'success=True' in out.split('response:')[1]
+    assert abs(paused_sim.sim.robots[T.name].pose()[0]) < 0.01  # back where it started
+
+
+@pytest.mark.parametrize('args,says', [
+    (['topic', 'echo', '/nothing/here', '--once'], 'no topic /nothing/here'),
+    (['topic', 'echo', T.odom, '--once', '--field', 'pose.x'], "no field 'x'"),
+    (['topic', 'pub', T.cmd_vel, 'geometry_msgs/msg/TwistStamped', '{twist: {linar: {}}}',
+      '--once'], "no field 'twist.linar'"),
+    (['topic', 'pub', T.cmd_vel, 'geometry_msgs/msg/TwistStamped', '{twist: [', '--once'],
+     'not valid YAML'),
+    (['topic', 'pub', T.cmd_vel, 'geometry_msgs/msg/Twistt', '{}', '--once'],
+     'no interface geometry_msgs/msg/Twistt'),
+    (['interface', 'show', 'nonsense'], 'is not a type name'),
+    (['param', 'get', '/no_such_node', 'x'], 'no node /no_such_node'),
+])
+def test_bad_input_is_one_line_and_exit_1(args, says, paused_sim, executor):
+    code, out, err = ros2(args, paused_sim, executor)
+    assert code == 1 and says in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_a_typo_in_a_verb_or_option_is_refused_with_exit_2():
+    for args in (['topic', 'lst'], ['topic', 'echo'], ['topic', 'pub', '/x', 'T', '{}', '-r',
+                                                       'nan']):
+        out = subprocess.run([sys.executable, '-m', 'miro_ball.ros2', *args],
+                             capture_output=True, text=True, timeout=60)
+        assert out.returncode == 2 and 'Traceback' not in out.stderr

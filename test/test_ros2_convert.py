@@ -1,0 +1,50 @@
+"""The ros2 command line's message <-> YAML conversion and interface text, without a graph."""
+import math
+
+import pytest
+import yaml
+from geometry_msgs.msg import PoseArray, TwistStamped
+from sensor_msgs.msg import Image
+from std_msgs.msg import Float32MultiArray
+
+from miro_ball.common.definitions import expanded
+from miro_ball.ros2.convert import field, fill, parse_yaml, to_data, to_yaml
+
+
+def test_yaml_round_trips_a_message_in_field_order():
+    msg = fill(TwistStamped(), parse_yaml('{header: {frame_id: miro/base_link}, '
+                                          'twist: {linear: {x: 0.2}, angular: {z: -1}}}'))
+    text = to_yaml(to_data(msg))
+    assert text.splitlines()[:2] == ['header:', '  stamp:']
+    assert fill(TwistStamped(), yaml.safe_load(text)) == msg
+    assert field(msg, 'twist.angular.z') == -1.0
+
+
+def test_long_arrays_are_cut_as_ros2_echo_cuts_them_and_nan_is_yaml():
+    data = to_data(Image(data=bytes(300)))
+    assert len(data['data']) == 129 and data['data'][-1] == '...'
+    assert math.isnan(yaml.safe_load(to_yaml(to_data(Float32MultiArray(data=[math.nan]))))
+                      ['data'][0])
+
+
+def test_a_list_of_messages_is_filled_from_a_list_of_mappings():
+    msg = fill(PoseArray(), {'poses': [{'position': {'x': 1.0}}, {}]})
+    assert [p.position.x for p in msg.poses] == [1.0, 0.0]
+
+
+@pytest.mark.parametrize('values,says', [
+    ({'twist': {'linar': {}}}, "no field 'twist.linar'"),
+    ({'twist': {'linear': {'x': 'fast'}}}, 'give a number'),
+    ({'twist': 3}, 'give a mapping'),
+    ({'header': {'stamp': {'sec': 1.5}}}, 'give an integer'),
+])
+def test_a_value_that_does_not_fit_is_named(values, says):
+    with pytest.raises(ValueError, match=says):
+        fill(TwistStamped(), values)
+
+
+def test_interface_text_expands_nested_types_a_tab_in():
+    lines = expanded('geometry_msgs/msg/TwistStamped')
+    assert 'std_msgs/Header header' in lines and '\t\tint32 sec' in lines
+    with pytest.raises(ValueError, match='not a type name'):
+        expanded('twist')
