@@ -5,6 +5,7 @@ Python environment's own prefix (where the ROS wheels and build_interfaces put t
 Used where a definition is shown (``ros2 interface show``) or stored (a bag's types, which
 rosbags knows for ROS 2's own packages but not for miro2_msg).
 """
+import functools
 import os
 import sys
 from pathlib import Path
@@ -51,6 +52,23 @@ def package_messages(package):
             return {f'{package}/msg/{path.stem}': path.read_text()
                     for path in sorted(folder.glob('*.msg'))}
     return {}
+
+
+@functools.cache
+def typestore():
+    """rosbags' typestore of ROS 2 Jazzy's types and ours that are built: what a bag or a
+    Foxglove channel says a type is (ros2msg definitions), and how CDR bytes decode."""
+    from rosbags.typesys import get_typestore, Stores
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+    register_own_types(store)
+    return store
+
+
+def ros2msg(type_name):
+    """A type's full definition as bags and Foxglove carry it (dependencies appended);
+    KeyError if the type is unknown."""
+    return typestore().generate_msgdef(type_name, ros_version=2)[0]
 
 
 def register_own_types(typestore):

@@ -26,13 +26,11 @@ from pathlib import Path
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, \
     QosReliability, QosTime
 from rosbags.rosbag2 import StoragePlugin, Writer
-from rosbags.typesys import Stores, get_typestore
 from ruamel.yaml import YAML
 
-from miro_ball.common.definitions import register_own_types
+from miro_ball.common.definitions import typestore
 
-TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
-register_own_types(TYPESTORE)  # miro2_msg, when it is built: rosbags knows only ROS 2's own
+TYPESTORE = typestore()  # ROS 2 Jazzy's types and miro2_msg's, when it is built
 METADATA = 'metadata.yaml'
 INFO = 'rosbag2_bagfile_information'
 UNFINISHED = '.unfinished'  # the split being written: hidden, never listed

@@ -1,0 +1,1 @@
+"""The live ROS graph for the Foxglove app (python -m miro_ball.foxglove)."""

@@ -1,0 +1,67 @@
+"""python -m miro_ball.foxglove: serve the running simulation to the Foxglove app.
+
+Open Foxglove, "Open connection", "Foxglove WebSocket", ws://127.0.0.1:8765: every topic of
+every robot is there with its ROS 2 type (the eyes, odometry, the sensors, sensors/package,
+the scene, /tf when published), decoded by the app as from a ROS 2 bag. docs/foxglove.md has
+a layout with both eyes, the 3D scene and the wheel speeds.
+"""
+import argparse
+import sys
+
+from miro_ball.common.cli import user_args
+from miro_ball.common.stopping import spin_until_stopped, StopRequest
+
+PROG = 'python -m miro_ball.foxglove'
+DEFAULT_HOST, DEFAULT_PORT = '127.0.0.1', 8765
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(prog=PROG, description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('--host', default=DEFAULT_HOST,
+                        help=f'address to listen on ({DEFAULT_HOST}: this machine only)')
+    parser.add_argument('--port', type=int, default=DEFAULT_PORT,
+                        help=f'port ({DEFAULT_PORT}, Foxglove\'s default); 0: any free port')
+    parser.add_argument('--allow-publish', action='store_true',
+                        help="let Foxglove publish (its Teleop panel on control/cmd_vel); off "
+                             'by default: a viewer drives nothing')
+    parser.add_argument('--topics', nargs='+', default=['*'], metavar='PATTERN',
+                        help="offer only these topics (fnmatch patterns: '/miro/*')")
+    return parser
+
+
+def main(argv=None):
+    argv = sys.argv if argv is None else argv
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.signals import SignalHandlerOptions
+
+    parser = build_parser()
+    args = parser.parse_args(user_args(argv, PROG))
+    if not 0 <= args.port <= 65535:
+        parser.error(f'--port must be in 0..65535, got {args.port}')
+    stop = StopRequest()
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    from miro_ball.foxglove.bridge import FoxgloveBridge
+
+    try:
+        bridge = FoxgloveBridge(args.host, args.port, args.allow_publish, args.topics)
+    except RuntimeError as err:  # the SDK's error when the port is taken
+        print(f'{PROG}: cannot serve on {args.host}:{args.port}: {err}', file=sys.stderr)
+        rclpy.try_shutdown()
+        return 1
+    print(f'{PROG}: Foxglove can connect to ws://{args.host}:{bridge.port}'
+          + (' (clients may publish)' if args.allow_publish else ''), flush=True)
+    executor = SingleThreadedExecutor()
+    executor.add_node(bridge)
+    try:
+        spin_until_stopped(executor, stop)
+    finally:
+        bridge.close()
+        bridge.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

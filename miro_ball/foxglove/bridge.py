@@ -1,0 +1,184 @@
+"""The ROS graph as Foxglove sees it: every topic a channel of the Foxglove SDK's WebSocket
+server (ros2msg schema, CDR data, so the app decodes them as it decodes a ROS 2 bag).
+
+A topic is subscribed to in ROS only while some Foxglove client subscribes to its channel:
+with nobody watching, the bridge reads nothing, and the simulator draws no eye for it. The
+server calls the listener from its own threads; those calls only queue work, which the
+node's timer does in the ROS thread (rclpy's entities are made and destroyed there).
+
+Messages are stamped with simulated time (the latest /clock) when a simulator runs, and the
+server tells clients that time, so Foxglove's timeline is the world's.
+"""
+import fnmatch
+import queue
+
+import foxglove
+from foxglove.websocket import Capability, ServerListener
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+
+from miro_ball.common.definitions import ros2msg
+from miro_ball.common.messages import message_class
+from miro_ball.miro.interface import CLOCK, CLOCK_QOS
+from miro_ball.common.qos import profile
+from miro_ball.common.throttle import Throttled
+
+NODE_NAME = 'miro_foxglove'
+DISCOVERY_PERIOD_S = 1.0  # wall seconds between looks for new topics
+WORK_PERIOD_S = 0.02  # how soon a client's subscribe reaches ROS
+MAX_QUEUED = 1000  # client requests waiting for the ROS thread (a flood is dropped)
+
+
+class Listener(ServerListener):
+    """The server's callbacks: each queues (verb, argument) for the ROS thread."""
+
+    def __init__(self, work, warn):
+        self.work = work
+        self.warn = warn
+
+    def _put(self, item):
+        try:
+            self.work.put_nowait(item)
+        except queue.Full:
+            self.warn('flood', 'Foxglove clients send more than can be handled: dropped')
+
+    def on_subscribe(self, client, channel):
+        self._put(('subscribe', channel.topic))
+
+    def on_unsubscribe(self, client, channel):
+        self._put(('unsubscribe', channel.topic))
+
+    def on_client_advertise(self, client, channel):
+        self._put(('advertise', (client.id, channel.id, channel.topic, channel.schema_name,
+                                 channel.encoding)))
+
+    def on_client_unadvertise(self, client, client_channel_id):
+        self._put(('unadvertise', (client.id, client_channel_id)))
+
+    def on_message_data(self, client, client_channel_id, data):
+        self._put(('publish', (client.id, client_channel_id, bytes(data))))
+
+
+class FoxgloveBridge(Node):
+    """See the module docstring. allow_publish: clients may publish (their advertised
+    channels become ROS publishers); topics: fnmatch patterns of what to offer (all)."""
+
+    def __init__(self, host, port, allow_publish=False, topics=('*',), context=None):
+        super().__init__(NODE_NAME, context=context)
+        self.patterns = tuple(topics)
+        self.allow_publish = allow_publish
+        self.channels = {}  # topic -> foxglove.Channel
+        self.watchers = {}  # topic -> (subscription, how many client subscriptions)
+        self.client_publishers = {}  # (client id, client channel id) -> (ROS publisher, topic)
+        self.sim_ns = None  # the latest /clock
+        self.work = queue.Queue(MAX_QUEUED)
+        self._warn = Throttled(self.get_logger().warning)
+        capabilities = [Capability.Time] + ([Capability.ClientPublish] if allow_publish else [])
+        self.server = foxglove.start_server(
+            name='miro_ball', host=host, port=port, capabilities=capabilities,
+            server_listener=Listener(self.work, self._warn),
+            supported_encodings=['cdr'] if allow_publish else None)
+        self.port = self.server.port
+        self.create_subscription(Clock, CLOCK, self._on_clock, profile(CLOCK_QOS))
+        self.create_timer(DISCOVERY_PERIOD_S, self.discover)
+        self.create_timer(WORK_PERIOD_S, self.do_work)
+        self.discover()
+
+    def close(self):
+        self.server.stop()
+        for channel in self.channels.values():
+            channel.close()
+
+    def _on_clock(self, msg):
+        self.sim_ns = msg.clock.sec * 10**9 + msg.clock.nanosec
+        self.server.broadcast_time(self.sim_ns)
+
+    def offered(self, topic):
+        return any(fnmatch.fnmatchcase(topic, p) for p in self.patterns)
+
+    def discover(self):
+        """A channel for every topic of the graph that has a publisher and a known type."""
+        for topic, types in self.get_topic_names_and_types():
+            if topic in self.channels or not self.offered(topic) \
+                    or not self.count_publishers(topic):
+                continue
+            try:
+                schema = ros2msg(types[0])
+            except KeyError:
+                self._warn(f'type:{types[0]}', f'{topic}: type {types[0]} unknown to the '
+                           'bridge: not offered')
+                continue
+            self.channels[topic] = foxglove.Channel(
+                topic, message_encoding='cdr',
+                schema=foxglove.Schema(name=types[0], encoding='ros2msg',
+                                       data=schema.encode()))
+
+    def do_work(self):
+        while True:
+            try:
+                verb, argument = self.work.get_nowait()
+            except queue.Empty:
+                return
+            getattr(self, f'_{verb}')(argument)
+
+    def _subscribe(self, topic):
+        if topic in self.watchers:
+            sub, count = self.watchers[topic]
+            self.watchers[topic] = (sub, count + 1)
+            return
+        infos = self.get_publishers_info_by_topic(topic)
+        if not infos:
+            return
+        reliable = all(i.qos_profile.reliability == ReliabilityPolicy.RELIABLE for i in infos)
+        qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE if reliable
+                         else ReliabilityPolicy.BEST_EFFORT)
+        channel = self.channels[topic]
+        sub = self.create_subscription(
+            message_class(infos[0].topic_type), topic,
+            lambda data: channel.log(data, log_time=self.sim_ns), qos, raw=True)
+        self.watchers[topic] = (sub, 1)
+        self.get_logger().info(f'a Foxglove client watches {topic}')
+
+    def _unsubscribe(self, topic):
+        if topic not in self.watchers:
+            return
+        sub, count = self.watchers[topic]
+        if count > 1:
+            self.watchers[topic] = (sub, count - 1)
+            return
+        self.destroy_subscription(sub)
+        del self.watchers[topic]
+
+    def _advertise(self, argument):
+        client, channel_id, topic, type_name, encoding = argument
+        if not self.allow_publish:
+            return
+        try:
+            msg_class = message_class(type_name)
+        except ValueError:
+            self._warn('advertise', f'a Foxglove client offers {topic} as {type_name!r}, '
+                       'not a ROS 2 type here: ignored')
+            return
+        if encoding != 'cdr':
+            self._warn('advertise', f'a Foxglove client offers {topic} in {encoding!r}, '
+                       'not cdr: ignored')
+            return
+        self.client_publishers[client, channel_id] = (self.create_publisher(msg_class, topic, 10),
+                                               topic)
+
+    def _unadvertise(self, argument):
+        publisher = self.client_publishers.pop(argument, None)
+        if publisher is not None:
+            self.destroy_publisher(publisher[0])
+
+    def _publish(self, argument):
+        client, channel_id, data = argument
+        publisher = self.client_publishers.get((client, channel_id))
+        if publisher is None:
+            return
+        try:
+            publisher[0].publish(data)
+        except Exception as err:  # rclpy's errors for undecodable bytes have no public class
+            self._warn('publish', f'a Foxglove message on {publisher[1]} was not valid CDR: '
+                       f'{err}')

@@ -1,0 +1,119 @@
+"""python -m miro_ball.foxglove: a client of Foxglove's WebSocket protocol (what the app does:
+serverInfo, advertise, subscribe, binary message data) sees the robot's topics with their
+ROS 2 schemas and gets CDR data for what it subscribes to, and only then does ROS read it."""
+import json
+import struct
+
+import pytest
+from nav_msgs.msg import Odometry
+from geometry_msgs.msg import TwistStamped
+from rclpy.serialization import deserialize_message, serialize_message
+from websockets.sync.client import connect
+
+from miro_ball.foxglove.bridge import FoxgloveBridge
+from miro_ball.miro.interface import default_robot_name, RobotTopics
+from rostools import advance_ticks
+
+T = RobotTopics(default_robot_name())
+MESSAGE_DATA = 1  # the binary opcode of a message on a subscription
+
+
+@pytest.fixture(params=[False])
+def bridge(request, ros_context, executor):
+    node = FoxgloveBridge('127.0.0.1', 0, allow_publish=request.param, context=ros_context)
+    executor.add_node(node)
+    yield node
+    executor.remove_node(node)
+    node.close()
+    node.destroy_node()
+
+
+def receive(ws, paused_sim, executor, until, ticks=500):
+    """Step the world, collecting what the server sends, until until(texts, frames)."""
+    texts, frames = [], []
+    for _ in range(ticks):
+        advance_ticks(paused_sim, executor)
+        while True:
+            try:
+                message = ws.recv(timeout=0.01)
+            except TimeoutError:
+                break
+            (frames if isinstance(message, bytes) else texts).append(message)
+        if until(texts, frames):
+            return texts, frames
+    raise AssertionError(f'not received after {ticks} ticks: {texts[:3]}')
+
+
+def channels_of(texts):
+    return {c['topic']: c for text in texts for c in json.loads(text).get('channels', [])
+            if json.loads(text)['op'] == 'advertise'}
+
+
+def test_a_client_is_advertised_the_robots_topics_and_gets_what_it_subscribes(
+        paused_sim, executor, bridge):
+    eye = T.eye_compressed('caml')
+    with connect(f'ws://127.0.0.1:{bridge.port}', subprotocols=['foxglove.sdk.v1']) as ws:
+        texts, _ = receive(ws, paused_sim, executor,
+                           lambda texts, _: {eye, T.odom, T.package} <= set(channels_of(texts)))
+        assert json.loads(texts[0])['op'] == 'serverInfo'
+        channels = channels_of(texts)
+        odom = channels[T.odom]
+        assert (odom['encoding'], odom['schemaName'], odom['schemaEncoding']) == \
+            ('cdr', 'nav_msgs/msg/Odometry', 'ros2msg')
+        assert 'geometry_msgs/PoseWithCovariance pose' in odom['schema']
+        assert channels[T.package]['schemaName'] == 'miro2_msg/msg/SensorsPackage'
+        # Nobody watches yet: the bridge reads nothing, and no eye is drawn for it.
+        eye_pub = paused_sim.robots[T.name].pub_eyes['caml'][0]
+        assert eye_pub.get_subscription_count() == 0 and not bridge.watchers
+        ws.send(json.dumps({'op': 'subscribe', 'subscriptions': [
+            {'id': 1, 'channelId': odom['id']}, {'id': 2, 'channelId': channels[eye]['id']}]}))
+
+        def data(frames, subscription):
+            return [f for f in frames if f[0] == MESSAGE_DATA
+                    and struct.unpack_from('<I', f, 1)[0] == subscription]
+
+        _, frames = receive(ws, paused_sim, executor,
+                            lambda _, frames: len(data(frames, 1)) >= 3 and data(frames, 2))
+        assert eye_pub.get_subscription_count() == 1  # drawn now, for the client
+        frame = data(frames, 1)[-1]
+        log_time = struct.unpack_from('<Q', frame, 5)[0]
+        msg = deserialize_message(frame[13:], Odometry)
+        assert msg.header.frame_id == f'{T.name}/odom'
+        assert log_time == pytest.approx(paused_sim.sim.time * 1e9, abs=0.1e9)  # simulated
+        assert data(frames, 2)[-1][13:][4:8] != b''  # a CompressedImage's bytes
+        ws.send(json.dumps({'op': 'unsubscribe', 'subscriptionIds': [2]}))
+        receive(ws, paused_sim, executor, lambda *_: eye_pub.get_subscription_count() == 0)
+
+
+@pytest.mark.parametrize('bridge', [True, False], indirect=True)
+def test_teleop_from_foxglove_drives_miro_only_when_allowed(paused_sim, executor, bridge):
+    robot = paused_sim.sim.robots[T.name]
+    twist = TwistStamped()
+    twist.twist.linear.x = 0.2
+    with connect(f'ws://127.0.0.1:{bridge.port}', subprotocols=['foxglove.sdk.v1']) as ws:
+        receive(ws, paused_sim, executor, lambda texts, _: T.odom in channels_of(texts))
+        ws.send(json.dumps({'op': 'advertise', 'channels': [
+            {'id': 5, 'topic': T.cmd_vel, 'encoding': 'cdr',
+             'schemaName': 'geometry_msgs/msg/TwistStamped'}]}))
+        advance_ticks(paused_sim, executor, 5)
+        for _ in range(50):  # a teleop panel sends at its own rate
+            ws.send(struct.pack('<BI', MESSAGE_DATA, 5) + serialize_message(twist))
+            advance_ticks(paused_sim, executor)
+    moved = robot.pose()[0]
+    assert moved > 0.05 if bridge.allow_publish else abs(moved) < 0.01
+
+
+def test_the_layout_in_docs_shows_topics_that_exist():
+    from pathlib import Path
+
+    from miro_ball.miro.interface import SimTopics
+
+    layout = json.loads((Path(__file__).parent.parent / 'docs' / 'foxglove_layout.json')
+                        .read_text())
+    text = json.dumps(layout['configById'])
+    named = {t for t in RobotTopics('miro').all() + [SimTopics().scene] if f'"{t}' in text}
+    robot = RobotTopics('miro')
+    assert {robot.eye_compressed('caml'), robot.eye_compressed('camr'), robot.wheel_speed_opto,
+            robot.wheel_speed_cmd, SimTopics().scene} <= named
+    panels = json.dumps(layout['layout'])
+    assert all(panel in panels for panel in layout['configById'])
