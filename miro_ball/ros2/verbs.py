@@ -41,11 +41,16 @@ def absolute(name):
     return name if name.startswith('/') else '/' + name
 
 
+def print_listing(listing, show_types):
+    """'name' or 'name [type, ...]' a line, sorted: ros2's topic and service lists."""
+    for name, types in sorted(listing.items()):
+        print(f'{name} [{", ".join(types)}]' if show_types else name)
+    return 0
+
+
 # -- topic ------------------------------------------------------------------------------------
 def topic_list(args, graph):
-    for name, types in sorted(graph.settle(graph.topics).items()):
-        print(f'{name} [{", ".join(types)}]' if args.show_types else name)
-    return 0
+    return print_listing(graph.settle(graph.topics), args.show_types)
 
 
 def topic_info(args, graph):
@@ -219,9 +224,7 @@ def param_set(args, graph):
 
 # -- service, interface -----------------------------------------------------------------------
 def service_list(args, graph):
-    for name, types in sorted(graph.settle(graph.services).items()):
-        print(f'{name} [{", ".join(types)}]' if args.show_types else name)
-    return 0
+    return print_listing(graph.settle(graph.services), args.show_types)
 
 
 def service_call(args, graph):
