@@ -28,6 +28,13 @@ def bridge(request, ros_context, executor):
     node.destroy_node()
 
 
+def client(bridge):
+    """A connection as the app makes it. After a client has advertised, the SDK's server does
+    not answer the closing handshake (0.30.3): a short close timeout, not websockets' 10 s."""
+    return connect(f'ws://127.0.0.1:{bridge.port}', subprotocols=['foxglove.sdk.v1'],
+                   close_timeout=0.5)
+
+
 def receive(ws, paused_sim, executor, until, ticks=500):
     """Step the world, collecting what the server sends, until until(texts, frames)."""
     texts, frames = [], []
@@ -52,7 +59,7 @@ def channels_of(texts):
 def test_a_client_is_advertised_the_robots_topics_and_gets_what_it_subscribes(
         paused_sim, executor, bridge):
     eye = T.eye_compressed('caml')
-    with connect(f'ws://127.0.0.1:{bridge.port}', subprotocols=['foxglove.sdk.v1']) as ws:
+    with client(bridge) as ws:
         texts, _ = receive(ws, paused_sim, executor,
                            lambda texts, _: {eye, T.odom, T.package} <= set(channels_of(texts)))
         assert json.loads(texts[0])['op'] == 'serverInfo'
@@ -90,12 +97,16 @@ def test_teleop_from_foxglove_drives_miro_only_when_allowed(paused_sim, executor
     robot = paused_sim.sim.robots[T.name]
     twist = TwistStamped()
     twist.twist.linear.x = 0.2
-    with connect(f'ws://127.0.0.1:{bridge.port}', subprotocols=['foxglove.sdk.v1']) as ws:
+    with client(bridge) as ws:
         receive(ws, paused_sim, executor, lambda texts, _: T.odom in channels_of(texts))
         ws.send(json.dumps({'op': 'advertise', 'channels': [
             {'id': 5, 'topic': T.cmd_vel, 'encoding': 'cdr',
              'schemaName': 'geometry_msgs/msg/TwistStamped'}]}))
         advance_ticks(paused_sim, executor, 5)
+        for garbage in (b'', b'\x00\x01', bytes(range(256)) * 40):  # dropped, with a warning
+            ws.send(struct.pack('<BI', MESSAGE_DATA, 5) + garbage)
+        advance_ticks(paused_sim, executor, 5)
+        assert abs(robot.pose()[0]) < 0.01
         for _ in range(50):  # a teleop panel sends at its own rate
             ws.send(struct.pack('<BI', MESSAGE_DATA, 5) + serialize_message(twist))
             advance_ticks(paused_sim, executor)

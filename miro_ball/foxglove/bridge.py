@@ -16,6 +16,7 @@ import foxglove
 from foxglove.websocket import Capability, ServerListener
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.serialization import deserialize_message
 from rosgraph_msgs.msg import Clock
 
 from miro_ball.common.definitions import ros2msg
@@ -164,8 +165,8 @@ class FoxgloveBridge(Node):
             self._warn('advertise', f'a Foxglove client offers {topic} in {encoding!r}, '
                        'not cdr: ignored')
             return
-        self.client_publishers[client, channel_id] = (self.create_publisher(msg_class, topic, 10),
-                                               topic)
+        self.client_publishers[client, channel_id] = (
+            self.create_publisher(msg_class, topic, 10), topic, msg_class)
 
     def _unadvertise(self, argument):
         publisher = self.client_publishers.pop(argument, None)
@@ -174,11 +175,15 @@ class FoxgloveBridge(Node):
 
     def _publish(self, argument):
         client, channel_id, data = argument
-        publisher = self.client_publishers.get((client, channel_id))
-        if publisher is None:
+        advertised = self.client_publishers.get((client, channel_id))
+        if advertised is None:
             return
+        publisher, topic, msg_class = advertised
+        # Decoded here, so that bytes that are no such message never reach a subscriber.
         try:
-            publisher[0].publish(data)
-        except Exception as err:  # rclpy's errors for undecodable bytes have no public class
-            self._warn('publish', f'a Foxglove message on {publisher[1]} was not valid CDR: '
-                       f'{err}')
+            msg = deserialize_message(data, msg_class)
+        except Exception as err:  # rclpy's error for undecodable bytes has no public class
+            self._warn('publish', f'a Foxglove message on {topic} is not a CDR '
+                       f'{msg_class.__name__}: dropped ({type(err).__name__})')
+            return
+        publisher.publish(msg)
