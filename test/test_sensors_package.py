@@ -60,3 +60,28 @@ def test_package_is_50_hz_and_holds_the_ticks_separate_readings(paused_sim, ros_
             assert getattr(tick, field) == messages[k], field
     assert package[-1].body_pose.x > 0.05  # it moved: the values are live
     assert package[-1].battery.voltage > 4.0
+
+
+def test_without_miro2_msg_the_simulator_runs_without_the_package_and_says_so(
+        make_sim, ros_context, executor, monkeypatch, capfd):
+    """A machine with no compiler has no miro2_msg: every other stream is there."""
+    from miro_ball.common import messages
+    from miro_sim_bullet.ros import robot_interface
+
+    def without_miro2_msg(type_name):
+        if type_name.startswith('miro2_msg/'):
+            raise ValueError(f'no ROS message type {type_name!r}')
+        return messages.message_class(type_name)
+
+    monkeypatch.setattr(robot_interface, 'message_class', without_miro2_msg)
+    node = make_sim()
+    interface = node.robots[T.name]
+    assert [row.key for row in interface.missing_types] == ['package']
+    with pytest.raises(KeyError):
+        interface.publisher('package')
+    assert 'sensors/package not published: its type miro2_msg/msg/SensorsPackage is not ' \
+           'installed (build it: python -m miro_ball.build_interfaces)' in capfd.readouterr().err
+    odom = Probe(ros_context, executor).watch(Odometry, T.odom)
+    spin_until(executor, lambda: interface.publisher('odom').get_subscription_count() > 0)
+    advance_ticks(node, executor, 5)
+    assert spin_until(executor, lambda: len(odom) == 5)
