@@ -8,10 +8,11 @@ import pytest
 from nav_msgs.msg import Odometry
 from geometry_msgs.msg import TwistStamped
 from rclpy.serialization import deserialize_message, serialize_message
+from tf2_msgs.msg import TFMessage
 from websockets.sync.client import connect
 
 from miro_ball.foxglove.bridge import FoxgloveBridge
-from miro_ball.miro.interface import default_robot_name, RobotTopics
+from miro_ball.miro.interface import default_robot_name, RobotTopics, TF, TF_STATIC
 from rostools import advance_ticks
 
 T = RobotTopics(default_robot_name())
@@ -61,7 +62,8 @@ def test_a_client_is_advertised_the_robots_topics_and_gets_what_it_subscribes(
     eye = T.eye_compressed('caml')
     with client(bridge) as ws:
         texts, _ = receive(ws, paused_sim, executor,
-                           lambda texts, _: {eye, T.odom, T.package} <= set(channels_of(texts)))
+                           lambda texts, _: {eye, T.odom, T.package, TF, TF_STATIC}
+                           <= set(channels_of(texts)))
         assert json.loads(texts[0])['op'] == 'serverInfo'
         channels = channels_of(texts)
         odom = channels[T.odom]
@@ -73,14 +75,16 @@ def test_a_client_is_advertised_the_robots_topics_and_gets_what_it_subscribes(
         eye_pub = paused_sim.robots[T.name].pub_eyes['caml'][0]
         assert eye_pub.get_subscription_count() == 0 and not bridge.watchers
         ws.send(json.dumps({'op': 'subscribe', 'subscriptions': [
-            {'id': 1, 'channelId': odom['id']}, {'id': 2, 'channelId': channels[eye]['id']}]}))
+            {'id': 1, 'channelId': odom['id']}, {'id': 2, 'channelId': channels[eye]['id']},
+            {'id': 3, 'channelId': channels[TF_STATIC]['id']}]}))
 
         def data(frames, subscription):
             return [f for f in frames if f[0] == MESSAGE_DATA
                     and struct.unpack_from('<I', f, 1)[0] == subscription]
 
         _, frames = receive(ws, paused_sim, executor,
-                            lambda _, frames: len(data(frames, 1)) >= 3 and data(frames, 2))
+                            lambda _, frames: len(data(frames, 1)) >= 3 and data(frames, 2)
+                            and data(frames, 3))
         assert eye_pub.get_subscription_count() == 1  # drawn now, for the client
         frame = data(frames, 1)[-1]
         log_time = struct.unpack_from('<Q', frame, 5)[0]
@@ -88,6 +92,9 @@ def test_a_client_is_advertised_the_robots_topics_and_gets_what_it_subscribes(
         assert msg.header.frame_id == f'{T.name}/odom'
         assert log_time == pytest.approx(paused_sim.sim.time * 1e9, abs=0.1e9)  # simulated
         assert data(frames, 2)[-1][13:][4:8] != b''  # a CompressedImage's bytes
+        # /tf_static went out at the start: the bridge's subscription still gets it (latched).
+        static = deserialize_message(data(frames, 3)[0][13:], TFMessage)
+        assert [t.child_frame_id for t in static.transforms] == [f'{T.name}/odom']
         ws.send(json.dumps({'op': 'unsubscribe', 'subscriptionIds': [2]}))
         receive(ws, paused_sim, executor, lambda *_: eye_pub.get_subscription_count() == 0)
 

@@ -15,14 +15,13 @@ import queue
 import foxglove
 from foxglove.websocket import Capability, ServerListener
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from rosgraph_msgs.msg import Clock
 
 from miro_ball.common.definitions import ros2msg
 from miro_ball.common.messages import message_class
 from miro_ball.miro.interface import CLOCK, CLOCK_QOS
-from miro_ball.common.qos import profile
+from miro_ball.common.qos import matching, profile
 from miro_ball.common.throttle import Throttled
 
 NODE_NAME = 'miro_foxglove'
@@ -131,13 +130,10 @@ class FoxgloveBridge(Node):
         infos = self.get_publishers_info_by_topic(topic)
         if not infos:
             return
-        reliable = all(i.qos_profile.reliability == ReliabilityPolicy.RELIABLE for i in infos)
-        qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE if reliable
-                         else ReliabilityPolicy.BEST_EFFORT)
         channel = self.channels[topic]
         sub = self.create_subscription(
             message_class(infos[0].topic_type), topic,
-            lambda data: channel.log(data, log_time=self.sim_ns), qos, raw=True)
+            lambda data: channel.log(data, log_time=self.sim_ns), matching(infos), raw=True)
         self.watchers[topic] = (sub, 1)
         self.get_logger().info(f'a Foxglove client watches {topic}')
 

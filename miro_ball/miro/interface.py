@@ -35,11 +35,13 @@ _TOKEN = re.compile(r'[A-Za-z][A-Za-z0-9_]*\Z')
 
 @dataclass(frozen=True)
 class Qos:
-    """A QoS profile in plain words: keep the newest ``depth``, reliable or best effort
-    (volatile: a late subscriber gets nothing from before)."""
+    """A QoS profile in plain words: keep the newest ``depth``, reliable or best effort;
+    volatile (a late subscriber gets nothing from before) unless ``latched`` (transient
+    local: a late subscriber gets the last ``depth`` messages, as /tf_static)."""
 
     depth: int
     reliable: bool = True
+    latched: bool = False
 
 
 # The eyes: the newest frame only (a late frame is worth less than none), reliable so
@@ -49,6 +51,13 @@ EYE_QOS = Qos(depth=1)
 SENSOR_QOS = Qos(depth=10)  # the 50 Hz platform topics, ROS's default
 CONTROL_QOS = Qos(depth=10)
 CLOCK_QOS = Qos(depth=10)  # matches rclpy's own best-effort /clock subscription
+
+# Where every robot is, for ROS's tools (tf2, RViz, Foxglove): global topics, frames named
+# with the robot (frame_id). tf2_msgs is built at set-up (build_interfaces), as miro2_msg.
+TF, TF_STATIC = '/tf', '/tf_static'
+TF_TYPE = 'tf2_msgs/msg/TFMessage'
+TF_QOS = Qos(depth=100)  # tf2's own
+TF_STATIC_QOS = Qos(depth=1, latched=True)
 
 SENSOR, CONTROL = 'sensor', 'control'  # out of the robot, into the robot
 PLATFORM_HZ = 50.0  # MiRo's platform tick: its sensors, /clock
@@ -140,7 +149,8 @@ TOPIC = {row.key: row for row in ROBOT_INTERFACE}
 # The frames of one robot, each prefixed with the robot's name (frame_id):
 #   <robot>/odom -> <robot>/base_link -> <robot>/imu_body, <robot>/imu_head, <robot>/sonar,
 #                                        <robot>/caml_optical, <robot>/camr_optical
-# beside the simulator's 'world' frame, which carries no robot (docs/frames.md).
+# beside the simulator's 'world' frame, which carries no robot (docs/frames.md). /tf_static
+# holds world -> <robot>/odom, /tf <robot>/odom -> <robot>/base_link.
 
 
 def check_name(name, what='robot name'):

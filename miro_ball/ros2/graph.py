@@ -10,7 +10,8 @@ import time
 
 import rclpy
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+from miro_ball.common.qos import matching
 
 DISCOVERY_S = 1.5  # wall seconds a listing listens before it answers
 STABLE_S = 0.5  # wall seconds a listing must stay the same to be the answer
@@ -82,17 +83,8 @@ class Graph:
         return types[0]
 
     def qos_for(self, topic):
-        """A subscription QoS every publisher of topic matches: best effort if any offers
-        only that, transient local if all keep their last messages (as ros2 topic echo)."""
-        infos = self.node.get_publishers_info_by_topic(topic)
-        reliable = all(i.qos_profile.reliability == ReliabilityPolicy.RELIABLE for i in infos)
-        latched = bool(infos) and all(i.qos_profile.durability ==
-                                      DurabilityPolicy.TRANSIENT_LOCAL for i in infos)
-        return QoSProfile(depth=10,
-                          reliability=ReliabilityPolicy.RELIABLE if reliable
-                          else ReliabilityPolicy.BEST_EFFORT,
-                          durability=DurabilityPolicy.TRANSIENT_LOCAL if latched
-                          else DurabilityPolicy.VOLATILE)
+        """A subscription QoS every publisher of topic matches (common.qos.matching)."""
+        return matching(self.node.get_publishers_info_by_topic(topic))
 
     def nodes(self):
         """['/namespace/name'] of every node but this one, sorted."""

@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 from builtin_interfaces.msg import Time
-from geometry_msgs.msg import PointStamped, Pose2D, PoseStamped
+from geometry_msgs.msg import PointStamped, Pose2D, PoseStamped, TransformStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState, \
     Range
@@ -41,6 +41,24 @@ def odometry(s, when, robot):
     o = msg.pose.pose.orientation
     o.x, o.y, o.z, o.w = yaw_quaternion(yaw)
     msg.twist.twist.linear.x, msg.twist.twist.angular.z = forward, turn
+    return msg
+
+
+def odom_transform(s, when, robot):
+    """<robot>/odom -> <robot>/base_link for /tf: the pose sensors/odom gives, the same
+    numbers (x, y, heading; the FOOT frame on the floor)."""
+    x, y, yaw = s.pose
+    return transform(frame_id(robot, 'odom'), frame_id(robot, 'base_link'), (x, y, 0.0),
+                     yaw_quaternion(yaw), when)
+
+
+def transform(parent, child, position, orientation, when):
+    """A TransformStamped: the child frame's pose in the parent frame."""
+    msg = TransformStamped(child_frame_id=child)
+    msg.header.stamp, msg.header.frame_id = when, parent
+    t, r = msg.transform.translation, msg.transform.rotation
+    t.x, t.y, t.z = (float(v) for v in position)
+    r.x, r.y, r.z, r.w = (float(v) for v in orientation)
     return msg
 
 

@@ -36,7 +36,8 @@ from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.interface import CLOCK, CLOCK_QOS, PLATFORM_HZ, robot_name, SIM_NODE_NAME
+from miro_ball.miro.interface import CLOCK, CLOCK_QOS, PLATFORM_HZ, robot_name, SIM_NODE_NAME, \
+    TF, TF_STATIC, TF_TYPE
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.eye_pipeline import EyePipeline
@@ -49,6 +50,7 @@ from miro_sim_bullet.ros.robot_interface import RobotInterface
 from miro_sim_bullet.ros.scene import SCENE_RATE_HZ
 from miro_sim_bullet.ros.scene_interface import SceneInterface
 from miro_sim_bullet.ros.sim_interface import SimInterface
+from miro_sim_bullet.ros.tf import TfInterface
 from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, WorldError
 
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
@@ -116,9 +118,16 @@ class SimNode(Node):
             f'world {self.sim.description.source}; robots {", ".join(self.robots)}; renderer '
             f'{self.cameras.renderer.name}; cameras {p.frame_width}x{p.frame_height} @ '
             f'{p.camera_rate:g} Hz; real-time factor {p.real_time_factor:g}')
-        for row in next(iter(self.robots.values())).missing_types:
+        try:
+            self.tf = TfInterface(ros, self.sim, convert.stamp(self.sim.time))
+        except ValueError:
+            self.tf = None
+        missing = [(row.name, row.type) for row in next(iter(self.robots.values())).missing_types]
+        if self.tf is None:
+            missing.append((f'{TF} and {TF_STATIC}', TF_TYPE))
+        for name, type_name in missing:
             self.get_logger().warning(
-                f'{row.name} not published: its type {row.type} is not installed (build it: '
+                f'{name} not published: its type {type_name} is not installed (build it: '
                 'python -m miro_ball.build_interfaces)')
         # The rates of the robots' sensor streams (the interface table's); /clock and the
         # ground truth go with the platform tick.
@@ -300,6 +309,8 @@ class SimNode(Node):
         for rate in rates:
             for interface in self.robots.values():
                 interface.publish_streams(rate, when)
+        if platform_tick and self.tf is not None:
+            self.tf.publish(when)
         if platform_tick and self.sim_interface is not None:
             self.sim_interface.publish_ground_truth(when)
 
