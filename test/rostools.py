@@ -102,3 +102,16 @@ class Probe:
         future = client.call_async(request)
         executor.spin_until_future_complete(future, timeout_sec=10.0)
         return future.result()
+
+
+def message_class_without(package):
+    """common.messages.message_class as on a machine where the interface package ``package``
+    (miro2_msg, tf2_msgs) was not built: its types are not there, every other one is."""
+    from miro_ball.common.messages import message_class
+
+    def without(type_name):
+        if type_name.startswith(package + '/'):
+            raise ValueError(f'no ROS message type {type_name!r}')
+        return message_class(type_name)
+
+    return without

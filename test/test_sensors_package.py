@@ -8,7 +8,7 @@ from std_msgs.msg import Float32MultiArray, UInt16, UInt32
 
 from miro_ball.common.definitions import package_messages
 from miro_ball.miro.interface import default_robot_name, RobotTopics
-from rostools import advance_ticks, Probe, spin_until
+from rostools import advance_ticks, message_class_without, Probe, spin_until
 
 T = RobotTopics(default_robot_name())
 
@@ -65,15 +65,9 @@ def test_package_is_50_hz_and_holds_the_ticks_separate_readings(paused_sim, ros_
 def test_without_miro2_msg_the_simulator_runs_without_the_package_and_says_so(
         make_sim, ros_context, executor, monkeypatch, capfd):
     """A machine with no compiler has no miro2_msg: every other stream is there."""
-    from miro_ball.common import messages
     from miro_sim_bullet.ros import robot_interface
 
-    def without_miro2_msg(type_name):
-        if type_name.startswith('miro2_msg/'):
-            raise ValueError(f'no ROS message type {type_name!r}')
-        return messages.message_class(type_name)
-
-    monkeypatch.setattr(robot_interface, 'message_class', without_miro2_msg)
+    monkeypatch.setattr(robot_interface, 'message_class', message_class_without('miro2_msg'))
     node = make_sim()
     interface = node.robots[T.name]
     assert [row.key for row in interface.missing_types] == ['package']

@@ -9,7 +9,7 @@ from tf2_msgs.msg import TFMessage
 from miro_ball.common.qos import profile
 from miro_ball.miro.interface import RobotTopics, SimTopics, TF, TF_STATIC, TF_QOS
 from miro_ball.miro.rotations import yaw_of
-from rostools import advance_ticks, Probe, spin_until
+from rostools import advance_ticks, message_class_without, Probe, spin_until
 
 ROBOTS = ['miro01', 'miro02', 'miro03']  # football_pitch's
 
@@ -70,15 +70,9 @@ def test_base_link_on_tf_is_the_pose_of_odom_and_of_the_ground_truth(pitch, ros_
 def test_without_tf2_msgs_the_simulator_runs_without_tf_and_says_so(make_sim, ros_context,
                                                                    executor, monkeypatch, capfd):
     """A machine with no compiler has no tf2_msgs: odometry is still there."""
-    from miro_ball.common import messages
     from miro_sim_bullet.ros import tf
 
-    def without_tf2_msgs(type_name):
-        if type_name.startswith('tf2_msgs/'):
-            raise ValueError(f'no ROS message type {type_name!r}')
-        return messages.message_class(type_name)
-
-    monkeypatch.setattr(tf, 'message_class', without_tf2_msgs)
+    monkeypatch.setattr(tf, 'message_class', message_class_without('tf2_msgs'))
     node = make_sim()
     assert node.tf is None
     assert '/tf and /tf_static not published: its type tf2_msgs/msg/TFMessage is not ' \

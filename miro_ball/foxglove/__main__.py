@@ -10,6 +10,7 @@ import sys
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
+from miro_ball.miro.interface import DEFAULT_ROBOT_NAME
 
 PROG = 'python -m miro_ball.foxglove'
 DEFAULT_HOST, DEFAULT_PORT = '127.0.0.1', 8765
@@ -26,7 +27,7 @@ def build_parser():
                         help="let Foxglove publish (its Teleop panel on control/cmd_vel); off "
                              'by default: a viewer drives nothing')
     parser.add_argument('--topics', nargs='+', default=['*'], metavar='PATTERN',
-                        help="offer only these topics (fnmatch patterns: '/miro/*')")
+                        help=f"offer only these topics (fnmatch patterns: '/{DEFAULT_ROBOT_NAME}/*')")
     return parser
 
 
