@@ -108,20 +108,23 @@ class Command:
     def _stop_sandbox(self, grace_s):
         # What runs under the sandbox's first process gets Ctrl+C, as in a terminal
         # (bubblewrap passes no signal on); bubblewrap ends when the command does.
-        _signal(descendants(self.proc.pid), signal.SIGINT)
+        # The tree is taken before anything ends: once bubblewrap has gone, what is left of
+        # its processes is no longer found under it.
+        tree = descendants(self.proc.pid)
+        _signal(tree, signal.SIGINT)
         try:
             self.proc.wait(timeout=grace_s)
             killed = False
         except subprocess.TimeoutExpired:
             killed = True
+        tree += descendants(self.proc.pid)  # what started since
         # Its PID namespace ends with bubblewrap: the kernel kills all that is left in it,
         # but after bubblewrap has gone. The next command of this host runs as the same user,
         # whose process limit a swarm of children not yet taken would fill (a measured
         # failure: the next command could not start a thread), so wait until they are gone.
-        tree = [self.proc.pid, *descendants(self.proc.pid)]
-        _signal(tree, signal.SIGKILL)
+        _signal([self.proc.pid, *tree], signal.SIGKILL)
         self.proc.wait()
-        wait_gone(tree[1:], GONE_S)
+        wait_gone(tree, GONE_S)
         return killed
 
     def _close_log(self):
