@@ -1,59 +1,54 @@
-"""MiRo-E built from primitive shapes with MiRo's real geometry.
+"""MiRo-E's physics body, built from the one body description (miro.body).
 
-Frames (miro_facts.md section 1): FOOT is the model origin on the floor under
-the wheel-axle midpoint. The PyBullet base link is BODY, whose origin is the
-axle midpoint (0.045 m up); nothing holds it tilted: the body rests back on
-its slider by about 6 degrees because of where the slider is. Positions below
-are in the MDK's model frame (untilted) minus the axle height, so they read as
-the MDK's numbers.
+PyBullet's base link is ``body`` (its origin the wheel-axle midpoint, 0.045 m up);
+nothing holds it tilted: it rests back on its slider by about 6 degrees because of where
+the slider is. Every other drawn or movable link of the description follows, in its
+order, so the link indices below are the description's. The other robots' eyes draw
+these shapes, so they see the MiRo the URDF describes.
 """
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-from miro_ball.miro.constants import (JOINT_LIMITS_RAD, LIFT, PITCH, TILT_RAD, WHEEL_RADIUS_M,
-                                      WHEEL_TRACK_M, YAW)
-from miro_ball.miro.kc import (AXLE_HEIGHT_M as AXLE_HEIGHT, camera_in_head, EAR_IN_HEAD, EYE_IN_HEAD,
-                               LIFT_JOINT_IN_BODY, YAW_JOINT_IN_NECK)
+from miro_ball.miro import body as desc
+from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT, PITCH, TILT_RAD, YAW
+from miro_ball.miro.kc import AXLE_HEIGHT_M as AXLE_HEIGHT
 from miro_sim_bullet.bullet import pybullet as pb
 
-CLIFF_IN_BODY = (0.062, 0.055, 0.085 - AXLE_HEIGHT)  # left; right mirrors y
-CLIFF_PITCH_DOWN = 0.52  # rad, the sensors look forward and down
+CLIFF_IN_BODY, CLIFF_PITCH_DOWN, BODY_COM = desc.CLIFF_IN_BODY, desc.CLIFF_PITCH_DOWN, desc.BODY_COM
 CLIFF_RANGE = 0.5
 SONAR_RANGE = (0.03, 1.0)
 SONAR_HALF_CONE = math.atan(0.309)  # cone radius 0.309 m at 1 m
-BODY_COM = (-0.060, 0.0, 0.050 - AXLE_HEIGHT)
-TAIL_JOINT_IN_BODY = (-0.143, 0.0, 0.085 - AXLE_HEIGHT)
+WHITE = desc.COLOURS['shell']  # an unlit LED
 
-WHITE = (0.92, 0.92, 0.90, 1.0)
-GREY = (0.35, 0.35, 0.37, 1.0)
-DARK = (0.08, 0.08, 0.08, 1.0)
-
-# Link (= joint) indices in creation order.
-WHEEL_L, WHEEL_R, NECK, GIMBAL, HEAD, TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L, EAR_R = \
-    range(11)
-# The six LEDs of control/illum in MiRo's order LF, LM, LR, RF, RM, RR: patches on the
-# body's flanks, fixed links so each can have a colour of its own.
-ILLUM_LINKS = tuple(range(11, 17))
-ILLUM_X = (0.03, -0.04, -0.11)  # front, middle, rear (BODY frame)
+# Link (= joint) indices: the description's physical links in order.
+(WHEEL_L, WHEEL_R, NECK, GIMBAL, HEAD, TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L,
+ EAR_R) = (desc.PHYSICAL.index(name) for name in (
+    'wheel_l', 'wheel_r', 'neck', 'gimbal', 'head', 'tail_droop', 'tail', 'eyelid_l',
+    'eyelid_r', 'ear_l', 'ear_r'))
+# The six LEDs of control/illum in MiRo's order LF, LM, LR, RF, RM, RR.
+ILLUM_LINKS = tuple(desc.PHYSICAL.index(name) for name in desc.ILLUM_NAMES)
 KIN_LINKS = {LIFT: NECK, YAW: GIMBAL, PITCH: HEAD}
-# Cosmetic order: droop, wag, eyelid l/r, ear l/r; value 0..1 -> angle range.
+# Cosmetic order: droop, wag, eyelid l/r, ear l/r; value 0..1 -> angle span.
 COSMETIC_LINKS = (TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L, EAR_R)
 COSMETIC_RADIUS_M = 0.02  # about the size of a tail piece, an ear or an eyelid
-COSMETIC_RANGES = ((0.0, 0.6), (-0.6, 0.6), (0.0, 0.9), (0.0, 0.9), (-0.5, 0.5), (0.5, -0.5))
+COSMETIC_RANGES = desc.COSMETIC_SPANS
+_GEOM = {desc.BOX: pb.GEOM_BOX, desc.SPHERE: pb.GEOM_SPHERE, desc.CYLINDER: pb.GEOM_CYLINDER}
+_JOINT = {desc.REVOLUTE: pb.JOINT_REVOLUTE, desc.CONTINUOUS: pb.JOINT_REVOLUTE,
+          desc.FIXED: pb.JOINT_FIXED}
 
 
-@dataclass
-class _Link:
-    mass: float
-    parent: int  # 0 = base, else index + 1 as pybullet wants
-    position: tuple  # joint position in the parent link frame
-    axis: tuple
-    collision: int
-    visual: int
-    com: tuple = (0.0, 0.0, 0.0)
-    joint_type: int = pb.JOINT_REVOLUTE
+def _dims(shape):
+    """PyBullet's size arguments of one shape (a box by its half extents)."""
+    if shape.kind == desc.BOX:
+        return {'halfExtents': [v / 2 for v in shape.size]}
+    if shape.kind == desc.CYLINDER:
+        return {'radius': shape.size[0], 'length': shape.size[1]}
+    return {'radius': shape.size[0]}
+
+
+def _frame(shape):
+    return list(shape.xyz), pb.getQuaternionFromEuler(shape.rpy)
 
 
 class MiroModel:
@@ -63,96 +58,60 @@ class MiroModel:
         self.client = client
         self.body_id = self._build()
 
-    def _shape(self, geom, colour=WHITE, collide=True, offset=(0, 0, 0), orn=(0, 0, 0, 1),
-               **dims):
-        kw = dict(physicsClientId=self.client)
-        visual = pb.createVisualShape(geom, rgbaColor=colour, visualFramePosition=offset,
-                                      visualFrameOrientation=orn, **dims, **kw)
-        if not collide:
-            return -1, visual
-        # Same dimensions; pybullet calls a cylinder's length 'height' here.
-        cdims = {('height' if k == 'length' else k): v for k, v in dims.items()}
-        collision = pb.createCollisionShape(geom, collisionFramePosition=offset,
-                                            collisionFrameOrientation=orn, **cdims, **kw)
-        return collision, visual
+    def _visual(self, shapes):
+        kw = {'physicsClientId': self.client}
+        if len(shapes) == 1:
+            (shape,) = shapes
+            position, orientation = _frame(shape)
+            return pb.createVisualShape(_GEOM[shape.kind], rgbaColor=desc.COLOURS[shape.colour],
+                                        visualFramePosition=position,
+                                        visualFrameOrientation=orientation, **_dims(shape), **kw)
+        dims = [_dims(s) for s in shapes]
+        return pb.createVisualShapeArray(
+            [_GEOM[s.kind] for s in shapes], radii=[d.get('radius', 0) for d in dims],
+            halfExtents=[d.get('halfExtents', [0] * 3) for d in dims],
+            lengths=[d.get('length', 0) for d in dims],
+            visualFramePositions=[_frame(s)[0] for s in shapes],
+            visualFrameOrientations=[_frame(s)[1] for s in shapes],
+            rgbaColors=[desc.COLOURS[s.colour] for s in shapes], **kw)
+
+    def _collision(self, shapes):
+        kw = {'physicsClientId': self.client}
+        if not shapes:
+            return -1
+        if len(shapes) == 1:
+            (shape,) = shapes
+            position, orientation = _frame(shape)
+            # pybullet calls a cylinder's length 'height' here
+            dims = {('height' if k == 'length' else k): v for k, v in _dims(shape).items()}
+            return pb.createCollisionShape(_GEOM[shape.kind], collisionFramePosition=position,
+                                           collisionFrameOrientation=orientation, **dims, **kw)
+        dims = [_dims(s) for s in shapes]
+        return pb.createCollisionShapeArray(
+            [_GEOM[s.kind] for s in shapes], radii=[d.get('radius', 0) for d in dims],
+            halfExtents=[d.get('halfExtents', [0] * 3) for d in dims],
+            lengths=[d.get('length', 0) for d in dims],
+            collisionFramePositions=[_frame(s)[0] for s in shapes],
+            collisionFrameOrientations=[_frame(s)[1] for s in shapes], **kw)
 
     def _build(self):
         kw = dict(physicsClientId=self.client)
-        box = pb.GEOM_BOX
-        y_axis_cylinder = pb.getQuaternionFromEuler((-math.pi / 2, 0, 0))
-        # Body: a shell box clear of the floor plus the low-friction slider sphere.
-        shell_lo, shell_hi = (-0.150, -0.100, 0.035), (0.070, 0.100, 0.160)
-        centre = [(a + b) / 2 for a, b in zip(shell_lo, shell_hi)]
-        centre[2] -= AXLE_HEIGHT
-        half = [(b - a) / 2 for a, b in zip(shell_lo, shell_hi)]
-        slider = (-0.1075, 0.0, 0.0264 - AXLE_HEIGHT)
-        body_collision = pb.createCollisionShapeArray(
-            [box, pb.GEOM_SPHERE], halfExtents=[half, [0, 0, 0]], radii=[0, 0.015],
-            collisionFramePositions=[centre, slider], **kw)
-        body_visual = pb.createVisualShapeArray(
-            [box, pb.GEOM_SPHERE], halfExtents=[half, [0, 0, 0]], radii=[0, 0.015],
-            visualFramePositions=[centre, slider], rgbaColors=[WHITE, GREY], **kw)
-
-        half_track = WHEEL_TRACK_M / 2
-        wheel = self._shape(pb.GEOM_CYLINDER, GREY, radius=WHEEL_RADIUS_M, length=0.01,
-                            orn=y_axis_cylinder)
-        neck = self._shape(pb.GEOM_CAPSULE, WHITE, radius=0.02, length=0.08,
-                           offset=(0, 0, 0.06))
-        gimbal = self._shape(pb.GEOM_SPHERE, GREY, collide=False, radius=0.02)
-        # The head is a cranium behind the eyes and a muzzle below them, so
-        # neither blocks the eye cameras' view.
-        head_collision = pb.createCollisionShapeArray(
-            [box, box], halfExtents=[[0.043, 0.063, 0.0575], [0.036, 0.035, 0.028]],
-            collisionFramePositions=[[-0.018, 0, 0.0315], [0.060, 0, 0.002]], **kw)
-        eye_positions = [camera_in_head(side)[0] - 0.013 * camera_in_head(side)[1][:, 0]
-                         for side in (1, -1)]
-        head_visual = pb.createVisualShapeArray(
-            [box, box, pb.GEOM_SPHERE, pb.GEOM_SPHERE],
-            halfExtents=[[0.043, 0.063, 0.0575], [0.036, 0.035, 0.028], [0] * 3, [0] * 3],
-            radii=[0, 0, 0.012, 0.012],
-            visualFramePositions=[[-0.018, 0, 0.0315], [0.060, 0, 0.002], *eye_positions],
-            rgbaColors=[WHITE, WHITE, DARK, DARK], **kw)
-        tail = self._shape(pb.GEOM_CAPSULE, GREY, collide=False, radius=0.008, length=0.08,
-                           offset=(-0.045, 0, 0.02),
-                           orn=pb.getQuaternionFromEuler((0, -1.2, 0)))
-        pivot = self._shape(pb.GEOM_SPHERE, GREY, collide=False, radius=0.006)
-        eyelid = self._shape(box, WHITE, collide=False, halfExtents=(0.012, 0.016, 0.003),
-                             offset=(-0.02, 0, 0.012))
-        ear = self._shape(box, WHITE, collide=False, halfExtents=(0.006, 0.02, 0.03),
-                          offset=(0, 0, 0.03))
-        ex, ey, ez = EYE_IN_HEAD
-        links = [
-            _Link(0.134041, 0, (0, half_track, 0), (0, 1, 0), *wheel),
-            _Link(0.134041, 0, (0, -half_track, 0), (0, 1, 0), *wheel),
-            _Link(0.075398, 0, LIFT_JOINT_IN_BODY, (0, 1, 0), *neck, com=(0, 0, 0.06)),
-            _Link(0.039270, NECK + 1, YAW_JOINT_IN_NECK, (0, 0, 1), *gimbal),
-            _Link(0.261799, GIMBAL + 1, (0, 0, 0), (0, 1, 0), head_collision,
-                  head_visual, com=(-0.0042, 0, 0.0202)),
-            _Link(0.0565, 0, TAIL_JOINT_IN_BODY, (0, 1, 0), *pivot),
-            _Link(0.0565, TAIL_DROOP + 1, (0, 0, 0), (0, 0, 1), *tail),
-            _Link(0.0168, HEAD + 1, (ex, ey, ez + 0.012), (0, 1, 0), *eyelid),
-            _Link(0.0168, HEAD + 1, (ex, -ey, ez + 0.012), (0, 1, 0), *eyelid),
-            _Link(0.0565, HEAD + 1, EAR_IN_HEAD, (0, 0, 1), *ear),
-            _Link(0.0565, HEAD + 1, (EAR_IN_HEAD[0], -EAR_IN_HEAD[1], EAR_IN_HEAD[2]),
-                  (0, 0, 1), *ear),
-        ]
-        led = self._shape(box, WHITE, collide=False, halfExtents=(0.025, 0.002, 0.012))
-        links += [_Link(0.001, 0, (x, side * 0.101, 0.055), (0, 0, 1), *led,
-                        joint_type=pb.JOINT_FIXED)
-                  for side in (1, -1) for x in ILLUM_X]
+        base = desc.LINK['body']
+        links = [desc.LINK[name] for name in desc.PHYSICAL]
+        index = {name: i + 1 for i, name in enumerate(desc.PHYSICAL)}  # pybullet's parents
         body = pb.createMultiBody(
-            baseMass=1.570796, baseCollisionShapeIndex=body_collision,
-            baseVisualShapeIndex=body_visual, basePosition=(0, 0, 1.0),
-            baseInertialFramePosition=BODY_COM,
+            baseMass=base.mass, baseCollisionShapeIndex=self._collision(base.collisions),
+            baseVisualShapeIndex=self._visual(base.visuals), basePosition=(0, 0, 1.0),
+            baseInertialFramePosition=base.com,
             linkMasses=[lk.mass for lk in links],
-            linkCollisionShapeIndices=[lk.collision for lk in links],
-            linkVisualShapeIndices=[lk.visual for lk in links],
-            linkPositions=[lk.position for lk in links],
-            linkOrientations=[(0, 0, 0, 1)] * len(links),
+            linkCollisionShapeIndices=[self._collision(lk.collisions) for lk in links],
+            linkVisualShapeIndices=[self._visual(lk.visuals) for lk in links],
+            linkPositions=[lk.xyz for lk in links],
+            linkOrientations=[pb.getQuaternionFromEuler(lk.rpy) for lk in links],
             linkInertialFramePositions=[lk.com for lk in links],
             linkInertialFrameOrientations=[(0, 0, 0, 1)] * len(links),
-            linkParentIndices=[lk.parent for lk in links],
-            linkJointTypes=[lk.joint_type for lk in links],
+            linkParentIndices=[index.get(lk.parent, 0) for lk in links],
+            linkJointTypes=[_JOINT[lk.kind] for lk in links],
             linkJointAxis=[lk.axis for lk in links],
             **kw)
         # The slider is the part of the base that touches the floor: its friction.
@@ -167,8 +126,7 @@ class MiroModel:
         # none (they touch nothing), and a link of zero inertia stays where its motor is
         # told to move it. Each gets the inertia of a sphere of its mass.
         for link in COSMETIC_LINKS:
-            mass = links[link].mass
-            inertia = 0.4 * mass * COSMETIC_RADIUS_M ** 2
+            inertia = 0.4 * links[link].mass * COSMETIC_RADIUS_M ** 2
             pb.changeDynamics(body, link, localInertiaDiagonal=(inertia,) * 3, **kw)
         return body
 

@@ -1,0 +1,89 @@
+"""MiRo's URDF, written from the one body description (body.py): robot_description.
+
+Link and joint names carry no robot's name (robot_state_publisher's convention); the
+frames on /tf do ('<robot>/<link>'). Inertias are those of each link's first shape as a
+solid of the link's mass: enough for a viewer, and the simulator takes its own from the
+collision shapes.
+"""
+from xml.sax.saxutils import quoteattr
+
+from miro_ball.miro.body import BOX, COLOURS, CYLINDER, FIXED, LINKS, ROOT
+
+ROBOT_NAME = 'miro_e'  # the model's name in the URDF, not a robot's
+
+
+def _numbers(values):
+    return quoteattr(' '.join(f'{float(v):.6g}' for v in values))
+
+
+def _origin(xyz, rpy):
+    return f'<origin xyz={_numbers(xyz)} rpy={_numbers(rpy)}/>'
+
+
+def _geometry(shape):
+    if shape.kind == BOX:
+        return f'<box size={_numbers(shape.size)}/>'
+    if shape.kind == CYLINDER:
+        radius, length = shape.size
+        return f'<cylinder radius="{radius:.6g}" length="{length:.6g}"/>'
+    return f'<sphere radius="{shape.size[0]:.6g}"/>'
+
+
+def inertia(link):
+    """(ixx, iyy, izz) of the link's first shape as a solid of its mass, about its centre."""
+    shapes = link.collisions or link.visuals
+    m = link.mass
+    if not shapes or m <= 0.0:
+        return (0.0, 0.0, 0.0)
+    shape = shapes[0]
+    if shape.kind == BOX:
+        x, y, z = shape.size
+        return (m * (y * y + z * z) / 12, m * (x * x + z * z) / 12, m * (x * x + y * y) / 12)
+    if shape.kind == CYLINDER:
+        r, h = shape.size
+        side = m * (3 * r * r + h * h) / 12
+        return (side, side, m * r * r / 2)
+    r = shape.size[0]
+    return (0.4 * m * r * r,) * 3
+
+
+def _link(link):
+    parts = [f'  <link name={quoteattr(link.name)}>']
+    if link.mass > 0.0:
+        ixx, iyy, izz = inertia(link)
+        parts.append(f'    <inertial>{_origin(link.com, (0, 0, 0))}<mass value="{link.mass:.6g}"/>'
+                     f'<inertia ixx="{ixx:.6g}" ixy="0" ixz="0" iyy="{iyy:.6g}" iyz="0" '
+                     f'izz="{izz:.6g}"/></inertial>')
+    for tag, shapes in (('visual', link.visuals), ('collision', link.collisions)):
+        for shape in shapes:
+            material = (f'<material name={quoteattr(shape.colour)}/>' if tag == 'visual'
+                        else '')
+            parts.append(f'    <{tag}>{_origin(shape.xyz, shape.rpy)}<geometry>'
+                         f'{_geometry(shape)}</geometry>{material}</{tag}>')
+    parts.append('  </link>')
+    return parts
+
+
+def _joint(link):
+    parts = [f'  <joint name={quoteattr(link.joint)} type="{link.kind}">',
+             f'    <parent link={quoteattr(link.parent)}/><child link={quoteattr(link.name)}/>',
+             f'    {_origin(link.xyz, link.rpy)}']
+    if link.kind != FIXED:
+        parts.append(f'    <axis xyz={_numbers(link.axis)}/>')
+    if link.limits is not None:
+        lo, hi = link.limits
+        parts.append(f'    <limit lower="{lo:.6g}" upper="{hi:.6g}" effort="1" velocity="10"/>')
+    parts.append('  </joint>')
+    return parts
+
+
+def urdf():
+    """The URDF of MiRo-E as XML text."""
+    lines = ['<?xml version="1.0"?>', f'<robot name="{ROBOT_NAME}">']
+    lines += [f'  <material name={quoteattr(name)}><color rgba={_numbers(rgba)}/></material>'
+              for name, rgba in COLOURS.items()]
+    lines.append(f'  <link name={quoteattr(ROOT)}/>')
+    for link in LINKS:
+        lines += _link(link) + _joint(link)
+    lines.append('</robot>')
+    return '\n'.join(lines) + '\n'
