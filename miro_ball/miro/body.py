@@ -103,23 +103,30 @@ def _eye_shapes():
     return tuple(shapes)
 
 
-# The body: a rounded shell (a capsule along x, as spheres and a cylinder) over a darker
-# skirt that is round at the front, with the slider under the back.
-_SHELL_Z, _SHELL_R = floor(0.091), 0.070
+# The body: a rounded shell (a capsule along x, as spheres and a cylinder) on a darker
+# round base, with the slider under the back.
+_SHELL_Z, _SHELL_R = floor(0.081), 0.080
 _SHELL_FRONT, _SHELL_BACK = 0.070 - _SHELL_R, -0.151 + _SHELL_R
-_SKIRT_Z = (floor(0.025), floor(0.095))
-_SKIRT_R = 0.104
+_BASE_Z = (floor(0.020), floor(0.072))
+_BASE_R = 0.108
 _BODY_VISUALS = (
     Shape(SPHERE, (_SHELL_R,), (_SHELL_FRONT, 0.0, _SHELL_Z)),
     Shape(SPHERE, (_SHELL_R,), (_SHELL_BACK, 0.0, _SHELL_Z)),
     Shape(CYLINDER, (_SHELL_R, _SHELL_FRONT - _SHELL_BACK),
           ((_SHELL_FRONT + _SHELL_BACK) / 2, 0.0, _SHELL_Z), X_AXIS_CYLINDER),
-    Shape(CYLINDER, (_SKIRT_R, _SKIRT_Z[1] - _SKIRT_Z[0]),
-          (0.070 - _SKIRT_R, 0.0, sum(_SKIRT_Z) / 2), colour='skirt'),
-    Shape(BOX, (0.070 - _SKIRT_R + 0.151, 2 * _SKIRT_R, _SKIRT_Z[1] - _SKIRT_Z[0]),
-          ((0.070 - _SKIRT_R - 0.151) / 2, 0.0, sum(_SKIRT_Z) / 2), colour='skirt'),
+    Shape(CYLINDER, (_BASE_R, _BASE_Z[1] - _BASE_Z[0]),
+          ((0.070 - 0.151) / 2, 0.0, sum(_BASE_Z) / 2), colour='skirt'),
     Shape(SPHERE, (SLIDER_RADIUS,), SLIDER, colour='joint'),
 )
+
+
+def _shell_half_width(x, z):
+    """Half the shell's width at (x, z) of body: where a patch on its flank sits."""
+    along = min(max(x, _SHELL_BACK), _SHELL_FRONT)
+    across = math.sqrt(max(_SHELL_R ** 2 - (x - along) ** 2, 0.0))
+    return math.sqrt(max(across ** 2 - (z - _SHELL_Z) ** 2, 0.0))
+
+
 # What the body collides with: a box clear of the floor and the slider (its friction is
 # the simulator's to set).
 _BODY_BOX = ((-0.150, -0.100, floor(0.035)), (0.070, 0.100, floor(0.160)))
@@ -150,11 +157,11 @@ _TAIL = (Shape(CYLINDER, (0.008, _TAIL_LENGTH),
                colour='dark'))
 _EYELID = Shape(BOX, (0.024, 0.032, 0.006), (-0.02, 0.0, 0.012))
 # An ear: a large upright disc facing forward, darker inside.
-_EAR = (Shape(CYLINDER, (0.032, 0.006), (0.0, 0.0, 0.040), X_AXIS_CYLINDER),
-        Shape(CYLINDER, (0.023, 0.002), (0.0035, 0.0, 0.040), X_AXIS_CYLINDER,
+_EAR = (Shape(CYLINDER, (0.032, 0.006), (0.0, 0.0, 0.032), X_AXIS_CYLINDER),
+        Shape(CYLINDER, (0.023, 0.002), (0.0035, 0.0, 0.032), X_AXIS_CYLINDER,
               colour='inner_ear'))
-_LED = Shape(BOX, (0.05, 0.006, 0.024))
-_LED_Y, _LED_Z = 0.066, floor(0.115)
+_LED = Shape(BOX, (0.04, 0.006, 0.02))
+_LED_Z = floor(0.115)
 
 # Cosmetic joints: (angle at 0, angle at 1) of control/cosmetic_joints' droop, wag,
 # eyelid l/r, ear l/r (the right ear mirrors the left).
@@ -224,7 +231,8 @@ LINKS = (
     Link('ear_r', 'head', 'ear_r', REVOLUTE, _mirror(EAR_IN_HEAD), axis=(0.0, 0.0, 1.0),
          limits=_span('ear_r'), mass=0.0565, visuals=_EAR),
 ) + tuple(
-    Link(name, 'body', f'{name}_joint', FIXED, (x, side * _LED_Y, _LED_Z), mass=0.001,
+    Link(name, 'body', f'{name}_joint', FIXED, (x, side * _shell_half_width(x, _LED_Z), _LED_Z),
+         mass=0.001,
          visuals=(_LED,))
     for name, (side, x) in zip(ILLUM_NAMES, [(s, x) for s in (1, -1) for x in ILLUM_X])
 ) + (
