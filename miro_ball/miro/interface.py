@@ -62,6 +62,8 @@ TF_STATIC_QOS = Qos(depth=1, latched=True)
 SENSOR, CONTROL = 'sensor', 'control'  # out of the robot, into the robot
 PLATFORM_HZ = 50.0  # MiRo's platform tick: its sensors, /clock
 CAMERA = 'camera'  # a stream at the eyes' rate (the simulator's camera_rate parameter)
+ONCE = 'once'  # a stream sent once and kept for late subscribers (latched)
+DESCRIPTION_QOS = Qos(depth=1, latched=True)  # robot_state_publisher's robot_description
 
 
 @dataclass(frozen=True)
@@ -127,6 +129,11 @@ ROBOT_INTERFACE = tuple(Topic(*row[:6], *(row[6:] or (None,))) for row in (
      'part head or body: a bit per touch sensor', PLATFORM_HZ),
     ('sensor_flags', 'sensors/flags', 'std_msgs/msg/UInt32', SENSOR, SENSOR_QOS,
      'platform flags (bit 15: simulator)', PLATFORM_HZ),
+    ('joint_states', 'joint_states', 'sensor_msgs/msg/JointState', SENSOR, SENSOR_QOS,
+     "every movable joint of robot_description, rad (tilt: the body's measured pitch)",
+     PLATFORM_HZ),
+    ('robot_description', 'robot_description', 'std_msgs/msg/String', SENSOR, DESCRIPTION_QOS,
+     'the URDF: link and joint names without the robot (its frames on /tf carry it)', ONCE),
     ('package', 'sensors/package', 'miro2_msg/msg/SensorsPackage', SENSOR, SENSOR_QOS,
      "every 50 Hz reading of one tick, stamped (miro2_msg: built at set-up)", PLATFORM_HZ),
     ('cmd_vel', 'control/cmd_vel', 'geometry_msgs/msg/TwistStamped', CONTROL, CONTROL_QOS,

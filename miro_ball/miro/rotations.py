@@ -31,3 +31,24 @@ def matrix_quaternions(matrices):
     """(n, 4) quaternions (x, y, z, w), w >= 0, of (n, 3, 3) rotation matrices."""
     q = Rotation.from_matrix(np.asarray(matrices, float).reshape(-1, 3, 3)).as_quat()
     return q * np.where(q[:, 3:] < 0, -1.0, 1.0)
+
+
+def rpy_quaternion(roll, pitch, yaw):
+    """(x, y, z, w) of URDF's roll, pitch, yaw (turns about the fixed x, y, z axes)."""
+    q = Rotation.from_euler('xyz', (roll, pitch, yaw)).as_quat()
+    return tuple((q if q[3] >= 0 else -q).tolist())
+
+
+def multiply(a, b):
+    """The quaternion product a * b (turn by b, then by a), both (x, y, z, w): by hand, as
+    this runs for every joint of every robot at 50 Hz."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz)
+
+
+def axis_angle_quaternion(axis, angle):
+    """(x, y, z, w) of a turn of ``angle`` rad about the unit vector ``axis``."""
+    s = math.sin(angle / 2)
+    return (axis[0] * s, axis[1] * s, axis[2] * s, math.cos(angle / 2))

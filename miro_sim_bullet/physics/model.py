@@ -29,6 +29,9 @@ WHITE = desc.COLOURS['shell']  # an unlit LED
 # The six LEDs of control/illum in MiRo's order LF, LM, LR, RF, RM, RR.
 ILLUM_LINKS = tuple(desc.PHYSICAL.index(name) for name in desc.ILLUM_NAMES)
 KIN_LINKS = {LIFT: NECK, YAW: GIMBAL, PITCH: HEAD}
+# The movable joints after the tilt (which is the base's own pitch), as PyBullet's joints.
+JOINT_LINKS = tuple(desc.PHYSICAL.index(desc.LINK_OF_JOINT[joint].name)
+                    for joint in desc.MOVABLE[1:])
 # Cosmetic order: droop, wag, eyelid l/r, ear l/r; value 0..1 -> angle span.
 COSMETIC_LINKS = (TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L, EAR_R)
 COSMETIC_RADIUS_M = 0.02  # about the size of a tail piece, an ear or an eyelid

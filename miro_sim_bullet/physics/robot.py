@@ -11,9 +11,10 @@ import numpy as np
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       KIN_CALIB_RAD, TILT_RAD, WHEEL_RADIUS_M)
-from miro_ball.miro.kc import camera_in_head, SONAR_IN_HEAD
+from miro_ball.miro.kc import camera_in_head, rot_z, SONAR_IN_HEAD
 from miro_ball.miro.interface import TOUCH_PARTS
 from miro_ball.miro.kinematics import clamp_wheel_speeds, cmd_vel2wheel_speed
+from miro_ball.miro.rotations import matrix_quaternions
 from miro_ball.miro.touch import pads_touched, TOUCH_PADS
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics import model as rb
@@ -223,19 +224,25 @@ class MiroRobot:
 
     def _read_sensors(self, cliff):
         kw = self._kw()
-        states = pb.getJointStates(self.body_id, [rb.NECK, rb.GIMBAL, rb.HEAD, rb.WHEEL_L,
-                                                  rb.WHEEL_R], **kw)
+        states = dict(zip(rb.JOINT_LINKS, pb.getJointStates(self.body_id, rb.JOINT_LINKS, **kw)))
+        neck = [states[link] for link in (rb.NECK, rb.GIMBAL, rb.HEAD)]
+        wheels = [states[link] for link in (rb.WHEEL_L, rb.WHEEL_R)]
         lin, ang = pb.getBaseVelocity(self.body_id, **kw)
         x, y, yaw = self.pose()
         forward = lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw)
+        body_xyz, body_quaternion, tilt = self._body_in_base(x, y, yaw)
+        tilt_rate = float(np.dot(ang, self.model.body_frame()[1][:, 1]))
         return Sensors(
             time=self.clock(),
-            kinematic_positions=(TILT_RAD, *(s[0] for s in states[:3])),
-            kinematic_velocities=(0.0, *(s[1] for s in states[:3])),
+            kinematic_positions=(TILT_RAD, *(s[0] for s in neck)),
+            kinematic_velocities=(0.0, *(s[1] for s in neck)),
+            joint_positions=(tilt, *(states[link][0] for link in rb.JOINT_LINKS)),
+            joint_velocities=(tilt_rate, *(states[link][1] for link in rb.JOINT_LINKS)),
+            body_in_base=(body_xyz, body_quaternion),
             pose=(x, y, yaw),
             velocity=(forward, ang[2]),
             wheel_speed_cmd=self.wheel_out,
-            wheel_speed_opto=tuple(s[1] * WHEEL_RADIUS_M for s in states[3:]),
+            wheel_speed_opto=tuple(s[1] * WHEEL_RADIUS_M for s in wheels),
             cliff=cliff,
             sonar=self._read_sonar(),
             imu_body=self._imu(-1, 'body'),
@@ -243,6 +250,16 @@ class MiroRobot:
             touch_head=self._touch_reading('head'),
             touch_body=self._touch_reading('body'),
         )
+
+    def _body_in_base(self, x, y, yaw):
+        """The body's exact pose on base_link (xyz, quaternion) and its pitch there (the
+        tilt joint of joint_states)."""
+        position, rotation = self.model.body_frame()
+        turn = rot_z(yaw)
+        relative = turn.T @ rotation
+        xyz = turn.T @ (position - np.array((x, y, 0.0)))
+        tilt = math.atan2(relative[0, 2], relative[0, 0])
+        return tuple(xyz.tolist()), tuple(matrix_quaternions(relative)[0].tolist()), tilt
 
     # -- cameras ----------------------------------------------------------------------------
     def eye_pose(self, side):

@@ -35,6 +35,12 @@ class Sensors:
     light: tuple = (AMBIENT_LIGHT,) * 4
     touch_head: int = 0  # pad bit masks (miro_ball.miro.touch)
     touch_body: int = 0
+    # Every movable joint of the body description (miro.body.MOVABLE, in order; tilt the
+    # body's measured pitch on base_link), and the body's exact pose on base_link
+    # (xyz, quaternion): joint_states and /tf.
+    joint_positions: tuple = ()
+    joint_velocities: tuple = ()
+    body_in_base: tuple = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 
 def cone_directions(half_angle, rings=(0.5, 1.0), per_ring=6):

@@ -9,6 +9,7 @@ from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Im
     Range
 from std_msgs.msg import Float32MultiArray
 
+from miro_ball.miro.body import MOVABLE
 from miro_ball.miro.constants import JOINT_NAMES
 from miro_ball.miro.interface import frame_id, WORLD_FRAME
 from miro_ball.miro.rotations import yaw_quaternion
@@ -27,6 +28,15 @@ def kinematic_joints(s, when, robot):
     msg = JointState(name=list(JOINT_NAMES), position=list(s.kinematic_positions),
                      velocity=list(s.kinematic_velocities))
     msg.header.stamp, msg.header.frame_id = when, frame_id(robot, 'base_link')
+    return msg
+
+
+def joint_states(s, when):
+    """joint_states: every movable joint of the URDF (names without the robot's, as
+    robot_state_publisher reads them)."""
+    msg = JointState(name=list(MOVABLE), position=list(s.joint_positions),
+                     velocity=list(s.joint_velocities))
+    msg.header.stamp = when
     return msg
 
 

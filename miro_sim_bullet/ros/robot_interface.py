@@ -14,7 +14,7 @@ from miro_ball.common.checks import finite, finite_values
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
 from miro_ball.miro.constants import JOINT_NAMES, JOINT_POSITIONS
-from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id,
+from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id, ONCE,
                                       ROBOT_INTERFACE, RobotTopics, SimTopics, TOPIC,
                                       TOUCH_PARTS)
 from miro_ball.miro.touch import ALL_PADS
@@ -66,6 +66,8 @@ class RobotInterface:
                 self._publishers[row.key, *fields.values()] = publisher
                 if row.rate == CAMERA:
                     self.pub_eyes[fields['eye']][EYE_ROWS.index(row.key)] = publisher
+                elif row.rate == ONCE:  # the same for the robot's whole life: kept (latched)
+                    publisher.publish(PRODUCERS[row.key](None, None, name, **fields))
                 else:
                     self.streams.setdefault(row.rate, []).append(
                         (PRODUCERS[row.key], fields, publisher))

@@ -11,11 +11,12 @@ table and a producer here (docs/development.md).
 import functools
 
 import numpy as np
-from std_msgs.msg import UInt16, UInt32
+from std_msgs.msg import String, UInt16, UInt32
 
 from miro_ball.common.messages import message_class
 from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR, WHEEL_MAX_SPEED_M_PER_S
 from miro_ball.miro.interface import frame_id, PLATFORM_HZ, ROBOT_INTERFACE, SENSOR, TOPIC
+from miro_ball.miro.urdf import urdf
 from miro_sim_bullet.ros import convert
 
 PRODUCERS = {
@@ -33,6 +34,8 @@ PRODUCERS = {
     'light': lambda r, when, name: convert.floats(r.sensors.light),
     'touch': lambda r, when, name, part: UInt16(data=getattr(r.sensors, f'touch_{part}')),
     'sensor_flags': lambda r, when, name: UInt32(data=UPSTREAM_FLAG_SIMULATOR),
+    'joint_states': lambda r, when, name: convert.joint_states(r.sensors, when),
+    'robot_description': lambda r, when, name: String(data=urdf()),
 }
 
 
@@ -45,7 +48,7 @@ def _package_parts():
     return [(relative.split('/', 1)[1], PRODUCERS[row.key], holes)
             for row in ROBOT_INTERFACE if row.direction == SENSOR and row.rate == PLATFORM_HZ
             and row.key in PRODUCERS for holes, relative in row.names()
-            if relative.split('/', 1)[1] in fields]
+            if relative.startswith('sensors/') and relative.split('/', 1)[1] in fields]
 
 
 def sensors_package(r, when, name):

@@ -1,16 +1,55 @@
-"""/tf and /tf_static: where each robot is, as tf2, RViz and Foxglove read it.
+"""/tf and /tf_static: every frame of every robot, as tf2, RViz and Foxglove read them.
 
-The tree: ``world`` -> ``<robot>/odom`` (static: the simulator's odometry is its ground
-truth, so odom coincides with the world) -> ``<robot>/base_link`` (moving, the pose that
-sensors/odom gives, published with it each platform tick). The type, tf2_msgs/TFMessage,
-is built at set-up (python -m miro_ball.build_interfaces); without it the simulator runs
-without /tf and says so once.
+The tree, each robot's frames prefixed with its name (REP 105):
+
+    world -> <robot>/odom -> <robot>/base_link -> <robot>/body -> ... every URDF link
+
+- ``world -> <robot>/odom`` (static): the simulator's odometry is its ground truth, so
+  odom coincides with the world;
+- ``<robot>/odom -> <robot>/base_link``: the pose of sensors/odom, the same numbers;
+- ``<robot>/base_link -> <robot>/body``: the body's exact pose (its tilt, as measured);
+- every other movable joint of the URDF from its position in joint_states (the same tick);
+- every fixed joint (the LEDs, the eyes and their optical frames, the sonar, the IMUs,
+  the microphones, the cliff sensors) on /tf_static, once.
+
+The moving transforms go out each platform tick, only while someone listens. The type,
+tf2_msgs/TFMessage, is built at set-up (python -m miro_ball.build_interfaces); without it
+the simulator runs without /tf and says so once.
 """
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
+from miro_ball.miro.body import LINK_OF_JOINT, MOVABLE
 from miro_ball.miro.interface import frame_id, TF, TF_QOS, TF_STATIC, TF_STATIC_QOS, TF_TYPE, \
     WORLD_FRAME
+from miro_ball.miro.link_poses import fixed_transforms, joint_transform, MOVING_LINKS
 from miro_sim_bullet.ros import convert
+
+_BODY = LINK_OF_JOINT['tilt']  # its exact pose, not the tilt alone (a slope rolls it too)
+# (link, index of its joint in Sensors.joint_positions) of the joints after the tilt.
+_JOINTS = tuple((link, MOVABLE.index(link.joint)) for link in MOVING_LINKS if link is not _BODY)
+
+
+def static_transforms(robots, when):
+    """The TransformStampeds of /tf_static for the robots named."""
+    out = []
+    for name in robots:
+        out.append(convert.transform(WORLD_FRAME, frame_id(name, 'odom'), (0.0, 0.0, 0.0),
+                                     (0.0, 0.0, 0.0, 1.0), when))
+        out += [convert.transform(frame_id(name, parent), frame_id(name, child), xyz, turn,
+                                  when) for parent, child, xyz, turn in fixed_transforms()]
+    return out
+
+
+def robot_transforms(s, when, name):
+    """The moving TransformStampeds of one robot from its tick's Sensors."""
+    out = [convert.odom_transform(s, when, name),
+           convert.transform(frame_id(name, _BODY.parent), frame_id(name, _BODY.name),
+                             *s.body_in_base, when)]
+    for link, index in _JOINTS:
+        xyz, turn = joint_transform(link, s.joint_positions[index])
+        out.append(convert.transform(frame_id(name, link.parent), frame_id(name, link.name),
+                                     xyz, turn, when))
+    return out
 
 
 class TfInterface:
@@ -24,14 +63,11 @@ class TfInterface:
         self.pub = ros.publisher(self.message, TF, profile(TF_QOS))
         self.pub_static = ros.publisher(self.message, TF_STATIC, profile(TF_STATIC_QOS))
         # Published once, kept for late subscribers (transient local).
-        self.pub_static.publish(self.message(transforms=[
-            convert.transform(WORLD_FRAME, frame_id(name, 'odom'), (0.0, 0.0, 0.0),
-                              (0.0, 0.0, 0.0, 1.0), when)
-            for name in world.robots]))
+        self.pub_static.publish(self.message(transforms=static_transforms(world.robots, when)))
 
     def publish(self, when):
-        """Every robot's odom -> base_link now, in one message (only while listened to)."""
+        """Every robot's moving frames now, in one message (only while listened to)."""
         if self.pub.get_subscription_count():
             self.pub.publish(self.message(transforms=[
-                convert.odom_transform(robot.sensors, when, name)
-                for name, robot in self.world.robots.items()]))
+                t for name, robot in self.world.robots.items()
+                for t in robot_transforms(robot.sensors, when, name)]))
