@@ -8,8 +8,8 @@ sim_link.py's; the images the pages show are frames.py's.
 
 Nothing is subscribed that no page shows: a robot's sensors only while a page watches
 it, each eye only while such a page shows it (so with no page open the simulator
-renders nothing for the GUI), the overhead view likewise, and the scene and the robots'
-link frames only while a page shows the world view.
+renders nothing for the GUI), the overhead view likewise, and the scene, the robots'
+robot_description and /tf only while a page shows the world view.
 
 It runs in the ROS thread (its own executor); the web server calls the thread-safe
 methods marked so. Commands from the pages go into a queue that a guard condition drains
@@ -24,11 +24,13 @@ import threading
 import time
 from dataclasses import dataclass
 
-from geometry_msgs.msg import PoseArray
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
+from miro_ball.common.messages import message_class
+from miro_ball.common.qos import profile
 from miro_ball.common.robots import robots_running
 from miro_ball.common.throttle import Throttled
 from miro_ball.gui import protocol as p
@@ -38,20 +40,21 @@ from miro_ball.gui.robot_part import NODE_NAME, PUBLISHED, RobotPart
 from miro_ball.gui.scene import SceneState
 from miro_ball.gui.sim_link import SimLink
 from miro_ball.miro.constants import PLATFORM_TICK_S
-from miro_ball.miro.interface import DEFAULT_ROBOT_NAME, EYES
+from miro_ball.miro.interface import (DEFAULT_ROBOT_NAME, EYES, RobotTopics, TF, TF_STATIC,
+                                      TF_STATIC_QOS, TF_TYPE, TOPIC)
 from miro_ball.miro.touch import pads_at
 
 DISCOVERY_PERIOD_S = 1.0
 READOUT_PERIOD_S = 0.05  # readouts to the pages at 20 Hz
 # What a page shows before it says (a page of an older version never says).
 DEFAULT_VIEW = (frozenset(EYES), False)
-# The scene is sent once and kept (transient local), as RViz expects; the link frames are
-# a stream (the newest only matters).
+# The scene is sent once and kept (transient local), as RViz expects.
 # The simulator keeps two messages on the scene for a late subscriber (the layout and the
 # movers, from a publisher each): a depth of 1 would keep only the one that came last.
 SCENE_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
-LINKS_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+# The page draws the newest frames: /tf's depth need not be tf2's 100.
+TF_PAGE_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 
 
 @dataclass
@@ -97,7 +100,12 @@ class GuiBridge(Node):
         self.status = ''
         self.robots = []
         self.scene = SceneState()  # under self._lock
-        self._scene_subs = {}  # 'scene' or a robot's name: subscription
+        self._scene_subs = {}  # 'scene', TF, TF_STATIC or a robot's name: subscription
+        try:
+            self._tf_type = message_class(TF_TYPE)
+        except ValueError as err:  # tf2_msgs not built: the world view shows no robot
+            self._tf_type = None
+            self.get_logger().warning(f'the world view draws no robot: {err}')
         self._overhead_sub = None
         self._wake = self.create_guard_condition(self._run_commands)
         self._states = {}
@@ -223,17 +231,26 @@ class GuiBridge(Node):
 
     def _update_scene_subscriptions(self):
         world = any(page.world for page in self.pages.values())
-        wanted = {'scene'} | set(self.robots) if world else set()
+        wanted = set()
+        if world:
+            wanted = {'scene'} | set(self.robots)
+            if self._tf_type is not None:
+                wanted |= {TF, TF_STATIC}
         for key in set(self._scene_subs) - wanted:
             self.destroy_subscription(self._scene_subs.pop(key))
         for key in wanted - set(self._scene_subs):
             if key == 'scene':
                 sub = self.create_subscription(MarkerArray, self.sim.topics.scene,
                                                self._on_scene, SCENE_QOS)
+            elif key in (TF, TF_STATIC):
+                sub = self.create_subscription(
+                    self._tf_type, key, self._on_tf,
+                    profile(TF_STATIC_QOS) if key == TF_STATIC else TF_PAGE_QOS)
             else:
                 sub = self.create_subscription(
-                    PoseArray, self.sim.topics.links(key),
-                    lambda msg, robot=key: self._on_links(robot, msg), LINKS_QOS)
+                    String, RobotTopics(key).topic(TOPIC['robot_description'].name),
+                    lambda msg, robot=key: self._on_description(robot, msg),
+                    profile(TOPIC['robot_description'].qos))
             self._scene_subs[key] = sub
 
     def _on_scene(self, msg):
@@ -242,9 +259,15 @@ class GuiBridge(Node):
         if changed:
             self.on_frame(None)
 
-    def _on_links(self, robot, msg):
+    def _on_description(self, robot, msg):
         with self._lock:
-            changed = self.scene.apply_links(robot, msg, self.warn)
+            changed = self.scene.apply_description(robot, msg.data, self.warn)
+        if changed:
+            self.on_frame(None)
+
+    def _on_tf(self, msg):
+        with self._lock:
+            changed = self.scene.apply_tf(msg.transforms, self.warn)
         if changed:
             self.on_frame(None)
 

@@ -1,11 +1,11 @@
-"""The world as the page draws it: the simulator's scene markers and frames, as JSON.
+"""The world as the page draws it: the simulator's scene markers, the robots and /tf, as JSON.
 
-The simulator publishes its world as visualization_msgs Markers (/miro_sim/scene), as
-RViz reads them, and where each robot's link frames are in the world as one PoseArray
-per robot (/miro_sim/links/<robot>, in the order of constants.LINK_FRAMES). The page gets
-the same in a form three.js takes at once: a marker becomes
+The simulator publishes its world as visualization_msgs Markers (/miro_sim/scene), each
+robot's body as its URDF (<robot>/robot_description) and every frame on /tf and
+/tf_static, as RViz reads them. The page gets the same in a form three.js takes at once:
+a marker, and each primitive <visual> of a URDF, becomes
 {"id": "<ns>/<id>", "ns", "frame", "kind", "p", "q", "scale", "colour", ...} and a
-frame {"<robot>/<link>": {"parent": "world", "p", "q"}}. SceneState keeps the newest of
+frame {"<robot>/<link>": {"parent": "<robot>/<its parent>", "p", "q"}}. SceneState keeps the newest of
 each with a sequence number, so each page is sent only what changed since it last heard,
 and a page that turns its world view on gets everything. Pictures' PNGs are kept here by key and
 served by the web server at TEXTURE_URL; the markers carry the URL, not the bytes.
@@ -16,8 +16,9 @@ import json
 import math
 import re
 
-from miro_ball.miro.constants import LINK_FRAMES
 from miro_ball.miro.interface import WORLD_FRAME, frame_id
+from miro_ball.miro.rotations import rpy_quaternion
+from miro_ball.miro.urdf import parse_visuals, UrdfError
 
 # visualization_msgs/Marker's numbers (the message's own constants; checked in the test).
 CUBE, SPHERE, CYLINDER, CUBE_LIST, TRIANGLE_LIST = 1, 2, 3, 6, 11
@@ -141,16 +142,50 @@ def marker_json(marker):
     return out, texture
 
 
-def link_frames(robot, pose_array, names=LINK_FRAMES):
-    """[(frame "<robot>/<name>", {"parent", "p", "q"})] of the simulator's PoseArray of one
-    robot's link frames (in the order of ``names``), or SceneRejected."""
-    parent = _frame(pose_array.header.frame_id, 'frame_id') or WORLD_FRAME
-    poses = pose_array.poses
-    if len(poses) != len(names):
-        raise SceneRejected(f'{len(poses)} link poses of {robot}, not {len(names)}')
-    return [(frame_id(robot, name), {'parent': parent, 'p': _xyz(pose.position),
-                                     'q': _quaternion(pose.orientation)})
-            for name, pose in zip(names, poses)]
+DESCRIPTION_ID = 'urdf-'  # the ids of a robot's shapes from its robot_description
+
+
+def description_markers(robot, text):
+    """The page's dicts of the shapes of a robot's robot_description (URDF text), each in
+    its link's frame '<robot>/<link>' (which /tf moves), or SceneRejected. The same form as
+    a marker's, so the page draws them as it draws the scene: a box by its size, a sphere
+    and a cylinder by their diameters, as RViz scales markers."""
+    try:
+        visuals = parse_visuals(text)
+    except UrdfError as err:
+        raise SceneRejected(str(err)) from None
+    out = []
+    for k, (link, shape, rgba) in enumerate(visuals):
+        if shape.kind == 'box':
+            scale = shape.size
+        elif shape.kind == 'sphere':
+            scale = (2 * shape.size[0],) * 3
+        else:
+            radius, length = shape.size
+            scale = (2 * radius, 2 * radius, length)
+        out.append({'id': f'{robot}/{DESCRIPTION_ID}{k}', 'ns': robot,
+                    'frame': frame_id(robot, _name(link, 'link')), 'kind': shape.kind,
+                    'p': _finite(shape.xyz, DIGITS_POSITION, 'a point'),
+                    'q': [round(c, DIGITS_ROTATION) for c in rpy_quaternion(*shape.rpy)],
+                    'scale': _finite(scale, DIGITS_POSITION, 'a scale'),
+                    'colour': [min(max(c, 0.0), 1.0) for c in
+                               _finite(rgba, DIGITS_COLOUR, 'a colour')],
+                    'link': link})
+    return out
+
+
+def tf_frames(transforms):
+    """[(child, {"parent", "p", "q"})] of a TFMessage's transforms, each checked (frame
+    names, finite numbers); a bad one raises SceneRejected."""
+    out = []
+    for t in transforms:
+        child = _frame(t.child_frame_id, 'child_frame_id')
+        parent = _frame(t.header.frame_id, 'frame_id') or WORLD_FRAME
+        if not child or child == parent:
+            raise SceneRejected(f'the transform of {child[:40]!r} has no frame of its own')
+        out.append((child, {'parent': parent, 'p': _xyz(t.transform.translation),
+                            'q': _quaternion(t.transform.rotation)}))
+    return out
 
 
 class SceneState:
@@ -202,6 +237,10 @@ class SceneState:
             if key not in self.textures and len(self.textures) >= MAX_TEXTURES:
                 raise SceneRejected(f'more than {MAX_TEXTURES} textures')
             self.textures[key] = data
+        return self._set_marker(out)
+
+    def _set_marker(self, out):
+        """Keep one marker's dict; 1 if it changed, else 0."""
         text = json.dumps(out, separators=(',', ':'))
         old = self.markers.get(out['id'])
         if old is not None and old[1] == text:
@@ -220,15 +259,31 @@ class SceneState:
             del self.removed[next(iter(self.removed))]
         return 1
 
-    def apply_links(self, robot, pose_array, warn):
-        """Take the PoseArray of one robot's link frames; returns how many frames changed."""
+    def apply_description(self, robot, text, warn):
+        """Take a robot's robot_description: its shapes replace those it had. Returns how
+        many markers changed."""
         try:
-            frames = link_frames(robot, pose_array)
+            markers = description_markers(robot, text)
         except SceneRejected as err:
-            warn(f'links:{robot}', f'the link frames of {robot} not shown: {err}')
+            warn(f'description:{robot}', f'the robot_description of {robot} not drawn: {err}')
+            return 0
+        prefix = f'{robot}/{DESCRIPTION_ID}'
+        ids = {m['id'] for m in markers}
+        changed = sum(self._remove(i) for i in list(self.markers)
+                      if i.startswith(prefix) and i not in ids)
+        for out in markers:
+            changed += self._set_marker(out)
+        return changed
+
+    def apply_tf(self, transforms, warn):
+        """Take a TFMessage's transforms; returns how many frames changed."""
+        try:
+            frames = tf_frames(transforms)
+        except SceneRejected as err:
+            warn('tf', f'a /tf message not shown: {err}')
             return 0
         except (TypeError, ValueError, AttributeError) as err:  # garbage from the graph
-            warn(f'links:{robot}', f'malformed link frames of {robot} ignored: {err}')
+            warn('tf', f'a malformed /tf message ignored: {err}')
             return 0
         changed = 0
         for child, out in frames:

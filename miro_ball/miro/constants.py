@@ -15,14 +15,6 @@ PLATFORM_TICK_S = 0.02  # 50 Hz sensor and control tick
 JOINT_NAMES = ('tilt', 'lift', 'yaw', 'pitch')
 # What a reader of a JointState of the neck wants, in words.
 JOINT_POSITIONS = f'positions [{", ".join(JOINT_NAMES)}]'
-# The simulated MiRo's links, as the scene draws them: the body (the base, at the wheel
-# axle), then each link; then the eyes' optical frames (REP 103: z along the optical axis,
-# x right, y down). /miro_sim/links/<robot> gives their world poses in this order, and a
-# robot's scene markers are in the frames '<robot>/<name>'.
-LINK_NAMES = ('body', 'wheel_l', 'wheel_r', 'neck', 'gimbal', 'head', 'tail_droop', 'tail',
-              'eyelid_l', 'eyelid_r', 'ear_l', 'ear_r', 'led_lf', 'led_lm', 'led_lr', 'led_rf',
-              'led_rm', 'led_rr')
-LINK_FRAMES = LINK_NAMES + ('caml_optical', 'camr_optical')
 TILT, LIFT, YAW, PITCH = range(4)
 TILT_RAD = math.radians(-6.0)  # fixed pseudo-joint: the body rests tilted back
 JOINT_LIMITS_RAD = (

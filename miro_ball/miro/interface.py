@@ -299,11 +299,6 @@ class SimTopics:
         """visualization_msgs/MarkerArray: the world to draw (RViz, Foxglove, the GUI)."""
         return self.topic('scene')
 
-    def links(self, robot):
-        """geometry_msgs/PoseArray: where a robot's link frames are in the world
-        (constants.LINK_FRAMES, in order), to move the robot's markers of the scene."""
-        return self.topic(f'links/{check_name(robot)}')
-
     def touch(self, robot, part):
         """std_msgs/UInt16 in: the pads of a robot's head or body a hand touches now."""
         if part not in TOUCH_PARTS:

@@ -5,9 +5,11 @@ frames on /tf do ('<robot>/<link>'). Inertias are those of each link's first sha
 solid of the link's mass: enough for a viewer, and the simulator takes its own from the
 collision shapes.
 """
+import math
+from xml.etree import ElementTree
 from xml.sax.saxutils import quoteattr
 
-from miro_ball.miro.body import BOX, COLOURS, CYLINDER, FIXED, LINKS, ROOT
+from miro_ball.miro.body import BOX, COLOURS, CYLINDER, FIXED, LINKS, ROOT, Shape, SPHERE
 
 ROBOT_NAME = 'miro_e'  # the model's name in the URDF, not a robot's
 
@@ -87,3 +89,75 @@ def urdf():
         lines += _link(link) + _joint(link)
     lines.append('</robot>')
     return '\n'.join(lines) + '\n'
+
+
+MAX_URDF_BYTES = 1 << 20  # ours is ~15 KB; a robot_description beyond this is refused
+MAX_VISUALS = 2000
+
+
+class UrdfError(ValueError):
+    """A robot_description that cannot be drawn; the text says why, in one line."""
+
+
+def _floats(text, count, what):
+    try:
+        values = [float(v) for v in (text or '').split()]
+    except ValueError:
+        raise UrdfError(f'{what} {text[:40]!r} is not {count} numbers') from None
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise UrdfError(f'{what} {str(text)[:40]!r} is not {count} finite numbers')
+    return tuple(values)
+
+
+def _size(geometry):
+    """(kind, size) of a <geometry>'s box, sphere or cylinder, or None (a mesh: not drawn)."""
+    for kind, attributes in ((BOX, ('size',)), (SPHERE, ('radius',)),
+                             (CYLINDER, ('radius', 'length'))):
+        element = geometry.find(kind)
+        if element is not None:
+            if kind == BOX:
+                return kind, _floats(element.get('size'), 3, 'a box size')
+            return kind, tuple(_floats(element.get(a), 1, f'a {kind} {a}')[0]
+                               for a in attributes)
+    return None
+
+
+def parse_visuals(text):
+    """[(link name, Shape, rgba)] of every primitive <visual> of a URDF's text (meshes are
+    skipped), or UrdfError in one line. Colours come from the visual's material, by name
+    from the robot's materials; grey when it has none."""
+    if not isinstance(text, str) or len(text) > MAX_URDF_BYTES:
+        raise UrdfError(f'a URDF of at most {MAX_URDF_BYTES} characters is needed')
+    try:
+        robot = ElementTree.fromstring(text)
+    except ElementTree.ParseError as err:
+        raise UrdfError(f'not XML: {err}') from None
+    if robot.tag != 'robot':
+        raise UrdfError(f'the root element is <{robot.tag[:40]}>, not <robot>')
+    named = {}
+    for material in robot.iter('material'):
+        colour = material.find('color')
+        if material.get('name') and colour is not None:
+            named[material.get('name')] = _floats(colour.get('rgba'), 4, 'a colour')
+    out = []
+    for link in robot.findall('link'):
+        for visual in link.findall('visual'):
+            geometry = visual.find('geometry')
+            shape = _size(geometry) if geometry is not None else None
+            if shape is None:
+                continue
+            origin = visual.find('origin')
+            xyz = _floats(origin.get('xyz', '0 0 0'), 3, 'an origin') if origin is not None \
+                else (0.0, 0.0, 0.0)
+            rpy = _floats(origin.get('rpy', '0 0 0'), 3, 'an origin') if origin is not None \
+                else (0.0, 0.0, 0.0)
+            material = visual.find('material')
+            rgba = (0.6, 0.6, 0.6, 1.0)
+            if material is not None:
+                inline = material.find('color')
+                rgba = _floats(inline.get('rgba'), 4, 'a colour') if inline is not None \
+                    else named.get(material.get('name'), rgba)
+            out.append((str(link.get('name', ''))[:256], Shape(*shape, xyz, rpy), rgba))
+            if len(out) > MAX_VISUALS:
+                raise UrdfError(f'more than {MAX_VISUALS} visuals')
+    return out

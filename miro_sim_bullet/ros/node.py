@@ -287,7 +287,7 @@ class SimNode(Node):
                 spent['sensor topics'] += clock() - started
             if self.scene is not None and sim.time >= self._next_scene:
                 started = clock()
-                self.scene.publish(convert.stamp(sim.time))
+                self.scene.publish()
                 self._next_scene += 1.0 / SCENE_RATE_HZ
                 spent['scene'] += clock() - started
             rate = self.params.overhead_rate

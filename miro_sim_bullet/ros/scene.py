@@ -4,15 +4,16 @@ Two kinds of message go out on the one topic, each from a publisher of its own t
 its newest message for late subscribers (transient local), so a viewer that joins at any
 time gets both:
 
-- the layout: every static shape and picture in frame ``world``, and every robot's shapes
-  in its link frames (``<robot>/<link>``, frame-locked: /miro_sim/links/<robot> says where
-  those frames are, see frames.py). Sent at the start, after a reset and when a robot's
-  colours change (its LEDs);
+- the layout: every static shape and picture in frame ``world``, and every robot's LEDs
+  in their link frames (``<robot>/led_lf``, ..., frame-locked: /tf moves them) in the
+  colours control/illum gives them. The robots themselves are drawn from their
+  robot_description (the URDF). Sent at the start, after a reset and when a robot's LEDs
+  change;
 - the movers: every movable object (the ball, named boxes) in frame ``world``, sent at up
   to SCENE_RATE_HZ of simulated time, only when one of them has moved.
 
 A robot costs the scene topic nothing while its LEDs stay as they are: its motion is on
-its links topic. Marker namespaces are the objects' and robots' names; unnamed statics are grouped by
+/tf. Marker namespaces are the objects' and robots' names; unnamed statics are grouped by
 the world-file table they come from (``wall``, ``ring``, ``table``, ``box``, ``ground``,
 ``picture``). A robot's markers carry the link's name in ``text``.
 """
@@ -20,19 +21,23 @@ import hashlib
 import math
 from pathlib import Path
 
+import numpy as np
+
 from builtin_interfaces.msg import Duration
 from geometry_msgs.msg import Point
 from sensor_msgs.msg import CompressedImage
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray, UVCoordinate
 
-from miro_ball.miro.constants import LINK_NAMES
+from miro_ball.miro.body import PHYSICAL
 from miro_ball.miro.interface import frame_id, WORLD_FRAME
+from miro_ball.miro.rotations import matrix_quaternions
 from miro_sim_bullet.bullet import pybullet as pb
+from miro_sim_bullet.physics.model import ILLUM_LINKS
 from miro_sim_bullet.render.visuals import BodyVisuals, MESHES
-from miro_sim_bullet.ros.frames import quaternion
 
 SCENE_RATE_HZ = 30.0
+LED_MARKER_SCALE = 1.15
 MOVED_M = 0.0005  # a mover is sent again once it has moved this far...
 TURNED = 2e-7  # ... or turned (1 - |q.q'|: about 0.05 degrees)
 _TYPES = {'box': Marker.CUBE, 'sphere': Marker.SPHERE, 'cylinder': Marker.CYLINDER}
@@ -63,7 +68,7 @@ def _shape_marker(mesh, scale, colour, frame, ns, marker_id):
 def _place(marker, rotation, position):
     p, o = marker.pose.position, marker.pose.orientation
     p.x, p.y, p.z = (float(v) for v in position)
-    o.x, o.y, o.z, o.w = quaternion(rotation)
+    o.x, o.y, o.z, o.w = (float(v) for v in matrix_quaternions(rotation)[0])
     return marker
 
 
@@ -119,13 +124,14 @@ class SceneMarkers:
         return MarkerArray(markers=markers)
 
     def _robot_markers(self, robot, visuals):
-        """A robot's shapes in its link frames, frame-locked: /tf moves them."""
+        """A robot's LEDs in their link frames, frame-locked: /tf moves them. A shade larger
+        than the URDF's patches, so a viewer that draws both shows the lit colour."""
         colours = visuals.colours()
         markers = []
-        for k in range(len(visuals.mesh)):
-            link = LINK_NAMES[visuals.link[k] + 1]
-            marker = _shape_marker(visuals.mesh[k], visuals.scale[k], colours[k],
-                                   frame_id(robot, link), robot, k)
+        for k in np.flatnonzero(np.isin(visuals.link, ILLUM_LINKS)):
+            link = PHYSICAL[visuals.link[k]]
+            marker = _shape_marker(visuals.mesh[k], visuals.scale[k] * LED_MARKER_SCALE,
+                                   colours[k], frame_id(robot, link), robot, int(k))
             marker.frame_locked, marker.text = True, link
             markers.append(_place(marker, visuals.rot[k], visuals.offset[k]))
         return markers
