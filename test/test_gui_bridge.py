@@ -6,23 +6,25 @@ import math
 import time
 
 import pytest
-from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
+from geometry_msgs.msg import PoseStamped, TransformStamped, TwistStamped
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import ParameterType, ParameterValue, SetParametersResult
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, JointState
-from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, UInt32MultiArray
+from std_msgs.msg import (Float32MultiArray, String, UInt16, UInt16MultiArray, UInt32,
+                          UInt32MultiArray)
+from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import Marker, MarkerArray
 
 from miro_ball.gui import protocol as p
 from miro_ball.gui.bridge import GuiBridge, handled_commands
 from miro_ball.gui.robot_part import DEADMAN_S, NODE_NAME
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.constants import (DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, LINK_FRAMES,
-                                      PLATFORM_TICK_S)
-from miro_ball.miro.interface import (BALL_NAME, EYES, RobotTopics, SimTopics,
-                                      default_robot_name)
+from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, PLATFORM_TICK_S
+from miro_ball.miro.interface import (BALL_NAME, default_robot_name, EYES, RobotTopics,
+                                      SimTopics, TF)
+from miro_ball.miro.urdf import urdf
 from miro_ball.miro.touch import pads_at
 from rostools import poll, Probe, spin_until
 
@@ -280,21 +282,26 @@ def test_the_scene_is_followed_only_while_a_page_shows_the_world(
     ball.header.frame_id = 'world'
     ball.pose.orientation.w = 1.0
     scene.publish(MarkerArray(markers=[ball]))  # before anyone listens: kept for them
-    links = probe.publisher(PoseArray, SIM.links(T.name))
+    tf = probe.publisher(TFMessage, TF)
+    description = probe.node.create_publisher(String, T.topic('robot_description'), latched)
+    description.publish(String(data=urdf()))
     assert spin_until(executor, lambda: bridge.robots == [T.name])
     opened(bridge, executor)
-    assert bridge.count_subscribers(SIM.scene) == 0 and bridge.count_subscribers(
-        SIM.links(T.name)) == 0
+    assert bridge.count_subscribers(SIM.scene) == 0 and bridge.count_subscribers(TF) == 0
     bridge.submit(p.View(frozenset(EYES), True), owner=1)
-    assert spin_until(executor, lambda: json.loads(bridge.scene_message(None)[0])['markers'])
-    assert json.loads(bridge.scene_message(None)[0])['markers'][0]['id'] == f'{BALL_NAME}/0'
-    assert spin_until(executor, lambda: links.get_subscription_count() == 1)
-    poses = PoseArray()
-    poses.header.frame_id = 'world'
-    poses.poses = [ball.pose] * len(LINK_FRAMES)
-    links.publish(poses)
+    assert spin_until(executor, lambda: f'{BALL_NAME}/0' in {
+        m['id'] for m in json.loads(bridge.scene_message(None)[0])['markers']})
+    assert spin_until(executor, lambda: any(  # MiRo drawn from its robot_description
+        m['frame'] == f'{T.name}/head' for m in
+        json.loads(bridge.scene_message(None)[0])['markers']))
+    assert spin_until(executor, lambda: tf.get_subscription_count() == 1)
+    head = TransformStamped(child_frame_id=f'{T.name}/head')
+    head.header.frame_id = f'{T.name}/gimbal'
+    head.transform.rotation.w = 1.0
+    tf.publish(TFMessage(transforms=[head]))
     assert spin_until(executor, lambda: bridge.tf_message(None)[0])
-    assert f'{T.name}/head' in json.loads(bridge.tf_message(None)[0])['frames']
+    assert json.loads(bridge.tf_message(None)[0])['frames'][f'{T.name}/head']['parent'] == \
+        f'{T.name}/gimbal'
     bridge.submit(p.View(frozenset(EYES), False), owner=1)
     assert spin_until(executor, lambda: bridge.count_subscribers(SIM.scene) == 0
-                      and bridge.count_subscribers(SIM.links(T.name)) == 0)
+                      and bridge.count_subscribers(TF) == 0)

@@ -346,13 +346,13 @@ def test_a_drag_reaches_the_simulator_at_most_30_times_a_second_the_newest_last(
 
 
 def test_a_page_that_shows_the_world_gets_it_whole_then_what_moved_and_its_pictures():
-    from test_gui_scene import Warnings, links, marker, picture  # the scene's own builders
+    from test_gui_scene import Warnings, marker, picture, transforms  # the scene's builders
 
     async def run():
         bridge = FakeBridge()
         warn = Warnings()
         bridge.scene.apply_markers([marker('ball'), marker('wall', 1), picture('logo')], warn)
-        bridge.scene.apply_links('miro02', links(), warn)
+        bridge.scene.apply_tf(transforms(), warn)
         async with web_gui(bridge) as (server, address, warnings), \
                 aiohttp.ClientSession() as session, \
                 session.ws_connect(address + 'ws') as ws:
@@ -373,7 +373,7 @@ def test_a_page_that_shows_the_world_gets_it_whole_then_what_moved_and_its_pictu
 
     whole, frames, moved, png, missing, tone = asyncio.run(run())
     assert {m['id'] for m in whole['markers']} == {'ball/0', 'wall/1', 'picture/3'}
-    assert len(frames['frames']) == len(links().poses)
+    assert len(frames['frames']) == len(transforms())
     assert [m['id'] for m in moved['markers']] == ['ball/0'] and moved['removed'] == []
     assert png[:2] == (200, 'image/png') and png[2].startswith(b'\x89PNG')
     assert missing == [404, 404, 404]

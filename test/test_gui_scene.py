@@ -1,15 +1,16 @@
-"""The scene as the page gets it: markers and link frames -> JSON, and only what changed."""
+"""The scene as the page gets it: markers, robot_description and /tf -> JSON, and only what
+changed."""
 import json
 import math
 
 import pytest
-from geometry_msgs.msg import Point, Pose, PoseArray
+from geometry_msgs.msg import Point, TransformStamped
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, UVCoordinate
 
 from miro_ball.gui import scene as s
-from miro_ball.miro.constants import LINK_FRAMES
 from miro_ball.miro.interface import DEFAULT_ROBOT_NAME, WORLD_FRAME
+from miro_ball.miro.urdf import parse_visuals, urdf
 
 PNG = b'\x89PNG\r\n\x1a\n' + b'\x00' * 20  # the page decodes it; the server only keeps it
 
@@ -39,15 +40,20 @@ def picture(key='logo'):
     return m
 
 
-def links(xyz=(0.0, 0.0, 0.0), count=len(LINK_FRAMES)):
-    msg = PoseArray()
-    msg.header.frame_id = WORLD_FRAME
-    for i in range(count):
-        pose = Pose()
-        pose.position.x, pose.position.y, pose.position.z = xyz[0] + i * 0.01, xyz[1], xyz[2]
-        pose.orientation.w = 1.0
-        msg.poses.append(pose)
-    return msg
+FRAMES = ('miro02/odom', 'miro02/base_link', 'miro02/body', 'miro02/neck')
+
+
+def transforms(xyz=(0.0, 0.0, 0.0), parent=WORLD_FRAME):
+    """/tf's transforms of a chain of frames under ``parent``."""
+    out = []
+    for i, child in enumerate(FRAMES):
+        t = TransformStamped(child_frame_id=child)
+        t.header.frame_id = parent if i == 0 else FRAMES[i - 1]
+        v = t.transform.translation
+        v.x, v.y, v.z = xyz[0] + i * 0.01, xyz[1], xyz[2]
+        t.transform.rotation.w = 1.0
+        out.append(t)
+    return out
 
 
 class Warnings(list):
@@ -173,28 +179,58 @@ def test_too_many_points_are_refused():
         s.marker_json(m)
 
 
-def test_link_frames_are_named_by_robot_and_link_under_the_world():
+def test_tf_frames_keep_their_parents_and_only_changes_go_out():
     state, warn = s.SceneState(), Warnings()
-    assert state.apply_links('miro02', links(), warn) == len(LINK_FRAMES)
+    assert state.apply_tf(transforms(), warn) == len(FRAMES)
     frames = json.loads(state.tf_message(None))['frames']
-    assert set(frames) == {f'miro02/{name}' for name in LINK_FRAMES}
-    assert frames['miro02/body'] == {'parent': WORLD_FRAME, 'p': [0.0, 0.0, 0.0],
+    assert set(frames) == set(FRAMES)
+    assert frames['miro02/odom'] == {'parent': WORLD_FRAME, 'p': [0.0, 0.0, 0.0],
                                      'q': [0.0, 0.0, 0.0, 1.0]}
+    assert frames['miro02/body']['parent'] == 'miro02/base_link'
     seen = state.seq
-    assert state.apply_links('miro02', links(), warn) == 0
+    assert state.apply_tf(transforms(), warn) == 0
     assert state.tf_message(seen) is None  # nothing moved: nothing to send
-    state.apply_links('miro02', links(xyz=(0.5, 0.0, 0.0)), warn)
-    assert len(json.loads(state.tf_message(seen))['frames']) == len(LINK_FRAMES)
+    state.apply_tf(transforms(xyz=(0.5, 0.0, 0.0)), warn)
+    assert len(json.loads(state.tf_message(seen))['frames']) == len(FRAMES)
     assert warn == []
 
 
-def test_link_poses_that_do_not_match_the_frames_are_ignored():
+def test_bad_transforms_are_refused_with_a_warning():
     state, warn = s.SceneState(), Warnings()
-    assert state.apply_links('miro02', links(count=3), warn) == 0
-    bad = links()
-    bad.poses[0].orientation.w = math.inf
-    assert state.apply_links('miro02', bad, warn) == 0
+    bad = transforms()
+    bad[0].transform.rotation.w = math.inf
+    assert state.apply_tf(bad, warn) == 0
+    looped = transforms()
+    looped[1].header.frame_id = looped[1].child_frame_id  # its own parent
+    assert state.apply_tf(looped, warn) == 0
     assert state.tf_message(None) is None and len(warn) == 2
+
+
+def test_a_robot_is_drawn_from_its_robot_description():
+    state, warn = s.SceneState(), Warnings()
+    visuals = parse_visuals(urdf())
+    assert state.apply_description('miro02', urdf(), warn) == len(visuals)
+    markers = [json.loads(text) for _, text in state.markers.values()]
+    assert {m['frame'] for m in markers} == {f'miro02/{link}' for link, _, _ in visuals}
+    assert {m['ns'] for m in markers} == {'miro02'}
+    assert {'head', 'body', 'ear_l', 'ear_r', 'tail', 'eyelid_l'} <= {m['link'] for m in markers}
+    spheres = [m for m in markers if m['kind'] == 'sphere']
+    assert spheres and all(len(set(m['scale'])) == 1 for m in spheres)  # by their diameter
+    assert state.apply_description('miro02', urdf(), warn) == 0  # again: nothing changed
+    assert warn == []
+
+
+@pytest.mark.parametrize('text', [
+    'not xml <', '<html/>', 'x' * (2 << 20),
+    '<robot><link name="a"><visual><geometry><box size="1 nan 1"/></geometry></visual>'
+    '</link></robot>',
+    '<robot><link name="a"><visual><geometry><sphere radius="big"/></geometry></visual>'
+    '</link></robot>',
+])
+def test_a_bad_robot_description_is_refused_in_one_line(text):
+    state, warn = s.SceneState(), Warnings()
+    assert state.apply_description('miro02', text, warn) == 0
+    assert len(warn) == 1 and '\n' not in warn[0] and state.markers == {}
 
 
 def test_orientations_are_unit_quaternions_and_numbers_short():

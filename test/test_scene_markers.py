@@ -1,30 +1,21 @@
-"""The scene as markers and link frames: what RViz, Foxglove and the GUI's world view draw.
+"""The scene as markers and the robots' frames: what RViz, Foxglove and the GUI's world view
+draw.
 
 Built straight from the simulated world (no ROS graph): every object of every bundled world
-is there as the world file says, the movers go out only when they move, a robot's markers
-hang in link frames whose poses are the simulator's own.
+is there as the world file says, the movers go out only when they move, a robot's LEDs hang
+in link frames whose poses on /tf are the simulator's own.
 """
-import math
-
-import numpy as np
 import pytest
 from visualization_msgs.msg import Marker
 
-from miro_ball.miro.constants import LINK_FRAMES, LINK_NAMES
+from miro_ball.miro.body import ILLUM_NAMES
 from miro_ball.miro.interface import BALL_NAME, EYE_SIDE, frame_id
+from miro_ball.miro.tf_tree import TfTree
 from miro_sim_bullet.physics.world import SimWorld
-from miro_sim_bullet.ros.frames import quaternion, RobotLinks
 from miro_sim_bullet.ros.scene import SceneMarkers
 from miro_sim_bullet.physics import model as rb
-from miro_sim_bullet.ros import convert
+from miro_sim_bullet.ros import convert, tf
 from miro_sim_bullet.scene.world_file import bundled_worlds
-
-
-def rotation_of(q):
-    x, y, z, w = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
 
 @pytest.fixture(scope='module', params=bundled_worlds())
@@ -58,13 +49,14 @@ def test_every_object_of_the_world_file_is_drawn(built):
     assert len(keys) == len(set(keys)), 'a marker would replace another'
 
 
-def test_a_robot_hangs_in_its_link_frames(built):
+def test_a_robots_leds_hang_in_their_link_frames(built):
+    """The robots are drawn from their robot_description; the scene adds their LEDs' colours."""
     layout = SceneMarkers(built).layout().markers
     for name in built.robots:
         mine = [m for m in layout if m.ns == name]
-        assert mine and all(m.frame_locked for m in mine)
-        assert {m.header.frame_id for m in mine} <= {frame_id(name, n) for n in LINK_NAMES}
-        assert {m.text for m in mine} >= {'body', 'head', 'ear_l', 'ear_r', 'tail'}
+        assert all(m.frame_locked for m in mine)
+        assert sorted(m.header.frame_id for m in mine) == sorted(
+            frame_id(name, led) for led in ILLUM_NAMES)
 
 
 def test_movers_go_out_when_they_move_and_only_then():
@@ -91,36 +83,27 @@ def test_the_layout_is_sent_again_when_the_leds_change():
     world.close()
 
 
-def test_the_link_frames_are_where_the_simulator_has_them():
+def test_the_frames_on_tf_are_where_the_simulator_has_the_links():
+    """/tf's transforms of one tick, composed, put the head and the eyes' optical frames
+    where the simulator draws the eyes from."""
     world = SimWorld('empty')
     robot = world.robot
     robot.set_kinematic_targets((0.0, 0.5, 0.6, -0.1))
     world.run(1.0)
-    links = RobotLinks(world, robot.name)
-    frames = {name: (rotation_of(q), np.array(p)) for name, (p, q) in
-              zip(LINK_FRAMES, links.frames())}
-    assert len(frames) == len(LINK_FRAMES) == len(links.frames())
-    message = links.message(convert.stamp(world.time))
-    assert message.header.frame_id == 'world' and len(message.poses) == len(LINK_FRAMES)
+    when = convert.stamp(world.time)
+    tree = TfTree()
+    for t in tf.static_transforms([robot.name], when) + tf.robot_transforms(
+            robot.sensors, when, robot.name):
+        v, r = t.transform.translation, t.transform.rotation
+        tree.set(t.header.frame_id, t.child_frame_id, (v.x, v.y, v.z), (r.x, r.y, r.z, r.w))
     for eye in ('caml', 'camr'):
         position, rotation = robot.eye_pose(EYE_SIDE[eye])
-        optical_rot, optical_pos = frames[f'{eye}_optical']
-        assert optical_pos == pytest.approx(position, abs=1e-6)
-        assert optical_rot[:, 2] == pytest.approx(rotation[:, 0], abs=1e-6)  # z looks out
-        assert optical_rot[:, 0] == pytest.approx(-rotation[:, 1], abs=1e-6)  # x right
-        pose = message.poses[LINK_FRAMES.index(f'{eye}_optical')]
-        q = (pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w)
-        assert rotation_of(q) == pytest.approx(optical_rot, abs=1e-6)
-    head_rot, head_pos = frames['head']
+        optical = tree.lookup('world', frame_id(robot.name, f'{eye}_optical'))
+        assert optical[:3, 3] == pytest.approx(position, abs=1e-5)
+        assert optical[:3, 2] == pytest.approx(rotation[:, 0], abs=1e-5)  # z looks out
+        assert optical[:3, 0] == pytest.approx(-rotation[:, 1], abs=1e-5)  # x right
+    head = tree.lookup('world', frame_id(robot.name, 'head'))
     position, rotation = robot.link_frame(rb.HEAD)
-    assert head_pos == pytest.approx(position, abs=1e-6)
-    assert head_rot == pytest.approx(rotation, abs=1e-6)
+    assert head[:3, 3] == pytest.approx(position, abs=1e-5)
+    assert head[:3, :3] == pytest.approx(rotation, abs=1e-5)
     world.close()
-
-
-@pytest.mark.parametrize('angles', [(0, 0, 0), (math.pi, 0, 0), (0, math.pi, 0),
-                                    (0.3, -2.0, 3.1), (math.pi / 2, math.pi / 2, 0)])
-def test_quaternions_turn_as_their_matrices(angles):
-    from miro_sim_bullet.bullet import pybullet as pb
-    matrix = np.array(pb.getMatrixFromQuaternion(pb.getQuaternionFromEuler(angles))).reshape(3, 3)
-    assert rotation_of(quaternion(matrix)) == pytest.approx(matrix, abs=1e-6)
