@@ -9,6 +9,7 @@ what it had to. Chromium asks for at most 60 frames a second. Run it alone:
 ``flock /tmp/miro_heavy.lock .venv/bin/python -m miro_ball.bench.world_view_bench``.
 """
 import argparse
+import contextlib
 import os
 import statistics
 import sys
@@ -35,9 +36,11 @@ COUNTS_JS = """() => ({drawn: miroGui.world.drawn, caml: miroGui.frames.caml || 
                        ms: miroGui.world.drawMs.slice()})"""
 
 
-def measure_world_view(seconds=10.0, warmup=3.0, renderer='auto', world=WORLD):
-    """{'fps', 'on_demand_fps', 'draw_ms_median', 'eye_fps', 'robots', 'webgl'} of the world
-    view with a page open; raises RuntimeError when the page never got ready."""
+@contextlib.contextmanager
+def world_view_page(renderer='auto', world=WORLD):
+    """(page, robots, errors): the simulator of ``world`` in this process, miro_gui in a child
+    process, and a headless Chromium page whose world view shows every robot and whose eyes
+    have drawn; RuntimeError when the page never got there."""
     from playwright.sync_api import sync_playwright
 
     domain = private_domain(salt=71)
@@ -62,19 +65,26 @@ def measure_world_view(seconds=10.0, warmup=3.0, renderer='auto', world=WORLD):
                     raise RuntimeError(f'the world view never showed {robots} robots and the '
                                        f'eyes (page errors: {errors})')
                 page.wait_for_timeout(200)
-            webgl = page.evaluate("""() => { const gl = miroGui.world.renderer.getContext();
-                const info = gl.getExtension('WEBGL_debug_renderer_info');
-                return info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : '?'; }""")
-            size = page.evaluate("[miroGui.world.canvas.width, miroGui.world.canvas.height]")
-            page.wait_for_timeout(warmup * 1000)
-            on_demand = _rates(page, seconds / 2)
-            page.evaluate('miroGui.world.continuous = true')
-            page.wait_for_timeout(500)
-            continuous = _rates(page, seconds)
+            yield page, robots, errors
             browser.close()
     finally:
         gui.stop()
         sim.close()
+
+
+def measure_world_view(seconds=10.0, warmup=3.0, renderer='auto', world=WORLD):
+    """{'fps', 'on_demand_fps', 'draw_ms_median', 'eye_fps', 'robots', 'webgl'} of the world
+    view with a page open; raises RuntimeError when the page never got ready."""
+    with world_view_page(renderer, world) as (page, robots, errors):
+        webgl = page.evaluate("""() => { const gl = miroGui.world.renderer.getContext();
+            const info = gl.getExtension('WEBGL_debug_renderer_info');
+            return info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : '?'; }""")
+        size = page.evaluate("[miroGui.world.canvas.width, miroGui.world.canvas.height]")
+        page.wait_for_timeout(warmup * 1000)
+        on_demand = _rates(page, seconds / 2)
+        page.evaluate('miroGui.world.continuous = true')
+        page.wait_for_timeout(500)
+        continuous = _rates(page, seconds)
     return {'fps': continuous['drawn'], 'on_demand_fps': on_demand['drawn'],
             'draw_ms_median': continuous['ms'], 'eye_fps': (continuous['caml'],
                                                              continuous['camr']),
@@ -97,7 +107,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(
         prog='python -m miro_ball.bench.world_view_bench',
         description="Frames per second of miro_gui's 3D world view in headless Chromium "
-                    f'(the {WORLD} world, its robots moving by their links, the eyes live).')
+                    f'(the {WORLD} world, its robots moving by /tf, the eyes live).')
     parser.add_argument('--seconds', type=float, default=10.0, help='measured time (10)')
     parser.add_argument('--warmup', type=float, default=3.0, help='time before measuring (3)')
     parser.add_argument('--renderer', choices=('auto', 'tiny', 'egl'), default='auto',
