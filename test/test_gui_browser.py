@@ -24,6 +24,7 @@ from rclpy.parameter import Parameter
 from miro_ball.common.isolation import isolated_env
 from miro_ball.gui.process import GuiProcess
 from miro_ball.miro.interface import BALL_NAME, RobotTopics, SimTopics, default_robot_name
+from miro_ball.miro.urdf import parse_visuals, urdf
 
 playwright_api = pytest.importorskip('playwright.sync_api')
 CHROMIUM = shutil.which('chromium') or '/usr/bin/chromium'
@@ -367,6 +368,27 @@ def test_the_world_view_shows_the_ball_and_miro_driving(rig, tmp_path):
     after = world_shot(page, tmp_path, 'world_view_after_driving')
     changed = (abs(after.astype(int) - before.astype(int)).sum(axis=2) > 40).mean()
     assert changed > 0.002, f'driving MiRo changed {changed:.2%} of the world view'
+    page.close()
+    assert not rig.errors
+
+
+def test_the_world_view_builds_miro_from_its_robot_description(rig, tmp_path):
+    """Every primitive <visual> of the URDF is a mesh of the page, hung on the frame of its
+    link ('<robot>/<link>', placed by /tf), and the head sits above the wheels."""
+    page = world_page(rig)
+    built = page.evaluate(f"""() => [...miroGui.world.markers.values()]
+        .filter(({{ data }}) => data.id.startsWith({ROBOT + '/urdf-'!r}))
+        .map(({{ data, obj }}) => [data.link, data.kind,
+             obj.parent === miroGui.world.frames.get({ROBOT!r} + '/' + data.link)])""")
+    visuals = parse_visuals(urdf())
+    assert sorted(link for link, _, _ in built) == sorted(link for link, _, _ in visuals)
+    assert sorted(kind for _, kind, _ in built) == sorted(shape.kind for _, shape, _ in visuals)
+    assert all(on_its_frame for _, _, on_its_frame in built)
+    head = page.evaluate(f'miroGui.world.worldOf({ROBOT!r} + "/head").toArray()')
+    wheel = page.evaluate(f'miroGui.world.worldOf({ROBOT!r} + "/wheel_l").toArray()')
+    assert head[2] - wheel[2] > 0.1
+    redrawn(rig, page)
+    world_shot(page, tmp_path, 'world_view_miro')
     page.close()
     assert not rig.errors
 
