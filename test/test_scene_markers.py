@@ -92,10 +92,9 @@ def test_the_frames_on_tf_are_where_the_simulator_has_the_links():
     world.run(1.0)
     when = convert.stamp(world.time)
     tree = TfTree()
-    for t in tf.static_transforms([robot.name], when) + tf.robot_transforms(
-            robot.sensors, when, robot.name):
-        v, r = t.transform.translation, t.transform.rotation
-        tree.set(t.header.frame_id, t.child_frame_id, (v.x, v.y, v.z), (r.x, r.y, r.z, r.w))
+    assert tree.set_message(tf.static_transforms([robot.name], when)) == []
+    for parent, child, xyz, turn in tf.robot_frames(robot.sensors, robot.name):
+        tree.set(parent, child, xyz, turn)
     for eye in ('caml', 'camr'):
         position, rotation = robot.eye_pose(EYE_SIDE[eye])
         optical = tree.lookup('world', frame_id(robot.name, f'{eye}_optical'))

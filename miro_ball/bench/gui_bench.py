@@ -10,8 +10,8 @@ time over the measured wall time.
 
 Scene (--scene): the football pitch (three MiRos, driving in circles) in this process,
 miro_gui beside it and one page (a WebSocket client, no browser) showing the world view
-and no eyes. At real time: the bytes a simulated second of /miro_sim/scene and of each
-robot's /miro_sim/links/<robot> (as serialised on the wire), and the JSON the page gets.
+and no eyes. At real time: the bytes a simulated second of /miro_sim/scene and of /tf
+(every robot's moving frames; as serialised on the wire), and the JSON the page gets.
 Then, the page having set the real-time factor to 0 (as fast as possible; no eye is
 rendered, so this is the worst case): the simulator's real-time factor and the share of
 its time spent publishing the scene (what the scene costs the real-time factor).
@@ -165,28 +165,29 @@ def measure(args):
 
 class SceneMeter(_Spinning):
     """A node of its own (as RViz would be) counting the serialised bytes of the scene and
-    of each robot's links, and driving every robot in circles so that they move."""
+    of /tf, and driving every robot in circles so that they move."""
 
     def __init__(self, domain, robots):
         import rclpy
-        from geometry_msgs.msg import PoseArray, TwistStamped
+        from geometry_msgs.msg import TwistStamped
         from rclpy.context import Context
         from visualization_msgs.msg import MarkerArray
 
+        from miro_ball.common.messages import message_class
         from miro_ball.common.qos import profile
-        from miro_ball.gui.bridge import LINKS_QOS, SCENE_QOS
-        from miro_ball.miro.interface import CONTROL_QOS, RobotTopics, SimTopics
+        from miro_ball.gui.bridge import SCENE_QOS
+        from miro_ball.miro.interface import (CONTROL_QOS, RobotTopics, SimTopics, TF, TF_QOS,
+                                              TF_TYPE)
 
         self.context = Context()
         rclpy.init(context=self.context, domain_id=domain)
         self.node = rclpy.create_node('scene_meter', context=self.context)
-        self.bytes = {'scene': 0, **{robot: 0 for robot in robots}}
-        self.counters = [self.node.create_subscription(
-            MarkerArray, SimTopics().scene, self._counting('scene'), SCENE_QOS, raw=True)]
-        for robot in robots:
-            self.counters.append(self.node.create_subscription(
-                PoseArray, SimTopics().links(robot), self._counting(robot), LINKS_QOS,
-                raw=True))
+        self.bytes = {'scene': 0, 'tf': 0}
+        self.counters = [
+            self.node.create_subscription(MarkerArray, SimTopics().scene,
+                                          self._counting('scene'), SCENE_QOS, raw=True),
+            self.node.create_subscription(message_class(TF_TYPE), TF, self._counting('tf'),
+                                          profile(TF_QOS), raw=True)]
         drives = [self.node.create_publisher(TwistStamped, RobotTopics(robot).cmd_vel,
                                              profile(CONTROL_QOS)) for robot in robots]
 
@@ -282,11 +283,10 @@ def measure_scene(args):
     (w0, t0, _, b0, p0), (w1, t1, _, b1, p1) = real_time
     sim_s = t1 - t0
     kb = {key: (b1[key] - b0[key]) / 1000 / sim_s for key in b1}
-    links = [kb[robot] for robot in robots]
-    per_robot = (kb['scene'] + sum(links)) / len(robots)
+    per_robot = (kb['scene'] + kb['tf']) / len(robots)
     verdict = 'within' if per_robot <= SCENE_KB_S_PER_ROBOT else 'OVER'
     lines = [f'scene topic: {kb["scene"]:.1f} KB per simulated second (layout and movers); '
-             f'links {statistics.mean(links):.1f} KB/s a robot; '
+             f'/tf {kb["tf"] / len(robots):.1f} KB/s a robot; '
              f'{per_robot:.1f} KB/s per robot in all ({verdict} {SCENE_KB_S_PER_ROBOT:g})',
              f'to the page (JSON): {(p1 - p0) / 1000 / (w1 - w0):.1f} KB/s with '
              f'{len(robots)} robots']

@@ -42,7 +42,7 @@ def main(argv=None):
     when = stamp(world.time)
     rows = [(row.key, holes) for row in ROBOT_INTERFACE
             if row.direction == SENSOR and row.rate == PLATFORM_HZ and row.key != 'package'
-            for holes, _ in row.names()]
+            for holes, relative in row.names() if relative.startswith('sensors/')]
     cases = {
         'separate topics': lambda: [serialize_message(PRODUCERS[key](robot, when, name, **holes))
                                     for key, holes in rows],

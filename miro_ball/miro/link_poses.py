@@ -3,6 +3,8 @@ robot_state_publisher computes from a URDF and joint_states, for the simulator's
 
 Pure. A transform is (xyz, quaternion x, y, z, w) of the child's frame in the parent's.
 """
+import math
+
 from miro_ball.miro.body import FIXED, LINKS
 from miro_ball.miro.rotations import axis_angle_quaternion, multiply, rpy_quaternion
 
@@ -31,3 +33,21 @@ def moving_transforms(positions):
     name: rad}; a joint not given is taken at 0)."""
     return [(link.parent, link.name, *joint_transform(link, positions.get(link.joint, 0.0)))
             for link in MOVING_LINKS]
+
+
+def pose_on_base(position, quaternion, x, y, yaw):
+    """The body's pose on base_link, from its pose in the world (position, quaternion) and
+    base_link's (x, y on the floor, heading yaw): (xyz, quaternion, tilt), tilt the body's
+    pitch there (joint_states' tilt). By hand: this runs for every robot every tick."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    dx, dy = position[0] - x, position[1] - y
+    xyz = (c * dx + s * dy, -s * dx + c * dy, position[2])
+    qx, qy, qz, qw = multiply(axis_angle_quaternion((0.0, 0.0, 1.0), -yaw), quaternion)
+    tilt = math.atan2(2 * (qx * qz + qw * qy), 1 - 2 * (qy * qy + qz * qz))
+    return xyz, (qx, qy, qz, qw), tilt
+
+
+def y_axis(quaternion):
+    """Where a turn by ``quaternion`` takes the y axis."""
+    x, y, z, w = quaternion
+    return (2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x))

@@ -158,6 +158,13 @@ class MiroModel:
         rot = np.array(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
         return np.array(com) - rot @ np.array(BODY_COM), rot
 
+    def body_pose(self):
+        """World (position, quaternion) of the BODY frame, as tuples (PyBullet's own
+        arithmetic: this runs for every robot every tick)."""
+        com, orn = pb.getBasePositionAndOrientation(self.body_id, physicsClientId=self.client)
+        return pb.multiplyTransforms(com, orn, [-v for v in BODY_COM], (0.0, 0.0, 0.0, 1.0),
+                                     physicsClientId=self.client)
+
     def place(self, x, y, yaw, floor=0.0):
         """Put the robot at rest on flat floor at height floor (FOOT pose x, y, yaw)."""
         orientation = pb.getQuaternionFromEuler((0.0, TILT_RAD, yaw))

@@ -11,10 +11,10 @@ import numpy as np
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       KIN_CALIB_RAD, TILT_RAD, WHEEL_RADIUS_M)
-from miro_ball.miro.kc import camera_in_head, rot_z, SONAR_IN_HEAD
+from miro_ball.miro.kc import camera_in_head, SONAR_IN_HEAD
 from miro_ball.miro.interface import TOUCH_PARTS
 from miro_ball.miro.kinematics import clamp_wheel_speeds, cmd_vel2wheel_speed
-from miro_ball.miro.rotations import matrix_quaternions
+from miro_ball.miro.link_poses import pose_on_base, y_axis
 from miro_ball.miro.touch import pads_touched, TOUCH_PADS
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics import model as rb
@@ -230,8 +230,9 @@ class MiroRobot:
         lin, ang = pb.getBaseVelocity(self.body_id, **kw)
         x, y, yaw = self.pose()
         forward = lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw)
-        body_xyz, body_quaternion, tilt = self._body_in_base(x, y, yaw)
-        tilt_rate = float(np.dot(ang, self.model.body_frame()[1][:, 1]))
+        position, orientation = self.model.body_pose()
+        body_xyz, body_quaternion, tilt = pose_on_base(position, orientation, x, y, yaw)
+        tilt_rate = sum(a * b for a, b in zip(ang, y_axis(orientation)))
         return Sensors(
             time=self.clock(),
             kinematic_positions=(TILT_RAD, *(s[0] for s in neck)),
@@ -250,16 +251,6 @@ class MiroRobot:
             touch_head=self._touch_reading('head'),
             touch_body=self._touch_reading('body'),
         )
-
-    def _body_in_base(self, x, y, yaw):
-        """The body's exact pose on base_link (xyz, quaternion) and its pitch there (the
-        tilt joint of joint_states)."""
-        position, rotation = self.model.body_frame()
-        turn = rot_z(yaw)
-        relative = turn.T @ rotation
-        xyz = turn.T @ (position - np.array((x, y, 0.0)))
-        tilt = math.atan2(relative[0, 2], relative[0, 0])
-        return tuple(xyz.tolist()), tuple(matrix_quaternions(relative)[0].tolist()), tilt
 
     # -- cameras ----------------------------------------------------------------------------
     def eye_pose(self, side):

@@ -54,14 +54,6 @@ def odometry(s, when, robot):
     return msg
 
 
-def odom_transform(s, when, robot):
-    """<robot>/odom -> <robot>/base_link for /tf: the pose sensors/odom gives, the same
-    numbers (x, y, heading; the FOOT frame on the floor)."""
-    x, y, yaw = s.pose
-    return transform(frame_id(robot, 'odom'), frame_id(robot, 'base_link'), (x, y, 0.0),
-                     yaw_quaternion(yaw), when)
-
-
 def transform(parent, child, position, orientation, when):
     """A TransformStamped: the child frame's pose in the parent frame."""
     msg = TransformStamped(child_frame_id=child)

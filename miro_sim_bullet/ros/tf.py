@@ -22,7 +22,9 @@ from miro_ball.miro.body import LINK_OF_JOINT, MOVABLE
 from miro_ball.miro.interface import frame_id, TF, TF_QOS, TF_STATIC, TF_STATIC_QOS, TF_TYPE, \
     WORLD_FRAME
 from miro_ball.miro.link_poses import fixed_transforms, joint_transform, MOVING_LINKS
+from miro_ball.miro.rotations import axis_angle_quaternion
 from miro_sim_bullet.ros import convert
+from miro_sim_bullet.ros.refill import Refill
 
 _BODY = LINK_OF_JOINT['tilt']  # its exact pose, not the tilt alone (a slope rolls it too)
 # (link, index of its joint in Sensors.joint_positions) of the joints after the tilt.
@@ -40,15 +42,16 @@ def static_transforms(robots, when):
     return out
 
 
-def robot_transforms(s, when, name):
-    """The moving TransformStampeds of one robot from its tick's Sensors."""
-    out = [convert.odom_transform(s, when, name),
-           convert.transform(frame_id(name, _BODY.parent), frame_id(name, _BODY.name),
-                             *s.body_in_base, when)]
+def robot_frames(s, name):
+    """[(parent, child, xyz, quaternion)] of one robot's moving frames from its tick's
+    Sensors, always in the same order."""
+    x, y, yaw = s.pose
+    out = [(frame_id(name, 'odom'), frame_id(name, 'base_link'), (x, y, 0.0),
+            axis_angle_quaternion((0.0, 0.0, 1.0), yaw)),
+           (frame_id(name, _BODY.parent), frame_id(name, _BODY.name), *s.body_in_base)]
     for link, index in _JOINTS:
-        xyz, turn = joint_transform(link, s.joint_positions[index])
-        out.append(convert.transform(frame_id(name, link.parent), frame_id(name, link.name),
-                                     xyz, turn, when))
+        out.append((frame_id(name, link.parent), frame_id(name, link.name),
+                    *joint_transform(link, s.joint_positions[index])))
     return out
 
 
@@ -64,10 +67,22 @@ class TfInterface:
         self.pub_static = ros.publisher(self.message, TF_STATIC, profile(TF_STATIC_QOS))
         # Published once, kept for late subscribers (transient local).
         self.pub_static.publish(self.message(transforms=static_transforms(world.robots, when)))
+        self._refill = None  # made on first use: the frames' order is the robots' now
+
+    def _frames(self):
+        return [frame for name, robot in self.world.robots.items()
+                for frame in robot_frames(robot.sensors, name)]
 
     def publish(self, when):
         """Every robot's moving frames now, in one message (only while listened to)."""
-        if self.pub.get_subscription_count():
-            self.pub.publish(self.message(transforms=[
-                t for name, robot in self.world.robots.items()
-                for t in robot_transforms(robot.sensors, when, name)]))
+        if not self.pub.get_subscription_count():
+            return
+        frames = self._frames()
+        if self._refill is None:
+            pairs = [(parent, child) for parent, child, _, _ in frames]
+            self._refill = Refill(lambda stamp, values: self.message(transforms=[
+                convert.transform(parent, child, values[7 * k:7 * k + 3],
+                                  values[7 * k + 3:7 * k + 7], stamp)
+                for k, (parent, child) in enumerate(pairs)]), 7 * len(pairs))
+        self.pub.publish(self._refill.fill(when, [v for _, _, xyz, turn in frames
+                                                  for v in (*xyz, *turn)]))
