@@ -90,6 +90,7 @@ setup(
             'grade = miro_ball.grade:main',
             'build_interfaces = miro_ball.build_interfaces:main',
             'client_read_battery = miro_ball.examples.client_read_battery:main',
+            'client_tf = miro_ball.examples.client_tf:main',
             'miro_foxglove = miro_ball.foxglove.__main__:main',
         ],
     },

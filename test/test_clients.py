@@ -14,19 +14,20 @@ from geometry_msgs.msg import TwistStamped
 from miro_ball.common.isolation import isolated_env
 from miro_ball.common.robots import missing_robot
 from miro_ball.examples import client_follower, client_minimal, client_read_battery, \
-    client_show, client_test, client_video
+    client_show, client_test, client_tf, client_video
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
 from miro_ball.miro.interface import RobotTopics, default_robot_name
 from rostools import Probe, advance_ticks, advance_until, kill_if_running, spin_until
 
 T = RobotTopics(default_robot_name())
 CLIENTS = ('client_minimal', 'client_video', 'client_show', 'client_follower', 'client_test',
-           'client_read_battery')
+           'client_read_battery', 'client_tf')
 
 
 CLASSES = {client_minimal: client_minimal.Minimal, client_show: client_show.Show,
            client_follower: client_follower.Follower, client_test: client_test.Bench,
-           client_video: client_video.Video, client_read_battery: client_read_battery.ReadBattery}
+           client_video: client_video.Video, client_read_battery: client_read_battery.ReadBattery,
+           client_tf: client_tf.WhereIsTheBall}
 
 
 def run_client(module, args, paused_sim, executor, context, limit_s, each_tick=None):
@@ -72,6 +73,27 @@ def test_minimal_drives_and_prints_the_battery(paused_sim, executor, ros_context
     out = capsys.readouterr().out
     assert code == 0 and 'battery: 4.80 V' in out
     assert math.hypot(x, y) > 0.1 and yaw > 0.3  # 0.2 m/s and 0.5 rad/s for 1 s
+
+
+def test_client_tf_says_where_the_ball_is_in_the_head_frame(paused_sim, executor, ros_context,
+                                                             capsys):
+    """The ball 0.8 m ahead of MiRo and 0.2 m to its left: client_tf, going through /tf,
+    finds it ahead and to the left of the head, where the kinematic chain has it."""
+    from miro_ball.miro.kc import HEAD, KinematicChain, WORLD
+
+    paused_sim.sim.place_ball(0.8, 0.2)
+    advance_ticks(paused_sim, executor, 25)
+    code = run_client(client_tf, ['--count', '2', '--every', '0.5'], paused_sim, executor,
+                      ros_context, limit_s=3.0)
+    lines = [line for line in capsys.readouterr().out.splitlines() if 'ball in' in line]
+    assert code == 0 and len(lines) == 2, lines
+    x, y, z = (float(lines[-1].split(f' {axis} ')[1].split()[0]) for axis in 'xyz')
+    chain = KinematicChain(robot(paused_sim).sensors.kinematic_positions,
+                           robot(paused_sim).pose())
+    ball = paused_sim.sim.ball_position()
+    expected = chain.change_frame_abs(WORLD, HEAD, ball)
+    assert (x, y, z) == pytest.approx(tuple(expected), abs=0.01)  # the body's tilt is measured
+    assert x > 0.5 and y > 0.1  # ahead and to the left
 
 
 def test_read_battery_prints_the_voltage_from_the_package_each_interval(paused_sim, executor,

@@ -1,0 +1,91 @@
+"""Where is the ball, as MiRo's head sees it? The frames of /tf, the ROS 2 way.
+
+The simulator puts every part of every MiRo on /tf and /tf_static (world -> <robot>/odom
+-> <robot>/base_link -> body -> neck -> gimbal -> head -> caml, camr, ...) and gives the
+ball's ground truth in frame world (/miro_sim/ball). This client keeps the newest of
+every frame (miro_ball.miro.tf_tree, what tf2's buffer does) and, every --every simulated
+seconds, takes the ball's centre into MiRo's head frame (x forward, y left, z up) and
+prints it with its distance and bearing: the MDK's kinematic-chain examples, done with
+the frames any ROS tool reads. Move the head (client_look) or the ball (the GUI) and
+watch the numbers change.
+
+    python -m miro_ball.examples.client_tf [--frame head] [--count 3] [--every 1.0]
+
+It needs tf2_msgs, which ./dev.sh setup builds (or python -m miro_ball.build_interfaces).
+"""
+import math
+import sys
+
+from geometry_msgs.msg import PointStamped
+
+from miro_ball.common.messages import message_class
+from miro_ball.common.qos import profile
+from miro_ball.examples._client import Client, make_parser, number, run
+from miro_ball.miro.body import LINK, ROOT
+from miro_ball.miro.interface import frame_id, SimTopics, TF, TF_QOS, TF_STATIC, \
+    TF_STATIC_QOS, TF_TYPE
+from miro_ball.miro.tf_tree import TfError, TfTree
+
+
+class WhereIsTheBall(Client):
+    def __init__(self, options, context=None):
+        super().__init__('client_tf', options, context)
+        self.tree = TfTree()
+        self.frame = frame_id(self.robot, options.frame)
+        tf_type = message_class(TF_TYPE)
+        self.create_subscription(tf_type, TF, self.on_tf, profile(TF_QOS))
+        self.create_subscription(tf_type, TF_STATIC, self.on_tf, profile(TF_STATIC_QOS))
+        self.subscribe(PointStamped, SimTopics().ball, self.on_ball)
+        self.printed = 0
+        self.next_at = None
+
+    def on_tf(self, msg):
+        for reason in self.tree.set_message(msg.transforms):
+            self.warn('tf', f'a transform ignored: {reason}')
+
+    def on_ball(self, msg):
+        when = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        if self.next_at is not None and when < self.next_at:
+            return
+        p = msg.point
+        try:
+            x, y, z = self.tree.transform_point(self.frame, msg.header.frame_id,
+                                                (p.x, p.y, p.z))
+        except (TfError, ValueError) as err:
+            self.warn('lookup', f'the ball not taken into {self.frame} yet: {err}')
+            return
+        self.next_at = when + self.options.every
+        distance = math.sqrt(x * x + y * y + z * z)
+        self.say(f't = {when:.2f} s: ball in {self.frame}: x {x:+.3f} y {y:+.3f} z {z:+.3f} m, '
+                 f'{distance:.3f} m away, azimuth {math.degrees(math.atan2(y, x)):+.1f} deg, '
+                 f'elevation {math.degrees(math.atan2(z, math.hypot(x, y))):+.1f} deg')
+        self.printed += 1
+        if self.printed == self.options.count:
+            raise SystemExit(0)
+
+
+def build_parser():
+    parser = make_parser('client_tf', __doc__)
+    frames = sorted({ROOT, *LINK})
+    parser.add_argument('--frame', default='head', choices=frames, metavar='FRAME',
+                        help='the robot\'s frame to see the ball from (head); one of '
+                             + ', '.join(frames))
+    parser.add_argument('--count', type=int, default=3,
+                        help='how many lines to print, 0 for no end (3)')
+    parser.add_argument('--every', type=number(0.02, 3600), default=1.0,
+                        help='simulated seconds between lines (1.0)')
+    return parser
+
+
+def main(argv=None):
+    parser = build_parser()
+    try:
+        message_class(TF_TYPE)
+    except ValueError:
+        parser.exit(1, f'{parser.prog}: {TF_TYPE} is not installed: build it with '
+                       'python -m miro_ball.build_interfaces\n')
+    return run(WhereIsTheBall, parser, argv)
+
+
+if __name__ == '__main__':
+    sys.exit(main())
