@@ -22,7 +22,8 @@ from miro_ball.common.isolation import isolated_env
 from miro_ball.recording.bag import SplitBag
 from miro_ball.recording.node import Recorder, RecordingFailed
 from miro_ball.recording.selection import Selection
-from miro_ball.miro.interface import CLOCK, RobotTopics, SimTopics, default_robot_name
+from miro_ball.miro.interface import CLOCK, default_robot_name, RobotTopics, SimTopics, TF, \
+    TF_STATIC
 from rostools import Probe, advance_ticks, advance_until, kill_if_running, run_command, spin_until
 import test_tutorial as tutorial
 from test_record_parts import listed, read_bag, visible
@@ -49,6 +50,8 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
     assert spin_until(executor, lambda: interface.publisher('odom').get_subscription_count()
                       and interface.publisher('cliff').get_subscription_count()
                       and interface.publisher('package').get_subscription_count()
+                      and interface.publisher('joint_states').get_subscription_count()
+                      and paused_sim.tf.pub.get_subscription_count()
                       and interface.pub_eyes['caml'][0].get_subscription_count()
                       and latched.get_subscription_count())
     advance_ticks(paused_sim, executor)  # the first /clock starts the recording
@@ -112,6 +115,22 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
         assert ns(decoded.header.stamp) == odom_ns[-1]
         assert decoded.battery.voltage == pytest.approx(4.8)
         assert list(decoded.cliff.data) == [1.0, 1.0]
+        # What Foxglove draws MiRo from, each with its definition.
+        for topic, name in ((TF, 'tf2_msgs/msg/TFMessage'), (TF_STATIC, 'tf2_msgs/msg/TFMessage'),
+                            (ROBOT.topic('robot_description'), 'std_msgs/msg/String'),
+                            (ROBOT.topic('joint_states'), 'sensor_msgs/msg/JointState')):
+            assert schemas[channels[topic].schema_id].name == name
+            assert schemas[channels[topic].schema_id].data  # the definition travels along
+    assert recorded[ROBOT.topic('robot_description')][1][0][1].data.startswith('<?xml')
+    assert [t.child_frame_id for t in recorded[TF_STATIC][1][0][1].transforms][0] == \
+        f'{ROBOT.name}/odom'
+    moving = [(t, m) for t, m in recorded[TF][1] if t > first_clock]
+    assert [t for t, _ in moving] == odom_ns  # every tick, at its stamp
+    last = {f.child_frame_id: f.transform.translation for f in moving[-1][1].transforms}
+    assert last[f'{ROBOT.name}/base_link'].x == pytest.approx(
+        recorded[ROBOT.odom][1][-1][1].pose.pose.position.x)
+    joints = recorded[ROBOT.topic('joint_states')][1]
+    assert [t for t, _ in joints if t > first_clock] == odom_ns
 
 
 def test_a_full_disk_ends_the_recording_and_keeps_the_finished_files(
@@ -178,7 +197,9 @@ def test_the_command_records_a_robot_until_ctrl_c_twice(tmp_path, executor, paus
     assert 'Traceback' not in output
     recorded = read_bag(tmp_path / 'bag')
     assert set(recorded) >= {ROBOT.odom, ROBOT.cliff, SimTopics().object_pose(ROBOT.name)}
+    assert {TF, TF_STATIC} <= set(recorded)  # the frames of every robot, with its own
     assert all(topic.startswith(f'/{ROBOT.name}/') or topic.endswith(f'/{ROBOT.name}')
+               or topic in (TF, TF_STATIC)
                for topic in recorded)
     stamps = [t for t, _ in recorded[ROBOT.odom][1]]
     assert len(stamps) >= 50 and all(b - a == TICK_NS for a, b in zip(stamps, stamps[1:]))

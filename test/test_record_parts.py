@@ -12,7 +12,8 @@ from ruamel.yaml import YAML
 from miro_ball.recording.bag import SplitBag, describe, offered_qos
 from miro_ball.recording.selection import (cdr_stamp_ns, has_stamp, log_time_ns, Progress,
                                            Selection)
-from miro_ball.miro.interface import CLOCK, default_robot_name, RobotTopics, SimTopics
+from miro_ball.miro.interface import CLOCK, default_robot_name, RobotTopics, SimTopics, TF, \
+    TF_STATIC
 
 ROBOT = RobotTopics(default_robot_name())
 TYPES = get_typestore(Stores.ROS2_JAZZY)
@@ -49,6 +50,8 @@ def test_a_robot_name_selects_its_topics_and_ground_truth_only():
     selection = Selection([ROBOT.name], exclude=[ROBOT.eye_raw('caml')])
     assert selection.wants(ROBOT.odom) and selection.wants(ROBOT.cmd_vel)
     assert selection.wants(SimTopics().object_pose(ROBOT.name))
+    assert all(selection.wants(topic) for topic in (  # what a viewer draws MiRo from
+        TF, TF_STATIC, ROBOT.topic('robot_description'), ROBOT.topic('joint_states')))
     assert not selection.wants(ROBOT.eye_raw('caml'))
     assert not selection.wants(other.odom) and not selection.wants(CLOCK)
     everything = Selection()

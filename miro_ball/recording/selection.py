@@ -2,8 +2,9 @@
 
 Topic selection: an argument with a slash (or a wildcard) is a topic name or an
 fnmatch pattern ('/<robot>/sensors/*'); a bare name is a robot, which selects every
-topic under /<name>/ and the simulator's ground truth of that robot. Nothing
-named selects everything. The robots' raw eye images are left out unless asked
+topic under /<name>/ (robot_description and joint_states among them), the simulator's
+ground truth of that robot and /tf and /tf_static (which hold every robot's frames), so
+the bag draws MiRo in Foxglove. Nothing named selects everything. The robots' raw eye images are left out unless asked
 for (raw_images) or named as topics: they are the JPEG frames again, uncompressed
 (about 20 MB/s a robot), and the simulator renders them only for a subscriber.
 
@@ -18,7 +19,8 @@ import fnmatch
 import struct
 from collections import Counter
 
-from miro_ball.miro.interface import EYES, TOPIC, RobotTopics, SimTopics, check_name
+from miro_ball.miro.interface import (check_name, EYES, RobotTopics, SimTopics, TF, TF_STATIC,
+                                      TOPIC)
 
 # A stamp further than this from the latest /clock is not simulated time.
 STAMP_WINDOW_NS = 10 * 10**9
@@ -45,7 +47,7 @@ class Selection:
         if '/' in target or _is_pattern(target):
             return [_absolute(target)]
         name = check_name(target, 'robot name (or a topic: start it with /)')
-        return [RobotTopics(name).topic('*'), SimTopics().object_pose(name)]
+        return [RobotTopics(name).topic('*'), SimTopics().object_pose(name), TF, TF_STATIC]
 
     def wants(self, topic):
         return self._matches(topic) and not self._raw_left_out(topic)
