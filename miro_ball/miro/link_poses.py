@@ -38,12 +38,14 @@ def moving_transforms(positions):
 def pose_on_base(position, quaternion, x, y, yaw):
     """The body's pose on base_link, from its pose in the world (position, quaternion) and
     base_link's (x, y on the floor, heading yaw): (xyz, quaternion, tilt), tilt the body's
-    pitch there (joint_states' tilt). By hand: this runs for every robot every tick."""
+    pitch there (joint_states' tilt). The body's own heading is taken to be yaw. By hand: this runs for every robot every tick."""
     c, s = math.cos(yaw), math.sin(yaw)
     dx, dy = position[0] - x, position[1] - y
     xyz = (c * dx + s * dy, -s * dx + c * dy, position[2])
     qx, qy, qz, qw = multiply(axis_angle_quaternion((0.0, 0.0, 1.0), -yaw), quaternion)
-    tilt = math.atan2(2 * (qx * qz + qw * qy), 1 - 2 * (qy * qy + qz * qz))
+    # The pitch of the turn taken as roll, then pitch, then yaw (URDF's rpy): the tilt
+    # even when a slope rolls the body too.
+    tilt = math.asin(max(-1.0, min(1.0, 2 * (qw * qy - qx * qz))))
     return xyz, (qx, qy, qz, qw), tilt
 
 

@@ -15,7 +15,7 @@ ROBOT_NAME = 'miro_e'  # the model's name in the URDF, not a robot's
 
 
 def _numbers(values):
-    return quoteattr(' '.join(f'{float(v):.6g}' for v in values))
+    return quoteattr(' '.join(f'{float(v):.10g}' for v in values))
 
 
 def _origin(xyz, rpy):
@@ -27,8 +27,8 @@ def _geometry(shape):
         return f'<box size={_numbers(shape.size)}/>'
     if shape.kind == CYLINDER:
         radius, length = shape.size
-        return f'<cylinder radius="{radius:.6g}" length="{length:.6g}"/>'
-    return f'<sphere radius="{shape.size[0]:.6g}"/>'
+        return f'<cylinder radius="{radius:.10g}" length="{length:.10g}"/>'
+    return f'<sphere radius="{shape.size[0]:.10g}"/>'
 
 
 def inertia(link):
@@ -53,9 +53,9 @@ def _link(link):
     parts = [f'  <link name={quoteattr(link.name)}>']
     if link.mass > 0.0:
         ixx, iyy, izz = inertia(link)
-        parts.append(f'    <inertial>{_origin(link.com, (0, 0, 0))}<mass value="{link.mass:.6g}"/>'
-                     f'<inertia ixx="{ixx:.6g}" ixy="0" ixz="0" iyy="{iyy:.6g}" iyz="0" '
-                     f'izz="{izz:.6g}"/></inertial>')
+        parts.append(f'    <inertial>{_origin(link.com, (0, 0, 0))}<mass value="{link.mass:.10g}"/>'
+                     f'<inertia ixx="{ixx:.10g}" ixy="0" ixz="0" iyy="{iyy:.10g}" iyz="0" '
+                     f'izz="{izz:.10g}"/></inertial>')
     for tag, shapes in (('visual', link.visuals), ('collision', link.collisions)):
         for shape in shapes:
             material = (f'<material name={quoteattr(shape.colour)}/>' if tag == 'visual'
@@ -74,7 +74,7 @@ def _joint(link):
         parts.append(f'    <axis xyz={_numbers(link.axis)}/>')
     if link.limits is not None:
         lo, hi = link.limits
-        parts.append(f'    <limit lower="{lo:.6g}" upper="{hi:.6g}" effort="1" velocity="10"/>')
+        parts.append(f'    <limit lower="{lo:.10g}" upper="{hi:.10g}" effort="1" velocity="10"/>')
     parts.append('  </joint>')
     return parts
 
