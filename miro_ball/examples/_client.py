@@ -23,7 +23,7 @@ from rclpy.signals import SignalHandlerOptions
 from miro_ball.common.checks import finite_values
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_guard import guard_clock
-from miro_ball.common.messages import drive_command
+from miro_ball.common.messages import drive_command, message_class
 from miro_ball.common.qos import profile
 from miro_ball.common.robots import missing_robot
 from miro_ball.common.sim_time import sim_time_overrides
@@ -61,6 +61,45 @@ def number(low, high):
             raise argparse.ArgumentTypeError(f'{text} is not within {low:g} and {high:g}')
         return value
     return convert
+
+
+def periodic_options(parser, what):
+    """--count and --every: a line of ``what`` every so many simulated seconds, so many
+    times (see Periodic)."""
+    parser.add_argument('--count', type=int, default=3,
+                        help=f'how many {what} to print, 0 for no end (3)')
+    parser.add_argument('--every', type=number(0.02, 3600), default=1.0,
+                        help=f'simulated seconds between {what} (1.0)')
+
+
+def require_type(parser, msg_type):
+    """Exit in one line when ``msg_type`` (a type built at set-up) is not installed."""
+    try:
+        message_class(msg_type)
+    except ValueError:
+        parser.exit(1, f'{parser.prog}: {msg_type} is not installed: build it with '
+                       'python -m miro_ball.build_interfaces\n')
+
+
+class Periodic:
+    """When a client that prints --every simulated seconds, --count times, is due."""
+
+    def __init__(self, options):
+        self.every, self.count = options.every, options.count
+        self.printed = 0
+        self.next_at = None
+
+    def due(self, stamp):
+        """True when a line is due at this message's stamp (builtin_interfaces/Time)."""
+        when = stamp.sec + stamp.nanosec * 1e-9
+        return self.next_at is None or when >= self.next_at
+
+    def done(self, stamp):
+        """A line was printed at this stamp: SystemExit(0) once --count are out."""
+        self.next_at = stamp.sec + stamp.nanosec * 1e-9 + self.every
+        self.printed += 1
+        if self.printed == self.count:
+            raise SystemExit(0)
 
 
 def heading(q):

@@ -12,7 +12,8 @@ It needs miro2_msg, which ./dev.sh setup builds (or python -m miro_ball.build_in
 import sys
 
 from miro_ball.common.messages import message_class
-from miro_ball.examples._client import Client, make_parser, number, run
+from miro_ball.examples._client import Client, make_parser, Periodic, periodic_options, \
+    require_type, run
 from miro_ball.miro.interface import TOPIC
 
 
@@ -21,36 +22,26 @@ class ReadBattery(Client):
         super().__init__('client_read_battery', options, context)
         self.subscribe(message_class(TOPIC['package'].type), self.topics.package,
                        self.on_package)
-        self.printed = 0
-        self.next_at = None
+        self.periodic = Periodic(options)
 
     def on_package(self, msg):
-        when = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-        if self.next_at is not None and when < self.next_at:
+        stamp = msg.header.stamp
+        if not self.periodic.due(stamp):
             return
-        self.next_at = when + self.options.every
-        self.say(f't = {when:.2f} s: battery {msg.battery.voltage:.2f} V')
-        self.printed += 1
-        if self.printed == self.options.count:
-            raise SystemExit(0)
+        self.say(f't = {stamp.sec + stamp.nanosec * 1e-9:.2f} s: battery '
+                 f'{msg.battery.voltage:.2f} V')
+        self.periodic.done(stamp)
 
 
 def build_parser():
     parser = make_parser('client_read_battery', __doc__)
-    parser.add_argument('--count', type=int, default=3,
-                        help='how many readings to print, 0 for no end (3)')
-    parser.add_argument('--every', type=number(0.02, 3600), default=1.0,
-                        help='simulated seconds between readings (1.0)')
+    periodic_options(parser, 'readings')
     return parser
 
 
 def main(argv=None):
     parser = build_parser()
-    try:
-        message_class(TOPIC['package'].type)
-    except ValueError:
-        parser.exit(1, f'{parser.prog}: {TOPIC["package"].type} is not installed: build it '
-                       'with python -m miro_ball.build_interfaces\n')
+    require_type(parser, TOPIC['package'].type)
     return run(ReadBattery, parser, argv)
 
 

@@ -20,7 +20,8 @@ from geometry_msgs.msg import PointStamped
 
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
-from miro_ball.examples._client import Client, make_parser, number, run
+from miro_ball.examples._client import Client, make_parser, Periodic, periodic_options, \
+    require_type, run
 from miro_ball.miro.body import LINK, ROOT
 from miro_ball.miro.interface import frame_id, SimTopics, TF, TF_QOS, TF_STATIC, \
     TF_STATIC_QOS, TF_TYPE
@@ -36,16 +37,15 @@ class WhereIsTheBall(Client):
         self.create_subscription(tf_type, TF, self.on_tf, profile(TF_QOS))
         self.create_subscription(tf_type, TF_STATIC, self.on_tf, profile(TF_STATIC_QOS))
         self.subscribe(PointStamped, SimTopics().ball, self.on_ball)
-        self.printed = 0
-        self.next_at = None
+        self.periodic = Periodic(options)
 
     def on_tf(self, msg):
         for reason in self.tree.set_message(msg.transforms):
             self.warn('tf', f'a transform ignored: {reason}')
 
     def on_ball(self, msg):
-        when = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-        if self.next_at is not None and when < self.next_at:
+        stamp = msg.header.stamp
+        if not self.periodic.due(stamp):
             return
         p = msg.point
         try:
@@ -54,14 +54,11 @@ class WhereIsTheBall(Client):
         except (TfError, ValueError) as err:
             self.warn('lookup', f'the ball not taken into {self.frame} yet: {err}')
             return
-        self.next_at = when + self.options.every
         distance = math.sqrt(x * x + y * y + z * z)
-        self.say(f't = {when:.2f} s: ball in {self.frame}: x {x:+.3f} y {y:+.3f} z {z:+.3f} m, '
+        self.say(f't = {stamp.sec + stamp.nanosec * 1e-9:.2f} s: ball in {self.frame}: x {x:+.3f} y {y:+.3f} z {z:+.3f} m, '
                  f'{distance:.3f} m away, azimuth {math.degrees(math.atan2(y, x)):+.1f} deg, '
                  f'elevation {math.degrees(math.atan2(z, math.hypot(x, y))):+.1f} deg')
-        self.printed += 1
-        if self.printed == self.options.count:
-            raise SystemExit(0)
+        self.periodic.done(stamp)
 
 
 def build_parser():
@@ -70,20 +67,13 @@ def build_parser():
     parser.add_argument('--frame', default='head', choices=frames, metavar='FRAME',
                         help='the robot\'s frame to see the ball from (head); one of '
                              + ', '.join(frames))
-    parser.add_argument('--count', type=int, default=3,
-                        help='how many lines to print, 0 for no end (3)')
-    parser.add_argument('--every', type=number(0.02, 3600), default=1.0,
-                        help='simulated seconds between lines (1.0)')
+    periodic_options(parser, 'lines')
     return parser
 
 
 def main(argv=None):
     parser = build_parser()
-    try:
-        message_class(TF_TYPE)
-    except ValueError:
-        parser.exit(1, f'{parser.prog}: {TF_TYPE} is not installed: build it with '
-                       'python -m miro_ball.build_interfaces\n')
+    require_type(parser, TF_TYPE)
     return run(WhereIsTheBall, parser, argv)
 
 

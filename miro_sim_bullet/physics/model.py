@@ -54,6 +54,18 @@ def _frame(shape):
     return list(shape.xyz), pb.getQuaternionFromEuler(shape.rpy)
 
 
+def _arrays(shapes):
+    """(kinds, size lists, positions, orientations): PyBullet's arguments for several
+    shapes in one (a compound)."""
+    dims = [_dims(s) for s in shapes]
+    sizes = {'radii': [d.get('radius', 0) for d in dims],
+             'halfExtents': [d.get('halfExtents', [0] * 3) for d in dims],
+             'lengths': [d.get('length', 0) for d in dims]}
+    frames = [_frame(s) for s in shapes]
+    return ([_GEOM[s.kind] for s in shapes], sizes, [f[0] for f in frames],
+            [f[1] for f in frames])
+
+
 class MiroModel:
     """Creates the robot in a client; indices and the eye geometry to go with it."""
 
@@ -69,13 +81,10 @@ class MiroModel:
             return pb.createVisualShape(_GEOM[shape.kind], rgbaColor=desc.COLOURS[shape.colour],
                                         visualFramePosition=position,
                                         visualFrameOrientation=orientation, **_dims(shape), **kw)
-        dims = [_dims(s) for s in shapes]
+        kinds, sizes, positions, orientations = _arrays(shapes)
         return pb.createVisualShapeArray(
-            [_GEOM[s.kind] for s in shapes], radii=[d.get('radius', 0) for d in dims],
-            halfExtents=[d.get('halfExtents', [0] * 3) for d in dims],
-            lengths=[d.get('length', 0) for d in dims],
-            visualFramePositions=[_frame(s)[0] for s in shapes],
-            visualFrameOrientations=[_frame(s)[1] for s in shapes],
+            kinds, **sizes, visualFramePositions=positions,
+            visualFrameOrientations=orientations,
             rgbaColors=[desc.COLOURS[s.colour] for s in shapes], **kw)
 
     def _collision(self, shapes):
@@ -89,13 +98,9 @@ class MiroModel:
             dims = {('height' if k == 'length' else k): v for k, v in _dims(shape).items()}
             return pb.createCollisionShape(_GEOM[shape.kind], collisionFramePosition=position,
                                            collisionFrameOrientation=orientation, **dims, **kw)
-        dims = [_dims(s) for s in shapes]
-        return pb.createCollisionShapeArray(
-            [_GEOM[s.kind] for s in shapes], radii=[d.get('radius', 0) for d in dims],
-            halfExtents=[d.get('halfExtents', [0] * 3) for d in dims],
-            lengths=[d.get('length', 0) for d in dims],
-            collisionFramePositions=[_frame(s)[0] for s in shapes],
-            collisionFrameOrientations=[_frame(s)[1] for s in shapes], **kw)
+        kinds, sizes, positions, orientations = _arrays(shapes)
+        return pb.createCollisionShapeArray(kinds, **sizes, collisionFramePositions=positions,
+                                            collisionFrameOrientations=orientations, **kw)
 
     def _build(self):
         kw = dict(physicsClientId=self.client)
