@@ -8,8 +8,10 @@ import math
 from miro_ball.miro.body import FIXED, LINKS
 from miro_ball.miro.rotations import axis_angle_quaternion, multiply, rpy_quaternion
 
-# (link, its joint's origin turn) of every link, worked out once.
-_ORIGIN_TURN = {link.name: rpy_quaternion(*link.rpy) for link in LINKS}
+# (link, its joint's origin turn) of every link, worked out once; None for no turn (every
+# movable joint of MiRo's: its turn is then the joint's alone).
+_ORIGIN_TURN = {link.name: rpy_quaternion(*link.rpy) if any(link.rpy) else None
+                for link in LINKS}
 FIXED_LINKS = tuple(link for link in LINKS if link.kind == FIXED)
 MOVING_LINKS = tuple(link for link in LINKS if link.kind != FIXED)
 
@@ -18,9 +20,10 @@ def joint_transform(link, position=0.0):
     """(xyz, quaternion) of ``link`` (a body.Link) in its parent, its joint at ``position``
     (rad; a fixed joint has none)."""
     turn = _ORIGIN_TURN[link.name]
-    if link.kind != FIXED:
-        turn = multiply(turn, axis_angle_quaternion(link.axis, position))
-    return link.xyz, turn
+    if link.kind == FIXED:
+        return link.xyz, turn or (0.0, 0.0, 0.0, 1.0)
+    joint = axis_angle_quaternion(link.axis, position)
+    return link.xyz, joint if turn is None else multiply(turn, joint)
 
 
 def fixed_transforms():

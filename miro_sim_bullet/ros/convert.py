@@ -31,11 +31,10 @@ def kinematic_joints(s, when, robot):
     return msg
 
 
-def joint_states(s, when):
+def joint_states(positions, velocities, when):
     """joint_states: every movable joint of the URDF (names without the robot's, as
     robot_state_publisher reads them)."""
-    msg = JointState(name=list(MOVABLE), position=list(s.joint_positions),
-                     velocity=list(s.joint_velocities))
+    msg = JointState(name=list(MOVABLE), position=list(positions), velocity=list(velocities))
     msg.header.stamp = when
     return msg
 

@@ -11,12 +11,29 @@ sentinels' places found in the bytes, and each tick the new numbers are written 
 import struct
 
 import numpy as np
-from rclpy.serialization import serialize_message
+from rclpy.serialization import deserialize_message, serialize_message
 
 _STAMP_SEC = 0x5E7A_11ED  # sentinels no number of ours takes
 _STAMP_NANOSEC = 0x3A9C_0DE5
 _DOUBLE_BASE = 7.0e300  # sentinel doubles: _DOUBLE_BASE + k * _DOUBLE_STEP
 _DOUBLE_STEP = 1.0e290
+
+
+MAX_TAIL = 8  # bytes of alignment rclpy may add after a message's last field
+
+
+def _exact(data, msg_type):
+    """The serialised message without the tail rclpy adds (it rounds the buffer up: 4 bytes
+    of whatever was in memory after a JointState): published as raw bytes the tail would go
+    out too, and strict readers (rosbags) refuse it. The shortest prefix that still
+    deserialises is the message."""
+    for _ in range(MAX_TAIL):
+        try:
+            deserialize_message(data[:-1], msg_type)
+        except Exception:  # rclpy raises its RMWError: too short, so data is exact
+            return data
+        data = data[:-1]
+    return data
 
 
 class Refill:
@@ -28,8 +45,8 @@ class Refill:
         from builtin_interfaces.msg import Time
 
         sentinels = [_DOUBLE_BASE + k * _DOUBLE_STEP for k in range(count)]
-        data = serialize_message(build(Time(sec=_STAMP_SEC, nanosec=_STAMP_NANOSEC),
-                                       sentinels))
+        msg = build(Time(sec=_STAMP_SEC, nanosec=_STAMP_NANOSEC), sentinels)
+        data = _exact(serialize_message(msg), type(msg))
         if data[:2] != b'\x00\x01':  # CDR, little endian: the numbers below are so
             raise ValueError('not a little-endian CDR message')
         self.template = bytearray(data)

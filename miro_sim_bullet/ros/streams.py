@@ -14,10 +14,12 @@ import numpy as np
 from std_msgs.msg import String, UInt16, UInt32
 
 from miro_ball.common.messages import message_class
+from miro_ball.miro.body import MOVABLE
 from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR, WHEEL_MAX_SPEED_M_PER_S
 from miro_ball.miro.interface import frame_id, PLATFORM_HZ, ROBOT_INTERFACE, SENSOR, TOPIC
 from miro_ball.miro.urdf import urdf
 from miro_sim_bullet.ros import convert
+from miro_sim_bullet.ros.refill import Refill
 
 PRODUCERS = {
     'kinematic_joints': lambda r, when, name: convert.kinematic_joints(r.sensors, when, name),
@@ -34,9 +36,19 @@ PRODUCERS = {
     'light': lambda r, when, name: convert.floats(r.sensors.light),
     'touch': lambda r, when, name, part: UInt16(data=getattr(r.sensors, f'touch_{part}')),
     'sensor_flags': lambda r, when, name: UInt32(data=UPSTREAM_FLAG_SIMULATOR),
-    'joint_states': lambda r, when, name: convert.joint_states(r.sensors, when),
+    'joint_states': lambda r, when, name: _joint_states().fill(
+        when, (*r.sensors.joint_positions, *r.sensors.joint_velocities)),
     'robot_description': lambda r, when, name: String(data=urdf()),
 }
+
+
+@functools.cache
+def _joint_states():
+    """joint_states' bytes, refilled each tick (the same names for every robot): a
+    message of 24 numbers at 50 Hz for every robot."""
+    count = len(MOVABLE)
+    return Refill(lambda stamp, values: convert.joint_states(values[:count], values[count:],
+                                                             stamp), 2 * count)
 
 
 @functools.cache  # on first use: miro2_msg may not be built, and then it is never called

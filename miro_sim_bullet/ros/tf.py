@@ -42,17 +42,18 @@ def static_transforms(robots, when):
     return out
 
 
-def robot_frames(s, name):
-    """[(parent, child, xyz, quaternion)] of one robot's moving frames from its tick's
-    Sensors, always in the same order."""
+def robot_pairs(name):
+    """[(parent, child)] of one robot's moving frames, in robot_poses' order."""
+    return [(frame_id(name, 'odom'), frame_id(name, 'base_link')),
+            (frame_id(name, _BODY.parent), frame_id(name, _BODY.name))] + [
+        (frame_id(name, link.parent), frame_id(name, link.name)) for link, _ in _JOINTS]
+
+
+def robot_poses(s):
+    """[(xyz, quaternion)] of one robot's moving frames from its tick's Sensors."""
     x, y, yaw = s.pose
-    out = [(frame_id(name, 'odom'), frame_id(name, 'base_link'), (x, y, 0.0),
-            axis_angle_quaternion((0.0, 0.0, 1.0), yaw)),
-           (frame_id(name, _BODY.parent), frame_id(name, _BODY.name), *s.body_in_base)]
-    for link, index in _JOINTS:
-        out.append((frame_id(name, link.parent), frame_id(name, link.name),
-                    *joint_transform(link, s.joint_positions[index])))
-    return out
+    return [((x, y, 0.0), axis_angle_quaternion((0.0, 0.0, 1.0), yaw)), s.body_in_base] + [
+        joint_transform(link, s.joint_positions[index]) for link, index in _JOINTS]
 
 
 class TfInterface:
@@ -67,22 +68,15 @@ class TfInterface:
         self.pub_static = ros.publisher(self.message, TF_STATIC, profile(TF_STATIC_QOS))
         # Published once, kept for late subscribers (transient local).
         self.pub_static.publish(self.message(transforms=static_transforms(world.robots, when)))
-        self._refill = None  # made on first use: the frames' order is the robots' now
-
-    def _frames(self):
-        return [frame for name, robot in self.world.robots.items()
-                for frame in robot_frames(robot.sensors, name)]
+        pairs = [pair for name in world.robots for pair in robot_pairs(name)]
+        self._refill = Refill(lambda stamp, values: self.message(transforms=[
+            convert.transform(parent, child, values[7 * k:7 * k + 3],
+                              values[7 * k + 3:7 * k + 7], stamp)
+            for k, (parent, child) in enumerate(pairs)]), 7 * len(pairs))
 
     def publish(self, when):
         """Every robot's moving frames now, in one message (only while listened to)."""
-        if not self.pub.get_subscription_count():
-            return
-        frames = self._frames()
-        if self._refill is None:
-            pairs = [(parent, child) for parent, child, _, _ in frames]
-            self._refill = Refill(lambda stamp, values: self.message(transforms=[
-                convert.transform(parent, child, values[7 * k:7 * k + 3],
-                                  values[7 * k + 3:7 * k + 7], stamp)
-                for k, (parent, child) in enumerate(pairs)]), 7 * len(pairs))
-        self.pub.publish(self._refill.fill(when, [v for _, _, xyz, turn in frames
-                                                  for v in (*xyz, *turn)]))
+        if self.pub.get_subscription_count():
+            self.pub.publish(self._refill.fill(when, [
+                v for robot in self.world.robots.values()
+                for xyz, turn in robot_poses(robot.sensors) for v in (*xyz, *turn)]))
