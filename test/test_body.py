@@ -12,7 +12,8 @@ from miro_ball.common.messages import message_class
 from miro_ball.miro.body import COSMETIC_JOINTS, COSMETIC_SPANS, LINK, LINKS, MOVABLE, PHYSICAL
 from miro_ball.miro.constants import JOINT_LIMITS_RAD, JOINT_NAMES, KIN_CALIB_RAD
 from miro_ball.miro.kc import CAML, CAMR, FOOT, HEAD, KinematicChain, SONAR
-from miro_ball.miro.link_poses import moving_transforms, fixed_transforms, pose_on_base
+from miro_ball.miro.link_poses import (fixed_transforms, FIXED_LINKS, JOINTED, jointed_poses,
+                                       MOVING_LINKS, pose_on_base)
 from miro_ball.miro.rotations import rpy_quaternion
 from miro_ball.miro.tf_tree import TfError, TfTree
 from miro_ball.miro.urdf import urdf
@@ -62,9 +63,26 @@ def test_the_physics_body_has_the_descriptions_links_in_order():
     assert [LINK[PHYSICAL[i]].joint for i in COSMETIC_LINKS] == list(COSMETIC_JOINTS)
 
 
-def test_fixed_and_moving_transforms_cover_every_link_once():
-    children = [child for _, child, _, _ in fixed_transforms() + moving_transforms({})]
+def test_fixed_and_moving_links_cover_every_link_once():
+    children = [link.name for link in FIXED_LINKS + MOVING_LINKS]
     assert sorted(children) == sorted(link.name for link in LINKS)
+    assert [child for _, child, _, _ in fixed_transforms()] == [l.name for l in FIXED_LINKS]
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.floats(-3, 3), min_size=len(JOINTED), max_size=len(JOINTED)))
+def test_jointed_poses_are_the_urdfs(model, positions):
+    """/tf's arithmetic for the moving joints is the URDF's (read by yourdfpy)."""
+    model.update_cfg({link.joint: q for link, q in zip(JOINTED, positions)})
+    poses = jointed_poses(positions)
+    for link, pose in zip(JOINTED, poses):
+        expected = model.get_transform(link.name, link.parent)
+        assert pose[:3] == pytest.approx(expected[:3, 3], abs=1e-9)
+        x, y, z, w = pose[3:]
+        got = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+        assert got == pytest.approx(expected[:3, :3], abs=1e-9)
 
 
 @settings(max_examples=50, deadline=None)

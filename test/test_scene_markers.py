@@ -93,9 +93,9 @@ def test_the_frames_on_tf_are_where_the_simulator_has_the_links():
     when = convert.stamp(world.time)
     tree = TfTree()
     assert tree.set_message(tf.static_transforms([robot.name], when)) == []
-    for (parent, child), (xyz, turn) in zip(tf.robot_pairs(robot.name),
-                                            tf.robot_poses(robot.sensors)):
-        tree.set(parent, child, xyz, turn)
+    for (parent, child), pose in zip(tf.robot_pairs(robot.name),
+                                     tf.robot_poses([robot.sensors])[0]):
+        tree.set(parent, child, pose[:3], pose[3:])
     for eye in ('caml', 'camr'):
         position, rotation = robot.eye_pose(EYE_SIDE[eye])
         optical = tree.lookup('world', frame_id(robot.name, f'{eye}_optical'))

@@ -5,37 +5,35 @@ Pure. A transform is (xyz, quaternion x, y, z, w) of the child's frame in the pa
 """
 import math
 
+import numpy as np
+
 from miro_ball.miro.body import FIXED, LINKS
 from miro_ball.miro.rotations import axis_angle_quaternion, multiply, rpy_quaternion
 
-# (link, its joint's origin turn) of every link, worked out once; None for no turn (every
-# movable joint of MiRo's: its turn is then the joint's alone).
-_ORIGIN_TURN = {link.name: rpy_quaternion(*link.rpy) if any(link.rpy) else None
-                for link in LINKS}
 FIXED_LINKS = tuple(link for link in LINKS if link.kind == FIXED)
 MOVING_LINKS = tuple(link for link in LINKS if link.kind != FIXED)
+# The links a joint moves after the tilt (the wheels, the neck, the tail, the eyelids, the
+# ears): each turns about its own axis, with no turn of its joint's origin (test_body).
+JOINTED = tuple(link for link in MOVING_LINKS if link.joint != 'tilt')
+_JOINTED_XYZ = np.array([link.xyz for link in JOINTED])
+_JOINTED_AXES = np.array([link.axis for link in JOINTED])
 
 
-def joint_transform(link, position=0.0):
-    """(xyz, quaternion) of ``link`` (a body.Link) in its parent, its joint at ``position``
-    (rad; a fixed joint has none)."""
-    turn = _ORIGIN_TURN[link.name]
-    if link.kind == FIXED:
-        return link.xyz, turn or (0.0, 0.0, 0.0, 1.0)
-    joint = axis_angle_quaternion(link.axis, position)
-    return link.xyz, joint if turn is None else multiply(turn, joint)
+def jointed_poses(positions):
+    """(..., J, 7): xyz and quaternion (x, y, z, w) in its parent of each JOINTED link, its
+    joint at ``positions`` (..., J) rad; for every robot at once, at 50 Hz."""
+    half = np.asarray(positions, float) / 2
+    out = np.empty(half.shape + (7,))
+    out[..., :3] = _JOINTED_XYZ
+    out[..., 3:6] = _JOINTED_AXES * np.sin(half)[..., None]
+    out[..., 6] = np.cos(half)
+    return out
 
 
 def fixed_transforms():
     """[(parent, child, xyz, quaternion)] of every fixed joint: /tf_static."""
-    return [(link.parent, link.name, *joint_transform(link)) for link in FIXED_LINKS]
-
-
-def moving_transforms(positions):
-    """[(parent, child, xyz, quaternion)] of every movable joint at ``positions`` ({joint
-    name: rad}; a joint not given is taken at 0)."""
-    return [(link.parent, link.name, *joint_transform(link, positions.get(link.joint, 0.0)))
-            for link in MOVING_LINKS]
+    return [(link.parent, link.name, link.xyz, rpy_quaternion(*link.rpy))
+            for link in FIXED_LINKS]
 
 
 def pose_on_base(position, quaternion, x, y, yaw):

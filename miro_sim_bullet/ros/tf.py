@@ -16,19 +16,21 @@ The moving transforms go out each platform tick, only while someone listens. The
 tf2_msgs/TFMessage, is built at set-up (python -m miro_ball.build_interfaces); without it
 the simulator runs without /tf and says so once.
 """
+import numpy as np
+
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
 from miro_ball.miro.body import LINK_OF_JOINT, MOVABLE
 from miro_ball.miro.interface import frame_id, TF, TF_QOS, TF_STATIC, TF_STATIC_QOS, TF_TYPE, \
     WORLD_FRAME
-from miro_ball.miro.link_poses import fixed_transforms, joint_transform, MOVING_LINKS
+from miro_ball.miro.link_poses import fixed_transforms, JOINTED, jointed_poses
 from miro_ball.miro.rotations import axis_angle_quaternion
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.refill import Refill
 
 _BODY = LINK_OF_JOINT['tilt']  # its exact pose, not the tilt alone (a slope rolls it too)
-# (link, index of its joint in Sensors.joint_positions) of the joints after the tilt.
-_JOINTS = tuple((link, MOVABLE.index(link.joint)) for link in MOVING_LINKS if link is not _BODY)
+# Where each JOINTED link's joint is in Sensors.joint_positions.
+_JOINT_INDEX = np.array([MOVABLE.index(link.joint) for link in JOINTED])
 
 
 def static_transforms(robots, when):
@@ -46,14 +48,19 @@ def robot_pairs(name):
     """[(parent, child)] of one robot's moving frames, in robot_poses' order."""
     return [(frame_id(name, 'odom'), frame_id(name, 'base_link')),
             (frame_id(name, _BODY.parent), frame_id(name, _BODY.name))] + [
-        (frame_id(name, link.parent), frame_id(name, link.name)) for link, _ in _JOINTS]
+        (frame_id(name, link.parent), frame_id(name, link.name)) for link in JOINTED]
 
 
-def robot_poses(s):
-    """[(xyz, quaternion)] of one robot's moving frames from its tick's Sensors."""
-    x, y, yaw = s.pose
-    return [((x, y, 0.0), axis_angle_quaternion((0.0, 0.0, 1.0), yaw)), s.body_in_base] + [
-        joint_transform(link, s.joint_positions[index]) for link, index in _JOINTS]
+def robot_poses(sensors):
+    """(robots, frames, 7): xyz and quaternion of the moving frames of every robot (each
+    robot's Sensors of its tick, in robot_pairs' order)."""
+    poses = np.empty((len(sensors), 2 + len(JOINTED), 7))
+    poses[:, 2:] = jointed_poses(np.array([s.joint_positions for s in sensors])[:, _JOINT_INDEX])
+    for pose, s in zip(poses, sensors):
+        x, y, yaw = s.pose
+        pose[0] = (x, y, 0.0, *axis_angle_quaternion((0.0, 0.0, 1.0), yaw))
+        pose[1, :3], pose[1, 3:] = s.body_in_base
+    return poses
 
 
 class TfInterface:
@@ -77,6 +84,5 @@ class TfInterface:
     def publish(self, when):
         """Every robot's moving frames now, in one message (only while listened to)."""
         if self.pub.get_subscription_count():
-            self.pub.publish(self._refill.fill(when, [
-                v for robot in self.world.robots.values()
-                for xyz, turn in robot_poses(robot.sensors) for v in (*xyz, *turn)]))
+            self.pub.publish(self._refill.fill(when, robot_poses(
+                [robot.sensors for robot in self.world.robots.values()]).ravel()))
