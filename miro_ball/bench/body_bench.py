@@ -105,10 +105,9 @@ def main(argv=None):
     from rclpy.parameter import Parameter
 
     from miro_ball.common.isolation import limit_discovery, private_domain
-    from miro_sim_bullet.ros.node import publish_asynchronously, SimNode
+    from miro_sim_bullet.ros.node import SimNode
 
     limit_discovery()
-    publish_asynchronously()  # as the simulator's own process does
     domain = private_domain(salt=73)
     context = Context()
     rclpy.init(context=context, domain_id=domain)

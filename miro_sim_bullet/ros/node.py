@@ -17,7 +17,6 @@ gives: an instant's images, then its /clock.
 """
 import argparse
 import collections
-import os
 import sys
 import time
 
@@ -377,18 +376,6 @@ def make_executor(context=None):
     return EventsExecutor(context=context)
 
 
-# The simulation loop publishes every stream itself. In Fast DDS's asynchronous mode a
-# publish hands the message to Fast DDS's own thread: /tf or a joint_states with a
-# subscriber in another process cost the loop 3-5 us instead of 18-20 (the sending runs on
-# the other core). Measured with bench/body_bench; a mode the user set is kept.
-PUBLICATION_MODE = ('RMW_FASTRTPS_PUBLICATION_MODE', 'ASYNCHRONOUS')
-
-
-def publish_asynchronously(environ=os.environ):
-    """Before rclpy.init of a simulator's process: Fast DDS publishes from its own thread."""
-    environ.setdefault(*PUBLICATION_MODE)
-
-
 def main(argv=None):
     argv = sys.argv if argv is None else argv
     args = parse_args(user_args(argv, SIM_NODE_NAME, (SimParams,)))
@@ -398,7 +385,6 @@ def main(argv=None):
     overrides = [] if args.world is None else [Parameter('world', value=args.world)]
     # Ctrl+C and SIGTERM end the spin with the context still up (see stopping.py).
     stop = StopRequest()
-    publish_asynchronously()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     try:
         node = SimNode(parameter_overrides=overrides, robot=args.robot, guard_domain=True)
