@@ -14,7 +14,7 @@ from miro_ball.miro.constants import JOINT_LIMITS_RAD, JOINT_NAMES, KIN_CALIB_RA
 from miro_ball.miro.kc import CAML, CAMR, FOOT, HEAD, KinematicChain, SONAR
 from miro_ball.miro.link_poses import (fixed_transforms, FIXED_LINKS, JOINTED, jointed_poses,
                                        MOVING_LINKS, pose_on_base)
-from miro_ball.miro.rotations import rpy_quaternion
+from miro_ball.miro.rotations import quaternion_matrix, rpy_quaternion
 from miro_ball.miro.tf_tree import TfError, TfTree
 from miro_ball.miro.urdf import urdf
 from miro_sim_bullet.physics.model import COSMETIC_LINKS, ILLUM_LINKS
@@ -78,11 +78,7 @@ def test_jointed_poses_are_the_urdfs(model, positions):
     for link, pose in zip(JOINTED, poses):
         expected = model.get_transform(link.name, link.parent)
         assert pose[:3] == pytest.approx(expected[:3, 3], abs=1e-9)
-        x, y, z, w = pose[3:]
-        got = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-        assert got == pytest.approx(expected[:3, :3], abs=1e-9)
+        assert quaternion_matrix(pose[3:]) == pytest.approx(expected[:3, :3], abs=1e-9)
 
 
 @settings(max_examples=50, deadline=None)

@@ -153,7 +153,8 @@ def test_the_ball_through_tf_lands_on_its_blob_in_the_eye(make_sim, ros_context,
         sim.robots[name].robot.set_kinematic_targets((0.0, lift, head_yaw, pitch_))
         advance_ticks(sim, executor, 60)  # the head gets there and holds still
         for images, infos in eyes.values():
-            images.clear(), infos.clear()
+            images.clear()
+            infos.clear()
         del tf[:], ball[:]
         advance_ticks(sim, executor, 8)
         assert spin_until(executor, lambda: tf and ball and all(

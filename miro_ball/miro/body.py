@@ -23,6 +23,7 @@ from miro_ball.miro.constants import (JOINT_LIMITS_RAD, LIFT, PITCH, WHEEL_RADIU
 from miro_ball.miro.kc import (AXLE_HEIGHT_M, camera_in_head, EAR_IN_HEAD, EYE_IN_HEAD,
                                LIFT_JOINT_IN_BODY, NOSE_IN_HEAD, SONAR_IN_HEAD,
                                YAW_JOINT_IN_NECK)
+from miro_ball.miro.rotations import matrix_rpy
 
 BOX, SPHERE, CYLINDER = 'box', 'sphere', 'cylinder'  # a cylinder's axis is its z, as URDF's
 REVOLUTE, CONTINUOUS, FIXED = 'revolute', 'continuous', 'fixed'
@@ -181,23 +182,16 @@ def _eyelid_pivot(side):
     return (x, side * y, z + 0.012)
 
 
-def rpy_of(rotation):
-    """URDF's roll, pitch, yaw (fixed axes x, y, z) of a 3x3 rotation matrix."""
-    r = np.asarray(rotation, float)
-    pitch = math.asin(max(-1.0, min(1.0, -r[2, 0])))
-    return (math.atan2(r[2, 1], r[2, 2]), pitch, math.atan2(r[1, 0], r[0, 0]))
-
-
 def _eye(name, side):
     """An eye's frame in HEAD, turned as kc's camera model turns it (x its optical axis)."""
     position, rotation = camera_in_head(side)
     return Link(name, 'head', f'{name}_joint', FIXED, tuple(float(v) for v in position),
-                rpy_of(rotation))
+                matrix_rpy(rotation))
 
 
 def _optical(eye):
     return Link(f'{eye}_optical', eye, f'{eye}_optical_joint', FIXED, (0.0, 0.0, 0.0),
-                rpy_of(OPTICAL_IN_CAMERA))
+                matrix_rpy(OPTICAL_IN_CAMERA))
 
 
 # Every link, parents before children. The order of the movable and drawn ones (all

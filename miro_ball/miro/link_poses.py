@@ -39,7 +39,8 @@ def fixed_transforms():
 def pose_on_base(position, quaternion, x, y, yaw):
     """The body's pose on base_link, from its pose in the world (position, quaternion) and
     base_link's (x, y on the floor, heading yaw): (xyz, quaternion, tilt), tilt the body's
-    pitch there (joint_states' tilt). The body's own heading is taken to be yaw. By hand: this runs for every robot every tick."""
+    pitch there (joint_states' tilt). The body's own heading is taken to be yaw. By hand:
+    this runs for every robot every tick."""
     c, s = math.cos(yaw), math.sin(yaw)
     dx, dy = position[0] - x, position[1] - y
     xyz = (c * dx + s * dy, -s * dx + c * dy, position[2])

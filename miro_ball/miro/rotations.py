@@ -33,6 +33,16 @@ def matrix_quaternions(matrices):
     return q * np.where(q[:, 3:] < 0, -1.0, 1.0)
 
 
+def matrix_rpy(rotation):
+    """URDF's roll, pitch, yaw (turns about the fixed x, y, z axes) of a 3x3 rotation."""
+    return tuple(Rotation.from_matrix(np.asarray(rotation, float)).as_euler('xyz').tolist())
+
+
+def quaternion_matrix(quaternion):
+    """The 3x3 rotation of a unit quaternion (x, y, z, w)."""
+    return Rotation.from_quat(quaternion).as_matrix()
+
+
 def rpy_quaternion(roll, pitch, yaw):
     """(x, y, z, w) of URDF's roll, pitch, yaw (turns about the fixed x, y, z axes)."""
     q = Rotation.from_euler('xyz', (roll, pitch, yaw)).as_quat()

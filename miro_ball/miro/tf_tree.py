@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from miro_ball.miro.rotations import MIN_NORM
+from miro_ball.miro.rotations import MIN_NORM, quaternion_matrix
 
 MAX_FRAMES = 5000  # far beyond a world of robots (~30 frames each)
 MAX_DEPTH = 64  # no tree of ours is deeper than ~8: a longer chain is a loop or garbage
@@ -22,11 +22,8 @@ class TfError(ValueError):
 
 
 def _matrix(xyz, q):
-    x, y, z, w = q
     t = np.eye(4)
-    t[:3, :3] = ((1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
-                 (2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
-                 (2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)))
+    t[:3, :3] = quaternion_matrix(q)
     t[:3, 3] = xyz
     return t
 
