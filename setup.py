@@ -37,7 +37,8 @@ setup(
         'pybullet',
         'rosbags',  # rosbag2 (MCAP) recording without a ROS install
         'ruamel.yaml',  # rosbag2 metadata (rosbags uses it too)
-        'scipy',  # rotations (scipy.spatial.transform)
+        'scipy',  # rotations (scipy.spatial.transform), the microphones' filters
+        'soundfile',  # sound files: a world's sounds, the recorder's WAV, the audio clients
     ],
     extras_require={
         # Left out for users whose ROS 2 Jazzy is installed and sourced.

@@ -63,16 +63,17 @@ def test_the_interface_is_one_table_with_one_eye_qos():
 
 
 def test_every_row_of_the_interface_is_served_by_the_simulator():
-    """A sensor row is drawn by the eyes (CAMERA) or made by a producer at its rate; a
-    control row is applied (RobotInterface refuses to start without a handler)."""
-    from miro_ball.miro.interface import CAMERA, CONTROL, ONCE, ROBOT_INTERFACE, SENSOR
+    """A sensor row is drawn by the eyes (CAMERA), heard by the ears (MICS) or made by a
+    producer at its rate; a control row is applied (RobotInterface refuses to start
+    without a handler)."""
+    from miro_ball.miro.interface import CAMERA, CONTROL, MICS, ONCE, ROBOT_INTERFACE, SENSOR
     from miro_sim_bullet.ros.streams import PRODUCERS
 
     streams = {row.key for row in ROBOT_INTERFACE if row.direction == SENSOR
-               and row.rate != CAMERA}
+               and row.rate not in (CAMERA, MICS)}
     assert set(PRODUCERS) == streams
     for row in ROBOT_INTERFACE:
         if row.direction == SENSOR:
-            assert row.rate in (CAMERA, ONCE) or 0 < row.rate <= 1000, row
+            assert row.rate in (CAMERA, MICS, ONCE) or 0 < row.rate <= 1000, row
         else:
             assert row.direction == CONTROL and row.rate is None, row

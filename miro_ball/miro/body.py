@@ -49,6 +49,11 @@ TAIL_JOINT_IN_BODY = (-0.143, 0.0, floor(0.085))
 TAIL_MIC_IN_BODY = (-0.160, 0.0, floor(0.085))
 IMU_IN_BODY = (-0.095, 0.048, 0.010)
 IMU_IN_HEAD = (0.050, 0.040, 0.025)
+# The head's microphone: its place is not published; taken on the head's midline between the
+# ears (miro_facts.md). The speaker: not published either; taken behind the muzzle, under
+# the sonar, where MiRo's voice seems to come from.
+MIC_C_IN_HEAD = (EAR_IN_HEAD[0], 0.0, EAR_IN_HEAD[2])
+SPEAKER_IN_HEAD = (0.060, 0.0, 0.0)
 BODY_COM = (-0.060, 0.0, floor(0.050))
 SLIDER = (-0.1075, 0.0, floor(0.0264))  # the low-friction ball the body rests back on
 SLIDER_RADIUS = 0.015
@@ -237,7 +242,9 @@ LINKS = (
     Link('imu_body', 'body', 'imu_body_joint', FIXED, IMU_IN_BODY),
     Link('mic_l', 'head', 'mic_l_joint', FIXED, EAR_IN_HEAD),
     Link('mic_r', 'head', 'mic_r_joint', FIXED, _mirror(EAR_IN_HEAD)),
+    Link('mic_c', 'head', 'mic_c_joint', FIXED, MIC_C_IN_HEAD),
     Link('mic_t', 'body', 'mic_t_joint', FIXED, TAIL_MIC_IN_BODY),
+    Link('speaker', 'head', 'speaker_joint', FIXED, SPEAKER_IN_HEAD),
     Link('cliff_l', 'body', 'cliff_l_joint', FIXED, CLIFF_IN_BODY,
          (0.0, CLIFF_PITCH_DOWN, 0.0)),
     Link('cliff_r', 'body', 'cliff_r_joint', FIXED, _mirror(CLIFF_IN_BODY),
@@ -249,3 +256,5 @@ LINK = {link.name: link for link in LINKS}
 PHYSICAL = tuple(link.name for link in LINKS[1:] if link.visuals or link.kind != FIXED)
 MOVABLE = tuple(link.joint for link in LINKS if link.kind != FIXED)  # joint_states' names
 LINK_OF_JOINT = {link.joint: link for link in LINKS}
+# sensors/mics' channels, in its order (miro.constants MIC_L, MIC_R, MIC_C, MIC_T).
+MICS = ('mic_l', 'mic_r', 'mic_c', 'mic_t')

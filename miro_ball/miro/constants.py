@@ -34,6 +34,16 @@ SPEAKER_SAMPLE_RATE_HZ = 8000
 TONE_FREQUENCY_RANGE_HZ = (200.0, 2000.0)  # the MDK's interface clips to this
 TONE_VOLUME_MAX = 255
 
+# Microphones (section 3.1, "Microphones and speaker"): sensors/mics carries 4 channels x
+# 500 samples at 20 kHz, channel-blocked (data[0:500] is channel 0), 40 messages a second;
+# the channels are the frames of miro.body.MICS, in this order (MIC_L 0, MIC_R 1, MIC_C 2,
+# MIC_T 3). Full scale is the int16 range.
+MIC_SAMPLE_RATE_HZ = 20000
+MIC_BLOCK_SAMPLES = 500
+MIC_L, MIC_R, MIC_C, MIC_T = range(4)
+MIC_FULL_SCALE = 32768
+SPEED_OF_SOUND_M_S = 343.0
+
 # Cameras (section 2)
 CAM_ELEVATION_RAD = math.radians(45.0)
 CAM_DIVERGENCE_RAD = math.radians(27.0)

@@ -63,6 +63,11 @@ SENSOR, CONTROL = 'sensor', 'control'  # out of the robot, into the robot
 PLATFORM_HZ = 50.0  # MiRo's platform tick: its sensors, /clock
 CAMERA = 'camera'  # a stream at the eyes' rate (the simulator's camera_rate parameter)
 ONCE = 'once'  # a stream sent once and kept for late subscribers (latched)
+# The microphones: 40 blocks of 25 ms a simulated second, each published as soon as all its
+# samples are heard (at the platform tick after its end); a second of them queued, so that
+# a reader that is a little late loses none.
+MICS = 'mics'
+MIC_QOS = Qos(depth=40)
 DESCRIPTION_QOS = Qos(depth=1, latched=True)  # robot_state_publisher's robot_description
 
 
@@ -134,6 +139,11 @@ ROBOT_INTERFACE = tuple(Topic(*row[:6], *(row[6:] or (None,))) for row in (
      PLATFORM_HZ),
     ('robot_description', 'robot_description', 'std_msgs/msg/String', SENSOR, DESCRIPTION_QOS,
      'the URDF: link and joint names without the robot (its frames on /tf carry it)', ONCE),
+    ('mics', 'sensors/mics', 'std_msgs/msg/Int16MultiArray', SENSOR, MIC_QOS,
+     'microphones [left ear, right ear, head, tail] x 500 samples at 20 kHz, 40 a second',
+     MICS),
+    ('stream_state', 'sensors/stream', 'std_msgs/msg/UInt16MultiArray', SENSOR, SENSOR_QOS,
+     "speaker buffer [room left, size], 8 kHz samples", PLATFORM_HZ),
     ('package', 'sensors/package', 'miro2_msg/msg/SensorsPackage', SENSOR, SENSOR_QOS,
      "every 50 Hz reading of one tick, stamped (miro2_msg: built at set-up)", PLATFORM_HZ),
     ('cmd_vel', 'control/cmd_vel', 'geometry_msgs/msg/TwistStamped', CONTROL, CONTROL_QOS,

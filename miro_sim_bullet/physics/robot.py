@@ -11,6 +11,7 @@ import numpy as np
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       KIN_CALIB_RAD, TILT_RAD, WHEEL_RADIUS_M)
+from miro_ball.miro.body import LINK, MICS
 from miro_ball.miro.kc import camera_in_head, SONAR_IN_HEAD
 from miro_ball.miro.interface import TOUCH_PARTS
 from miro_ball.miro.kinematics import clamp_wheel_speeds, cmd_vel2wheel_speed
@@ -30,6 +31,12 @@ COSMETIC_TORQUE_NM = 0.2
 # A touched pad reads touched this long after the last message that named it: a stroke is a
 # stream of touch messages (the GUI sends 20 a second), and letting go is their end.
 TOUCH_HOLD_S = 0.25
+# Where the microphones and the speaker are: (its link, xyz there) from the body model.
+_MIC_POINTS = tuple((LINK[mic].parent, np.array(LINK[mic].xyz)) for mic in MICS)
+_SPEAKER_IN_HEAD = np.array(LINK['speaker'].xyz)
+# The ear microphones face out of the head's sides (+y left, -y right); the others, on its
+# top and on the body, are not shadowed by it.
+_EAR_SIDES = np.array([1.0, -1.0, 0.0, 0.0])
 
 
 class MiroRobot:
@@ -64,6 +71,7 @@ class MiroRobot:
         self.flags = 0
         self.illum = [0] * 6
         self.speaker = Speaker()
+        self.sound = None  # what the speaker sent into the world over the last tick
         self.touched_at = {part: [-math.inf] * TOUCH_PADS for part in TOUCH_PARTS}
         for accelerometer in self.imu.values():
             accelerometer.reset()
@@ -161,7 +169,7 @@ class MiroRobot:
             self.body_id, [rb.WHEEL_L, rb.WHEEL_R], pb.VELOCITY_CONTROL,
             targetVelocities=[left / WHEEL_RADIUS_M, right / WHEEL_RADIUS_M],
             forces=[WHEEL_TORQUE_NM] * 2, **self._kw())
-        self.speaker.tick(self.clock())
+        self.sound = self.speaker.tick(self.clock())
         self.sensors = self._read_sensors(cliff)
 
     # -- ground truth -----------------------------------------------------------------------
@@ -251,6 +259,19 @@ class MiroRobot:
             touch_head=self._touch_reading('head'),
             touch_body=self._touch_reading('body'),
         )
+
+    def hearing_frame(self):
+        """Where MiRo hears and speaks from, in the world: (the four microphones (4, 3) in
+        sensors/mics' order, their outward normals where the head shadows them (4, 3; zero
+        else), the speaker (3,), the wheels' middle on the floor (3,))."""
+        head_pos, head_rot = self.link_frame(rb.HEAD)
+        body_pos, body_rot = self.link_frame(-1)
+        frames = {'head': (head_pos, head_rot), 'body': (body_pos, body_rot)}
+        mics = np.array([frames[link][0] + frames[link][1] @ xyz for link, xyz in _MIC_POINTS])
+        outward = _EAR_SIDES[:, None] * head_rot[:, 1]
+        x, y, _ = self.pose()
+        return mics, outward, head_pos + head_rot @ _SPEAKER_IN_HEAD, \
+            np.array([x, y, body_pos[2] - rb.AXLE_HEIGHT])
 
     # -- cameras ----------------------------------------------------------------------------
     def eye_pose(self, side):

@@ -1,21 +1,35 @@
 """MiRo's speaker as the platform keeps it: the tone it is told to play and the stream of
-samples it is sent (plain Python, simulated time passed in).
+samples it is sent, and the sound it makes (plain Python, simulated time passed in).
 
 ``control/tone`` plays one tone for a number of platform ticks; ``control/stream`` appends
 8 kHz samples to a buffer that the speaker plays at its own pace, one platform tick's worth
 (160 samples) a tick. The buffer is bounded: what does not fit is dropped and counted, as a
-client that sends faster than the speaker plays must learn (``sensors/stream`` in the MDK).
+client that sends faster than the speaker plays must learn (``sensors/stream`` reports the
+room left). Each tick the speaker sends its sound into the world at the microphones' rate
+(20 kHz): the stream upsampled, plus the tone.
 """
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import firwin, lfilter
 
-from miro_ball.miro.constants import (PLATFORM_TICK_S, SPEAKER_SAMPLE_RATE_HZ,
-                                      TONE_FREQUENCY_RANGE_HZ, TONE_VOLUME_MAX)
+from miro_ball.miro.constants import (MIC_SAMPLE_RATE_HZ, PLATFORM_TICK_S,
+                                      SPEAKER_SAMPLE_RATE_HZ, TONE_FREQUENCY_RANGE_HZ,
+                                      TONE_VOLUME_MAX)
 
 BUFFER_S = 4.0  # what the platform holds ahead of the speaker
 BUFFER_SAMPLES = int(BUFFER_S * SPEAKER_SAMPLE_RATE_HZ)
 TICK_SAMPLES = int(round(PLATFORM_TICK_S * SPEAKER_SAMPLE_RATE_HZ))
+TICK_OUT = int(round(PLATFORM_TICK_S * MIC_SAMPLE_RATE_HZ))  # samples sent into the world a tick
+# The sound pressure 1 m in front of the speaker at full volume (a full-scale stream, a tone
+# of volume 255), in the microphones' full-scale units: another MiRo 1 m away hears it at
+# -23 dBFS, MiRo's own ears (14 cm away) just below clipping.
+PEAK_AT_1M = 0.1
+# 8 kHz -> 20 kHz: 5 up (zeros between), a low-pass below the old Nyquist frequency, 2 down.
+_UP, _DOWN = 5, 2
+_HIGH_RATE = SPEAKER_SAMPLE_RATE_HZ * _UP
+_TAPS = firwin(121, 3600.0, fs=_HIGH_RATE) * _UP
+QUIET = 1e-6  # below this the upsampler's memory is silence
 
 
 @dataclass(frozen=True)
@@ -34,6 +48,8 @@ class Speaker:
         self._buffer = np.zeros(0, np.int16)
         self.playing = np.zeros(0, np.int16)
         self.dropped = 0
+        self._phase = 0.0  # the tone's, carried from tick to tick: no click
+        self._filter = np.zeros(len(_TAPS) - 1)
 
     def play_tone(self, frequency, volume, ticks, now):
         """[frequency Hz, volume 0..255, duration in platform ticks], as control/tone says
@@ -59,9 +75,37 @@ class Speaker:
     def buffered(self):
         return len(self._buffer)
 
+    @property
+    def free(self):
+        """Samples the buffer can still take (sensors/stream)."""
+        return BUFFER_SAMPLES - len(self._buffer)
+
     def tick(self, now):
-        """One platform tick: the speaker plays the next tick's samples; a tone that has
-        run its time ends."""
+        """One platform tick, the one that ends at ``now``: the speaker plays the next tick's
+        samples and the tone. Returns the sound it sent into the world over the tick,
+        TICK_OUT samples at 20 kHz as pressure 1 m away, or None when it was silent."""
         self.playing, self._buffer = self._buffer[:TICK_SAMPLES], self._buffer[TICK_SAMPLES:]
-        if self.tone is not None and now >= self.tone.until:
-            self.tone = None
+        sound = self._stream_sound()
+        tone = self.tone
+        if tone is not None:
+            start = now - PLATFORM_TICK_S
+            times = start + np.arange(TICK_OUT) / MIC_SAMPLE_RATE_HZ
+            step = 2 * np.pi * tone.frequency / MIC_SAMPLE_RATE_HZ
+            phases = self._phase + step * np.arange(TICK_OUT)
+            self._phase = (self._phase + step * TICK_OUT) % (2 * np.pi)
+            wave = tone.volume * PEAK_AT_1M * np.sin(phases) * (times < tone.until)
+            sound = wave if sound is None else sound + wave
+            if now >= tone.until:
+                self.tone = None
+        return sound
+
+    def _stream_sound(self):
+        """The tick's stream samples at 20 kHz (None once it and the filter are quiet)."""
+        if not len(self.playing) and not np.any(np.abs(self._filter) > QUIET):
+            return None
+        stream = np.zeros(TICK_SAMPLES)
+        stream[:len(self.playing)] = self.playing / 32768.0 * PEAK_AT_1M
+        stuffed = np.zeros(TICK_SAMPLES * _UP)
+        stuffed[::_UP] = stream
+        high, self._filter = lfilter(_TAPS, 1.0, stuffed, zi=self._filter)
+        return high[::_DOWN]

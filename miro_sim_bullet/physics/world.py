@@ -10,6 +10,7 @@ import math
 from miro_ball.miro.constants import PLATFORM_TICK_S
 from miro_ball.miro.interface import default_robot_name
 from miro_ball.miro.rotations import yaw_of
+from miro_sim_bullet.acoustics.hearing import Acoustics
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.robot import MiroRobot
 from miro_sim_bullet.physics.sensors import GRAVITY
@@ -57,6 +58,8 @@ class SimWorld:
         self.dt = physics_dt
         self.ticks_per_platform_tick = max(1, round(PLATFORM_TICK_S / physics_dt))
         self.client = pb.connect(pb.DIRECT)
+        # Whose microphones are worked out (the ROS node: those someone listens to).
+        self.listened = lambda name: True
         self.generation = 0
         self._build()
 
@@ -111,6 +114,9 @@ class SimWorld:
             self.robots[name] = robot
             self.body_labels[robot.body_id] = (name, 'robot')
         self._pictures()  # last, so that the other bodies keep their ids
+        self.acoustics = Acoustics(self.robots, world.sounds, world.hearing,
+                                   ground=world.ground_height or 0.0,
+                                   listened=lambda name: self.listened(name))
         self.generation += 1
 
     def _shape(self, shape):
@@ -228,6 +234,7 @@ class SimWorld:
             if self.step_index % self.ticks_per_platform_tick == 0:
                 for robot in self.robots.values():
                     robot.tick()
+                self.acoustics.tick()
 
     def run(self, seconds):
         self.step(round(seconds / self.dt))

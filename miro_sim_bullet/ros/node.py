@@ -309,6 +309,10 @@ class SimNode(Node):
         for rate in rates:
             for interface in self.robots.values():
                 interface.publish_streams(rate, when)
+        if platform_tick:  # the microphone blocks this tick completed
+            for _, heard in self.sim.acoustics.take():
+                for name, samples in heard.items():
+                    self.robots[name].publish_mics(samples)
         if platform_tick and self.tf is not None:
             self.tf.publish(when)
         if platform_tick and self.sim_interface is not None:

@@ -6,16 +6,17 @@ are ignored, finite values out of range are clamped, both with a rate-limited
 warning. The robot is looked up each time, so a world reset (which rebuilds
 every robot) needs nothing from here.
 """
+import array
 import math
 
-from std_msgs.msg import UInt16
+from std_msgs.msg import Int16MultiArray, MultiArrayDimension, UInt16
 
 from miro_ball.common.checks import finite, finite_values
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
 from miro_ball.miro.constants import JOINT_NAMES, JOINT_POSITIONS
-from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id, ONCE,
-                                      ROBOT_INTERFACE, RobotTopics, SimTopics, TOPIC,
+from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id, MICS,
+                                      ONCE, ROBOT_INTERFACE, RobotTopics, SimTopics, TOPIC,
                                       TOUCH_PARTS)
 from miro_ball.miro.touch import ALL_PADS
 from miro_sim_bullet.render.eye_images import EyeWants
@@ -66,6 +67,8 @@ class RobotInterface:
                 self._publishers[row.key, *fields.values()] = publisher
                 if row.rate == CAMERA:
                     self.pub_eyes[fields['eye']][EYE_ROWS.index(row.key)] = publisher
+                elif row.rate == MICS:
+                    self.pub_mics = publisher
                 elif row.rate == ONCE:  # the same for the robot's whole life: kept (latched)
                     publisher.publish(PRODUCERS[row.key](None, None, name, **fields))
                 else:
@@ -156,6 +159,21 @@ class RobotInterface:
         robot, name = self.robot, self.name
         for make, fields, publisher in self.streams.get(rate, ()):
             send_if_listened(publisher, lambda: make(robot, when, name, **fields))
+
+    def hears(self):
+        """Whether someone subscribes to the microphones (else they are not worked out)."""
+        return self.pub_mics.get_subscription_count() > 0
+
+    def publish_mics(self, samples):
+        """One block of the microphones, int16 (channels, samples), channel by channel."""
+        data = array.array('h')
+        data.frombytes(samples.tobytes())
+        channels, count = samples.shape
+        msg = Int16MultiArray(data=data)
+        msg.layout.dim = [MultiArrayDimension(label='channels', size=channels,
+                                              stride=channels * count),
+                          MultiArrayDimension(label='samples', size=count, stride=count)]
+        self.pub_mics.publish(msg)
 
     def wanted_eyes(self):
         """[(eye, side, EyeWants)] of the eyes someone subscribes to (images or only

@@ -11,7 +11,7 @@ table and a producer here (docs/development.md).
 import functools
 
 import numpy as np
-from std_msgs.msg import String, UInt16, UInt32
+from std_msgs.msg import String, UInt16, UInt16MultiArray, UInt32
 
 from miro_ball.common.messages import message_class
 from miro_ball.miro.body import MOVABLE
@@ -19,6 +19,7 @@ from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR, WHEEL_MAX_SPEED_M_
 from miro_ball.miro.interface import frame_id, PLATFORM_HZ, ROBOT_INTERFACE, SENSOR, TOPIC
 from miro_ball.miro.urdf import urdf
 from miro_sim_bullet.ros import convert
+from miro_sim_bullet.physics.speaker import BUFFER_SAMPLES as SPEAKER_BUFFER_SAMPLES
 from miro_sim_bullet.ros.refill import Refill
 
 PRODUCERS = {
@@ -39,6 +40,8 @@ PRODUCERS = {
     'joint_states': lambda r, when, name: _joint_states().fill(
         when, (*r.sensors.joint_positions, *r.sensors.joint_velocities)),
     'robot_description': lambda r, when, name: String(data=urdf()),
+    'stream_state': lambda r, when, name: UInt16MultiArray(
+        data=[r.speaker.free, SPEAKER_BUFFER_SAMPLES]),
 }
 
 
@@ -67,7 +70,7 @@ def sensors_package(r, when, name):
     """sensors/package: the tick's readings in one stamped message. The simulator models no
     motor electronics, so the two motor fields are ideal: the back-EMF estimate is the
     measured wheel speed, the PWM effort the commanded speed as a fraction of full speed.
-    No DIP switch is set; the speaker's stream state is not reported yet (empty)."""
+    No DIP switch is set."""
     msg = message_class(TOPIC['package'].type)()
     msg.header.stamp, msg.header.frame_id = when, frame_id(name, 'base_link')
     for field, make, holes in _package_parts():

@@ -45,6 +45,7 @@ from pathlib import Path
 
 from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_sim_bullet.scene.png import PngError, png_size
+from miro_sim_bullet.scene.sounds import Hearing, parse_hearing, parse_sounds
 
 DEFAULT_COLOUR = (0.7, 0.7, 0.7)
 MAX_FILE_BYTES = 1_000_000
@@ -152,6 +153,8 @@ class World:
     ground_size: tuple = (100.0, 100.0)
     shapes: tuple = field(default_factory=tuple)
     pictures: tuple = field(default_factory=tuple)  # of Picture
+    sounds: tuple = ()  # of scene.sounds.Sound
+    hearing: Hearing = Hearing()
 
 
 def bundled_worlds():
@@ -305,7 +308,8 @@ class _Parser:
 
     def world(self, data, name):
         self.keys('top level', data, {'description', 'robot', 'ball', 'ground', 'box',
-                                      'cylinder', 'sphere', 'ring', 'wall', 'table'})
+                                      'cylinder', 'sphere', 'ring', 'wall', 'table', 'sound',
+                                      'hearing'})
         description = data.get('description', '')
         if not isinstance(description, str):
             self.fail('description', 'must be a string')
@@ -334,6 +338,8 @@ class _Parser:
                 'ground.size', ground.get('size', [100.0, 100.0]), 2),
             shapes=tuple(self.shapes),
             pictures=tuple(self.pictures),
+            sounds=parse_sounds(self, data.get('sound', [])),
+            hearing=parse_hearing(self, data.get('hearing')),
         )
 
     def robots(self, value):

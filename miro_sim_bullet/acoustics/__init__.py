@@ -1,0 +1,1 @@
+"""Sound in the world: sources, how it travels, what MiRo's microphones hear."""

@@ -1,0 +1,189 @@
+"""The sound of one world: its sources' recent past and what every robot's four
+microphones hear, block by block (no ROS; the world ticks it with simulated time).
+
+Sources: the world file's [[sound]]s (and any placed while it runs), every robot's speaker
+(in its head) and, when the world asks for it, every robot's wheels. Each platform tick
+each source sends one tick of samples into its ring buffer; each time the samples of a
+microphone block (500, 25 ms) are all sent, the block is heard by every robot someone
+listens to, with the microphones and sources where they are then (propagation.render),
+plus each microphone's own seeded noise floor. Block k of every robot covers the same
+samples, whoever listens and whenever.
+"""
+import collections
+
+import numpy as np
+
+from miro_ball.miro.constants import MIC_BLOCK_SAMPLES, MIC_FULL_SCALE, MIC_SAMPLE_RATE_HZ, \
+    PLATFORM_TICK_S, WHEEL_MAX_SPEED_M_PER_S
+from miro_sim_bullet.acoustics.propagation import HISTORY, low_band, LOW_PASS, render
+from miro_sim_bullet.acoustics.sources import Noise, rms_scale, WorldSource
+from miro_sim_bullet.scene.sounds import Hearing, MAX_SOUNDS
+
+TICK = round(PLATFORM_TICK_S * MIC_SAMPLE_RATE_HZ)
+SELF_NOISE_DB = -60.0  # each microphone's own noise floor, RMS
+WHEEL_NOISE_DB = -50.0  # the wheels at full speed, RMS 1 m away
+BLOCKS_KEPT = 40  # heard blocks waiting to be taken: 1 s (a reader that never takes loses
+#                   the oldest, memory stays bounded)
+_QUIET_AFTER = HISTORY - 2 * MIC_BLOCK_SAMPLES  # a source silent this long is heard no more
+
+
+class _Row:
+    """One source's place in the ring buffers: what it is and when it last sounded."""
+
+    def __init__(self, kind, owner):
+        self.kind, self.owner = kind, owner  # 'sound' | 'speaker' | 'wheels', name
+        self.loud_until = -1  # one past the last sample it sent that was not silence
+        self.state = np.zeros(len(LOW_PASS[1]) - 1)
+
+
+class Acoustics:
+    """Sound for ``robots`` ({name: MiroRobot}) and the world's ``sounds`` (scene.sounds)
+    with ``hearing`` (scene.sounds.Hearing); ``seed`` makes every noise.
+
+    ``listened(name)`` says whether a robot's microphones are wanted now; ``take()`` gives the blocks heard since the last take.
+    """
+
+    def __init__(self, robots, sounds=(), hearing=Hearing(), seed=0, ground=0.0,
+                 listened=lambda name: True):
+        self.robots = robots
+        self.hearing = hearing
+        self.seed = seed
+        self.listened = listened
+        self.sent = 0  # samples every source has sent
+        self.next_block = 0
+        self._blocks = collections.deque(maxlen=BLOCKS_KEPT)
+        capacity = MAX_SOUNDS + 2 * len(robots)
+        self.history = np.zeros((capacity, HISTORY))
+        self.low = np.zeros((capacity, HISTORY))
+        self._rows = [None] * capacity
+        self.sounds = {}  # name -> (row, WorldSource)
+        for sound in sounds:
+            self.add_sound(sound)
+        self._speaker_rows = {name: self._take_row('speaker', name) for name in robots}
+        self._wheel_rows = {name: self._take_row('wheels', name) for name in robots} \
+            if hearing.wheel_noise else {}
+        self._noise = {name: Noise((seed, 1, index)) for index, name in enumerate(robots)}
+        self._wheel_noise = {name: Noise((seed, 2, index)) for index, name in enumerate(robots)}
+        self._before = None  # the geometry at the last block's end
+        # The surfaces that echo (axis, coordinate): the ground, and the room's walls and
+        # ceiling; an echo keeps sqrt(1 - absorption) of the pressure.
+        self._planes = [(2, ground)]
+        if hearing.room:
+            x0, y0, x1, y1, height = hearing.room
+            self._planes += [(0, x0), (0, x1), (1, y0), (1, y1), (2, ground + height)]
+        self._reflected = (1.0 - hearing.absorption) ** 0.5
+
+    # -- sources ------------------------------------------------------------------------------
+    def _take_row(self, kind, owner):
+        row = self._rows.index(None)  # ValueError: full (the world file's limit keeps it not)
+        self._rows[row] = _Row(kind, owner)
+        self.history[row] = self.low[row] = 0.0
+        return row
+
+    def add_sound(self, sound):
+        """A world sound (scene.sounds.Sound) starts to play; its name replaces one of the
+        same name. ValueError when MAX_SOUNDS already play."""
+        self.remove_sound(sound.name)
+        if len(self.sounds) >= MAX_SOUNDS:
+            raise ValueError(f'at most {MAX_SOUNDS} sounds play at once')
+        self.sounds[sound.name] = (self._take_row('sound', sound.name),
+                                   WorldSource(sound, (self.seed, 0, len(self.sounds))))
+
+    def remove_sound(self, name):
+        """Silence a world sound at once (what it sent is still on its way: not heard)."""
+        if name in self.sounds:
+            row, _ = self.sounds.pop(name)
+            self._rows[row] = None
+
+    def source_positions(self):
+        """{name: world position} of every world sound and every robot's speaker (the
+        ground truth a test or a lab compares with what the ears make of it)."""
+        out = {name: source.position for name, (_, source) in self.sounds.items()}
+        out.update({name: robot.hearing_frame()[2] for name, robot in self.robots.items()})
+        return out
+
+    # -- time ---------------------------------------------------------------------------------
+    def tick(self):
+        """One platform tick: every source sends its samples; every block whose samples are
+        all sent is heard."""
+        n0 = self.sent
+        chunks = [(row, source.emit(n0, TICK)) for row, source in self.sounds.values()]
+        chunks += [(self._speaker_rows[name], robot.sound) for name, robot in self.robots.items()]
+        for name, row in self._wheel_rows.items():
+            speed = sum(abs(v) for v in self.robots[name].wheel_out) / 2
+            chunks.append((row, None if speed == 0 else self._wheel_noise[name](n0, TICK)
+                           * rms_scale(WHEEL_NOISE_DB) * speed / WHEEL_MAX_SPEED_M_PER_S))
+        at = np.arange(n0, n0 + TICK) & (HISTORY - 1)
+        for row, samples in chunks:
+            info = self._rows[row]
+            if samples is None:
+                if info.loud_until > n0 - _QUIET_AFTER:
+                    self.history[row, at] = 0.0
+                    self.low[row, at], info.state = low_band(np.zeros(TICK), info.state)
+                continue
+            self.history[row, at] = samples
+            self.low[row, at], info.state = low_band(samples, info.state)
+            info.loud_until = n0 + TICK
+        self.sent = n0 + TICK
+        while (self.next_block + 1) * MIC_BLOCK_SAMPLES <= self.sent:
+            self._hear_block()
+
+    def _geometry(self):
+        """[(mics (4, 3), outward normals (4, 3))] of the robots, and {row: position} of
+        the sources."""
+        frames = {name: robot.hearing_frame() for name, robot in self.robots.items()}
+        sources = {row: source.position for row, source in self.sounds.values()}
+        sources.update({self._speaker_rows[name]: frame[2] for name, frame in frames.items()})
+        sources.update({self._wheel_rows[name]: frame[3] for name, frame in frames.items()
+                        if name in self._wheel_rows})
+        return frames, sources
+
+    def _hear_block(self):
+        block = self.next_block
+        self.next_block += 1
+        now = self._geometry()
+        before = self._before if self._before is not None else now
+        self._before = now
+        heard = [name for name in self.robots if self.listened(name)]
+        if not heard:
+            return
+        n0 = block * MIC_BLOCK_SAMPLES
+        rows = [row for row, info in enumerate(self._rows)
+                if info is not None and info.loud_until > n0 - _QUIET_AFTER]
+        gains, start = self._images(rows, before, now, heard)
+        _, end = self._images(rows, now, now, heard)
+        echoes = len(self._planes) if self.hearing.reflections else 0
+        pressure = render(self.history, self.low, rows * (1 + echoes), gains, n0,
+                          MIC_BLOCK_SAMPLES, start, end)
+        out = {}
+        for index, name in enumerate(heard):
+            mics = pressure[4 * index:4 * index + 4]
+            mics += rms_scale(SELF_NOISE_DB) * self._noise[name](block, 4 * MIC_BLOCK_SAMPLES
+                                                                 ).reshape(4, -1)
+            out[name] = np.clip(np.rint(mics * MIC_FULL_SCALE), -MIC_FULL_SCALE,
+                                MIC_FULL_SCALE - 1).astype(np.int16)
+        self._blocks.append((block, out))
+
+    def _images(self, rows, geometry, now, heard):
+        """(gains, (source positions, mic positions, outward normals)) of the sources of
+        ``rows`` followed by their echoes off each wall, and of the listened robots'
+        microphones, from ``geometry`` (a source new since then: from ``now``)."""
+        (frames, sources), latest = geometry, now[1]
+        count = len(rows)
+        positions = np.array([sources.get(row, latest[row]) for row in rows],
+                             float).reshape(-1, 3)
+        images, gains = [positions], [np.ones(count)]
+        for axis, value in self._planes if self.hearing.reflections else ():
+            mirrored = positions.copy()
+            mirrored[:, axis] = 2 * value - mirrored[:, axis]
+            images.append(mirrored)
+            gains.append(np.full(count, self._reflected))
+        mics = np.concatenate([frames[name][0] for name in heard])
+        outward = np.concatenate([frames[name][1] for name in heard])
+        return np.concatenate(gains), (np.concatenate(images), mics, outward)
+
+    def take(self):
+        """[(block index, {robot: int16 (4, 500)})] heard since the last take, oldest first."""
+        blocks = list(self._blocks)
+        self._blocks.clear()
+        return blocks

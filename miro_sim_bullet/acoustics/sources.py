@@ -1,0 +1,72 @@
+"""What each kind of world sound sends, sample by sample (pure numpy, seeded).
+
+A source's ``emit(n0, count)`` gives its samples n0 .. n0 + count - 1 at the microphones'
+rate, as the pressure 1 m away in full-scale units, or None when it is silent then. The
+samples depend on n0 only: the same world gives the same sound, whoever listens.
+"""
+import math
+
+import numpy as np
+import soundfile
+from scipy.signal import resample_poly
+
+from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ
+
+FS = MIC_SAMPLE_RATE_HZ
+
+
+def rms_scale(level_db):
+    """The factor that gives a signal of RMS 1 an RMS of level_db of full scale."""
+    return 10 ** (level_db / 20)
+
+
+class WorldSource:
+    """A [[sound]] of the world file (scene.sounds.Sound), playing at its position."""
+
+    def __init__(self, sound, seed):
+        self.sound = sound
+        self.position = np.array(sound.position, float)
+        self._noise = Noise(seed)
+        self._first = round(sound.start * FS)
+        self._last = round(min(sound.stop, 1e9) * FS)  # one past it
+        self._scale = rms_scale(sound.level_db)
+        self._samples = _read(sound.file) if sound.kind == 'file' else None
+        if self._samples is not None and not sound.loop:
+            self._last = min(self._last, self._first + len(self._samples))
+
+    def emit(self, n0, count):
+        lo, hi = max(n0, self._first), min(n0 + count, self._last)
+        if lo >= hi:
+            return None
+        out = np.zeros(count)
+        played = np.arange(lo, hi) - self._first  # samples since it started
+        kind = self.sound.kind
+        if kind == 'tone':
+            out[lo - n0:hi - n0] = math.sqrt(2) * np.sin(
+                2 * np.pi * self.sound.frequency / FS * played)
+        elif kind == 'noise':
+            out[lo - n0:hi - n0] = self._noise(lo, hi - lo)
+        else:
+            out[lo - n0:hi - n0] = self._samples.take(played, mode='wrap')
+        return out * self._scale
+
+
+def _read(path):
+    """A sound file as one channel at FS with RMS 1 (its level is the world file's)."""
+    data, rate = soundfile.read(path, dtype='float64', always_2d=True)
+    mono = data.mean(axis=1)
+    if rate != FS:
+        divisor = math.gcd(int(rate), FS)
+        mono = resample_poly(mono, FS // divisor, int(rate) // divisor)
+    rms = math.sqrt(float(np.mean(mono ** 2)))
+    return mono / rms if rms > 0 else mono
+
+
+class Noise:
+    """White noise of RMS 1, the same for the same seed (a tuple of ints) and n0."""
+
+    def __init__(self, seed):
+        self._seed = tuple(seed)
+
+    def __call__(self, n0, count):
+        return np.random.default_rng((*self._seed, n0)).standard_normal(count)

@@ -1,0 +1,129 @@
+"""A world file's sounds: ``[[sound]]`` sources and the ``[hearing]`` options (docs/worlds.md).
+
+A sound plays from a point: a sound file (WAV, FLAC, OGG: what libsndfile reads), a tone
+or white noise, at a level (its RMS 1 m away, in dB of the microphones' full scale), from
+``start`` seconds of simulated time until ``stop`` (or for ever), a file once or looped.
+A file that is missing, not audio, or too long is refused when the world loads, in one
+line, as every other mistake in a world file.
+"""
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+KINDS = ('file', 'tone', 'noise')
+MAX_SOUNDS = 32
+MAX_SOUND_S = 600.0  # a file's length; 10 minutes at 20 kHz is 48 MB of samples
+LEVEL_RANGE_DB = (-120.0, 0.0)
+TONE_RANGE_HZ = (20.0, 9000.0)  # below the microphones' Nyquist frequency
+
+
+@dataclass(frozen=True)
+class Sound:
+    name: str
+    position: tuple  # x, y, z (m)
+    kind: str  # file | tone | noise
+    level_db: float  # RMS 1 m away, dB of full scale
+    file: str = ''  # absolute path, for a file
+    frequency: float = 0.0  # Hz, for a tone
+    loop: bool = False  # a file starts again when it ends
+    start: float = 0.0  # s of simulated time
+    stop: float = math.inf
+
+
+@dataclass(frozen=True)
+class Hearing:
+    """How the world sounds beyond its sources."""
+    wheel_noise: bool = False  # each robot's wheels whirr as they turn
+    reflections: bool = False  # the ground's and the room's walls' echoes (image sources)
+    absorption: float = 0.5  # of the walls, 0..1: the energy a reflection loses
+    room: tuple = ()  # x0, y0, x1, y1, height (m): the walls' box; () = no walls, ground only
+
+
+def parse_sounds(parser, value):
+    """The checked [[sound]] tables, as Sounds; parser is the world file's (its checks)."""
+    tables = parser.array('sound', value)
+    if len(tables) > MAX_SOUNDS:
+        parser.fail('sound', f'at most {MAX_SOUNDS} sounds, got {len(tables)}')
+    return tuple(_sound(parser, f'sound[{i}]', i, table) for i, table in enumerate(tables))
+
+
+def _sound(parser, where, index, table):
+    parser.keys(where, table, {'name', 'position', 'file', 'tone', 'noise', 'level', 'loop',
+                               'start', 'stop'})
+    kinds = [kind for kind in ('file', 'tone', 'noise') if kind in table]
+    if len(kinds) != 1:
+        parser.fail(where, "needs exactly one of 'file' (a sound file), 'tone' (Hz) or "
+                           "'noise = true'")
+    kind, = kinds
+    name = parser.name(f'{where}.name', table['name'], 'sound name') \
+        if 'name' in table else f'sound{index}'
+    level = parser.number(f'{where}.level', table.get('level', -30.0))
+    lo, hi = LEVEL_RANGE_DB
+    if not lo <= level <= hi:
+        parser.fail(f'{where}.level', f'must be {lo:g}..{hi:g} dB (RMS 1 m away, of full '
+                                      f'scale), got {level:g}')
+    start = parser.number(f'{where}.start', table.get('start', 0.0), minimum=0.0)
+    stop = parser.number(f'{where}.stop', table['stop'], positive=True) \
+        if 'stop' in table else math.inf
+    if stop <= start:
+        parser.fail(f'{where}.stop', f'must be after start ({start:g} s), got {stop:g}')
+    loop = table.get('loop', False)
+    if not isinstance(loop, bool):
+        parser.fail(f'{where}.loop', f'must be true or false, got {loop!r}'[:120])
+    extra = {}
+    if kind == 'tone':
+        extra['frequency'] = parser.number(f'{where}.tone', table['tone'], positive=True)
+        if not TONE_RANGE_HZ[0] <= extra['frequency'] <= TONE_RANGE_HZ[1]:
+            parser.fail(f'{where}.tone', f'must be {TONE_RANGE_HZ[0]:g}..{TONE_RANGE_HZ[1]:g} '
+                                         f'Hz, got {extra["frequency"]:g}')
+    elif kind == 'noise':
+        if table['noise'] is not True:
+            parser.fail(f'{where}.noise', 'must be true')
+    else:
+        extra['file'] = _sound_file(parser, f'{where}.file', table['file'])
+    if loop and kind != 'file':
+        parser.fail(f'{where}.loop', 'only a file loops (a tone and noise play on)')
+    return Sound(name=name, position=parser.vector(f'{where}.position',
+                                                   table.get('position', [0, 0, 0]), 3),
+                 kind=kind, level_db=level, loop=loop, start=start, stop=stop, **extra)
+
+
+def _sound_file(parser, where, value):
+    """The absolute path of a sound file that libsndfile reads, not too long."""
+    import soundfile  # here: a world without sound files loads with the standard library only
+    if not isinstance(value, str) or not value or '\0' in value:
+        parser.fail(where, f'must be the name of a sound file, got {value!r}'[:120])
+    path = Path(value)
+    if parser.folder is not None and not path.is_absolute():
+        path = parser.folder / path
+    try:
+        info = soundfile.info(str(path))
+    except (OSError, RuntimeError, soundfile.LibsndfileError) as err:
+        parser.fail(where, f'cannot read {value!r} as sound: {str(err)[:100]}')
+    if info.frames <= 0 or info.samplerate <= 0:
+        parser.fail(where, f'{value!r} holds no sound')
+    if info.frames / info.samplerate > MAX_SOUND_S:
+        parser.fail(where, f'{value!r} is longer than {MAX_SOUND_S:g} s')
+    return str(path.resolve())
+
+
+def parse_hearing(parser, table):
+    """The checked [hearing] table, as Hearing."""
+    if table is None:
+        return Hearing()
+    parser.keys('hearing', table, {'wheel_noise', 'reflections', 'absorption', 'room'})
+    flags = {}
+    for key in ('wheel_noise', 'reflections'):
+        flags[key] = table.get(key, False)
+        if not isinstance(flags[key], bool):
+            parser.fail(f'hearing.{key}', 'must be true or false')
+    absorption = parser.number('hearing.absorption', table.get('absorption', 0.5))
+    if not 0.0 <= absorption <= 1.0:
+        parser.fail('hearing.absorption', f'must be 0..1, got {absorption:g}')
+    room = ()
+    if 'room' in table:
+        room = parser.vector('hearing.room', table['room'], 5)
+        if room[2] <= room[0] or room[3] <= room[1] or room[4] <= 0:
+            parser.fail('hearing.room', 'must be [x0, y0, x1, y1, height] with x1 > x0, '
+                                        'y1 > y0, height > 0')
+    return Hearing(absorption=absorption, room=room, **flags)
