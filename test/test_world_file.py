@@ -214,6 +214,17 @@ def robots(count, name=lambda i: f'miro{i:02d}'):
     ('[[wall]]\nfrom = [0, 0]\ncount = 2\n', "wall[0]: missing 'to'"),
     ('[[table]]\nheight = 0.02\n', "table[0].height: must be more than the top's thickness"),
     ('a = ' + '[' * 5000 + ']' * 5000 + '\n', 'nested too deeply'),
+    ('[[sound]]\nposition = [0, 0, 0]\n', "sound[0]: needs exactly one of 'file'"),
+    ('[[sound]]\ntone = 440\nnoise = true\n', "sound[0]: needs exactly one of 'file'"),
+    ('[[sound]]\nfile = "nowhere.wav"\n', "sound[0].file: cannot read 'nowhere.wav' as sound"),
+    ('[[sound]]\nfile = "broken.toml"\n', "sound[0].file: cannot read 'broken.toml' as sound"),
+    ('[[sound]]\ntone = 20000\n', 'sound[0].tone: must be 20..9000 Hz'),
+    ('[[sound]]\nnoise = true\nlevel = 10\n', 'sound[0].level: must be -120..0 dB'),
+    ('[[sound]]\nnoise = true\nstart = 2\nstop = 1\n', 'sound[0].stop: must be after start'),
+    ('[[sound]]\ntone = 300\nloop = true\n', 'sound[0].loop: only a file loops'),
+    ('[[sound]]\nnoise = true\nvolume = 3\n', "sound[0]: unknown key 'volume'"),
+    ('[hearing]\nroom = [0, 0, -1, 1, 1]\n', 'hearing.room: must be [x0, y0, x1, y1, height]'),
+    ('[hearing]\nechoes = true\n', "hearing: unknown key 'echoes'"),
 ])
 def test_mistakes_name_the_file_and_the_key(tmp_path, text, expected):
     path = write(tmp_path, text, 'broken.toml')
@@ -245,3 +256,19 @@ def test_unknown_empty_and_missing_names():
         load_world('')
     with pytest.raises(WorldError, match='cannot read world file'):
         load_world('/no/such/world.toml')
+
+
+def test_a_world_plays_sound_files_tones_and_noise_from_where_it_says(tmp_path):
+    import numpy as np
+    import soundfile
+    soundfile.write(str(tmp_path / 'chirp.wav'), np.zeros(800), 8000)
+    world = load_world(write(tmp_path, '[[sound]]\nname = "radio"\nfile = "chirp.wav"\n'
+                                       'position = [1, 2, 0.5]\nloop = true\nlevel = -20\n'
+                                       '[[sound]]\ntone = 440\nstop = 3\n'
+                                       '[hearing]\nreflections = true\nroom = [-1, -1, 1, 1, 2]\n'))
+    radio, tone = world.sounds
+    assert (radio.name, radio.kind, radio.position, radio.loop, radio.level_db) == \
+        ('radio', 'file', (1.0, 2.0, 0.5), True, -20.0)
+    assert radio.file == str(tmp_path / 'chirp.wav')
+    assert (tone.name, tone.kind, tone.frequency, tone.stop) == ('sound1', 'tone', 440.0, 3.0)
+    assert world.hearing.reflections and world.hearing.room == (-1.0, -1.0, 1.0, 1.0, 2.0)

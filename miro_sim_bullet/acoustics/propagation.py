@@ -71,12 +71,20 @@ def render(history, low, rows, gains, n0, count, start, end):
     back = np.arange(count) - delay  # (M, S, count), relative to n0
     whole = np.floor(back)
     frac = back - whole
-    index = (whole.astype(np.int64) + n0) & _MASK
-    index += (np.asarray(rows, np.int64) * HISTORY)[None, :, None]
-    after = index + 1
-    after -= ((after & _MASK) == 0) * HISTORY  # wraps within the source's own row
-    full = history.take(index) * (1 - frac) + history.take(after) * frac
-    lows = low.take(index) * (1 - frac) + low.take(after) * frac
+    base = whole.astype(np.int64) + n0
+    offset = (np.asarray(rows, np.int64) * HISTORY)[None, :, None]
+
+    def tap(k):  # indices of sample whole + k, within each source's own row
+        return ((base + k) & _MASK) + offset
+
+    # The signal between samples by Catmull-Rom (4 taps: within 1.1 dB up to 5 kHz,
+    # where 2 would lose 3 dB), its low band (below 2 kHz) by a straight line.
+    f2, f3 = frac * frac, frac * frac * frac
+    full = (history.take(tap(-1)) * (-0.5 * f3 + f2 - 0.5 * frac)
+            + history.take(tap(0)) * (1.5 * f3 - 2.5 * f2 + 1)
+            + history.take(tap(1)) * (-1.5 * f3 + 2 * f2 + 0.5 * frac)
+            + history.take(tap(2)) * (0.5 * f3 - 0.5 * f2))
+    lows = low.take(tap(0)) * (1 - frac) + low.take(tap(1)) * frac
     low_gain = low0[..., None] + (low1 - low0)[..., None] * ramp
     high_gain = high0[..., None] + (high1 - high0)[..., None] * ramp
     return (low_gain * lows + high_gain * (full - lows)).sum(axis=1)

@@ -8,11 +8,15 @@ import math
 
 import numpy as np
 import soundfile
-from scipy.signal import resample_poly
+from scipy.signal import butter, resample_poly, sosfilt
 
 from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ
 
 FS = MIC_SAMPLE_RATE_HZ
+# A world's noise is hiss below 5 kHz (a fan, a radio between stations), scaled back to RMS
+# 1 after the filter.
+_HISS = butter(4, 5000.0, fs=FS, output='sos')
+_HISS_GAIN = math.sqrt(FS / 2 / 5000.0)
 
 
 def rms_scale(level_db):
@@ -27,6 +31,7 @@ class WorldSource:
         self.sound = sound
         self.position = np.array(sound.position, float)
         self._noise = Noise(seed)
+        self._hiss_state = None
         self._first = round(sound.start * FS)
         self._last = round(min(sound.stop, 1e9) * FS)  # one past it
         self._scale = rms_scale(sound.level_db)
@@ -45,10 +50,19 @@ class WorldSource:
             out[lo - n0:hi - n0] = math.sqrt(2) * np.sin(
                 2 * np.pi * self.sound.frequency / FS * played)
         elif kind == 'noise':
-            out[lo - n0:hi - n0] = self._noise(lo, hi - lo)
+            out[lo - n0:hi - n0] = self._hiss(lo, hi - lo)
         else:
             out[lo - n0:hi - n0] = self._samples.take(played, mode='wrap')
         return out * self._scale
+
+
+    def _hiss(self, n0, count):
+        """Noise below 5 kHz; the filter's state carries on from the last call (emit is
+        called for consecutive samples)."""
+        if self._hiss_state is None:
+            self._hiss_state = np.zeros((_HISS.shape[0], 2))
+        hiss, self._hiss_state = sosfilt(_HISS, self._noise(n0, count), zi=self._hiss_state)
+        return hiss * _HISS_GAIN
 
 
 def _read(path):

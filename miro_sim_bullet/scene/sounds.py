@@ -72,10 +72,12 @@ def _sound(parser, where, index, table):
         parser.fail(f'{where}.loop', f'must be true or false, got {loop!r}'[:120])
     extra = {}
     if kind == 'tone':
-        extra['frequency'] = parser.number(f'{where}.tone', table['tone'], positive=True)
-        if not TONE_RANGE_HZ[0] <= extra['frequency'] <= TONE_RANGE_HZ[1]:
-            parser.fail(f'{where}.tone', f'must be {TONE_RANGE_HZ[0]:g}..{TONE_RANGE_HZ[1]:g} '
-                                         f'Hz, got {extra["frequency"]:g}')
+        # Not parser.number: a tone's Hz go past the file's limit of 1000 on a number.
+        hz = table['tone']
+        lo, hi = TONE_RANGE_HZ
+        if isinstance(hz, bool) or not isinstance(hz, (int, float)) or not lo <= hz <= hi:
+            parser.fail(f'{where}.tone', f'must be {lo:g}..{hi:g} Hz, got {hz!r}'[:120])
+        extra['frequency'] = float(hz)
     elif kind == 'noise':
         if table['noise'] is not True:
             parser.fail(f'{where}.noise', 'must be true')
