@@ -314,6 +314,32 @@ def test_tone_and_stream_reach_the_robots_speaker(sim_node, probe, executor):
     assert speaker.tone is None and speaker.buffered == 0  # 25 ticks, then silence
 
 
+def test_the_microphones_hear_the_speaker_40_blocks_a_second_and_stream_reports_room(
+        sim_node, probe, executor):
+    mics = probe.watch(Int16MultiArray, T.mics)
+    room = probe.watch(UInt16MultiArray, T.stream_state)
+    tone = probe.publisher(UInt16MultiArray, T.tone)
+    interface = sim_node.robots[T.name]
+    assert spin_until(executor, lambda: interface.hears() and tone.get_subscription_count())
+    run(sim_node, executor, 0.5)
+    assert spin_until(executor, lambda: len(mics) >= 20)
+    quiet = len(mics)
+    tone.publish(UInt16MultiArray(data=[800, 255, 50]))
+    assert spin_until(executor, lambda: sim_node.sim.robot.speaker.tone is not None)
+    sim_node.sim.robot.stream(np.zeros(1000, np.int16))
+    run(sim_node, executor, 1.0)
+    assert spin_until(executor, lambda: len(mics) >= quiet + 40)
+    assert len(mics) == quiet + 40  # 40 blocks a simulated second, none lost
+    block = np.asarray(mics[-5].data).reshape(4, 500)  # channel by channel, as the MDK's
+    assert [d.size for d in mics[-5].layout.dim] == [4, 500]
+    # Its own speaker, 14 cm from its ears: loud in every microphone.
+    assert all(np.sqrt(np.mean(block.astype(float) ** 2, axis=1)) > 300)
+    assert np.sqrt(np.mean(np.asarray(mics[0].data, float) ** 2)) < 100
+    free, size = room[-1].data
+    assert size == 32000 and free == size  # the 1000 samples were played
+    assert any(m.data[0] < size for m in room)
+
+
 def test_a_stream_is_one_row_and_its_producer(make_sim, probe, executor, monkeypatch):
     """What adding a stream takes (docs/development.md): a row of the interface table with
     its rate, and a producer; the simulator publishes it at that rate of simulated time."""

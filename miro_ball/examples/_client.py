@@ -15,6 +15,7 @@ import time
 
 import rclpy
 from sensor_msgs.msg import CameraInfo, CompressedImage
+from std_msgs.msg import Int16MultiArray
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -31,8 +32,9 @@ from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_POSITIONS
+from miro_ball.miro.hearing import mic_window
 from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
-                                      robot_name, robot_namespace, robot_of_namespace,
+                                      MIC_QOS, robot_name, robot_namespace, robot_of_namespace,
                                       RobotTopics, SENSOR_QOS)
 from miro_ball.miro.rotations import yaw_of
 
@@ -151,6 +153,18 @@ class Client(Node):
                            lambda msg, eye=eye: on_image(eye, msg), EYE_QOS)
             self.subscribe(CameraInfo, self.topics.camera_info(eye),
                            lambda msg, eye=eye: self._on_camera_info(eye, msg), EYE_QOS)
+
+    def watch_mics(self, on_block):
+        """The microphones: on_block(samples) for every block of sensors/mics, (4, 500)
+        of full scale; a block of another length is dropped with a warning."""
+        def heard(msg):
+            try:
+                block = mic_window(msg.data)
+            except ValueError as err:
+                self.warn('mics', f'{self.topics.mics} ignored: {err}')
+                return
+            on_block(block)
+        self.subscribe(Int16MultiArray, self.topics.mics, heard, MIC_QOS)
 
     def _on_camera_info(self, eye, msg):
         try:
