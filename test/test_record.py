@@ -8,7 +8,9 @@ import signal
 import subprocess
 import sys
 
+import numpy as np
 import pytest
+import soundfile
 from mcap.reader import make_reader
 from geometry_msgs.msg import TwistStamped
 from rclpy.qos import DurabilityPolicy, QoSProfile
@@ -16,7 +18,7 @@ from rosgraph_msgs.msg import Clock
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import get_types_from_msg, get_typestore, Stores
 from ruamel.yaml import YAML
-from std_msgs.msg import String
+from std_msgs.msg import Int16MultiArray, String
 
 from miro_ball.common.isolation import isolated_env
 from miro_ball.recording.bag import SplitBag
@@ -53,7 +55,7 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
                       and interface.publisher('joint_states').get_subscription_count()
                       and paused_sim.tf.pub.get_subscription_count()
                       and interface.pub_eyes['caml'][0].get_subscription_count()
-                      and latched.get_subscription_count())
+                      and interface.hears() and latched.get_subscription_count())
     advance_ticks(paused_sim, executor)  # the first /clock starts the recording
     first_clock = round(paused_sim.sim.time * 1e9)
     start = paused_sim.sim.time
@@ -63,6 +65,10 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
     assert spin_until(executor, lambda: late.get_subscription_count() >= 2)  # sim, recorder
     late.publish(TwistStamped())  # unstamped: logged at the latest /clock
     assert spin_until(executor, lambda: recorder.progress.total[ROBOT.cmd_vel] == 1)
+    voice = Probe(ros_context, executor, 'voice').publisher(Int16MultiArray, ROBOT.stream)
+    assert spin_until(executor, lambda: voice.get_subscription_count() >= 2)
+    voice.publish(Int16MultiArray(data=list(range(-400, 400))))
+    assert spin_until(executor, lambda: recorder.progress.total[ROBOT.stream] == 1)
     bag.close()
     executor.remove_node(recorder)
     recorder.destroy_node()
@@ -131,6 +137,17 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
         recorded[ROBOT.odom][1][-1][1].pose.pose.position.x)
     joints = recorded[ROBOT.topic('joint_states')][1]
     assert [t for t, _ in joints if t > first_clock] == odom_ns
+    # The microphones, 40 blocks a simulated second, and the bag's sound as WAV files.
+    mics = [m for t, m in recorded[ROBOT.mics][1] if t > first_clock]
+    assert 39 <= len(mics) <= 41 and all(len(m.data) == 2000 for m in mics)
+    from miro_ball.recording.node import main
+    assert main(['record', '--wav', str(tmp_path / 'wav'), str(tmp_path / 'bag')]) == 0
+    heard, rate = soundfile.read(str(tmp_path / 'wav' / f'{ROBOT.name}_mics.wav'), dtype='int16')
+    blocks = [np.asarray(m.data, np.int16).reshape(4, 500) for _, m in recorded[ROBOT.mics][1]]
+    assert rate == 20000 and np.array_equal(heard, np.concatenate(blocks, axis=1).T)
+    said, rate = soundfile.read(str(tmp_path / 'wav' / f'{ROBOT.name}_stream.wav'),
+                                dtype='int16')
+    assert rate == 8000 and said.tolist() == list(range(-400, 400))
 
 
 def test_a_full_disk_ends_the_recording_and_keeps_the_finished_files(
@@ -264,6 +281,13 @@ def test_bad_arguments_are_one_line_errors(tmp_path):
         out = subprocess.run([sys.executable, '-m', 'miro_ball.record', *args],
                              capture_output=True, text=True, timeout=60)
         assert out.returncode == 2 and 'error:' in out.stderr and 'Traceback' not in out.stderr
+    for args, code in ((['--wav', str(tmp_path / 'w')], 2),
+                       (['--wav', str(tmp_path / 'w'), str(tmp_path / 'no bag')], 1),
+                       (['--wav', str(tmp_path / 'w'), str(tmp_path / 'taken')], 1)):
+        out = subprocess.run([sys.executable, '-m', 'miro_ball.record', *args],
+                             capture_output=True, text=True, timeout=60)
+        assert out.returncode == code and out.stderr.count('\n') <= 3, out.stderr
+        assert 'error:' in out.stderr and 'Traceback' not in out.stderr
     help_text = subprocess.run([sys.executable, '-m', 'miro_ball.record', '--help'],
                                capture_output=True, text=True, timeout=60).stdout
     assert '-o DIR' in help_text and 'robot name' in help_text

@@ -1,6 +1,7 @@
 """miro_record: record ROS topics into a rosbag2 directory (MCAP, ROS 2 Jazzy types).
 
     python -m miro_ball.record -o DIR [TOPIC|ROBOT ...]
+    python -m miro_ball.record --wav DIR BAG    (a bag's sound as WAV files)
 
 What `ros2 bag record` does, for a pip install without ROS tools. Every topic
 is subscribed raw: the CDR bytes that arrive are the bytes a rosbag2 stores, so
@@ -32,6 +33,7 @@ from miro_ball.common.cli import user_args
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.recording.bag import BagError, SplitBag, TYPESTORE, describe, offered_qos
+from miro_ball.recording.wav import export_wav, WavError
 from miro_ball.recording.selection import Progress, Selection, cdr_stamp_ns, has_stamp, \
     import_name, log_time_ns
 from miro_ball.miro.interface import CLOCK, DEFAULT_ROBOT_NAME, RobotTopics
@@ -173,8 +175,11 @@ def parse_args(argv):
                'nothing is recorded before the first /clock. Ctrl+C finishes the bag; a hard '
                'stop or a\nfull disk loses at most the last --split-seconds, and leaves no '
                'unfinished file in sight.')
-    parser.add_argument('-o', '--output', required=True, metavar='DIR',
+    parser.add_argument('-o', '--output', metavar='DIR',
                         help='the bag directory to create (must not exist, or be empty)')
+    parser.add_argument('--wav', metavar='DIR',
+                        help="instead of recording: write the bag (the one TOPIC given) as WAV "
+                             "files into DIR, each robot's microphones and its control/stream")
     parser.add_argument('targets', nargs='*', metavar='TOPIC',
                         help='topics, patterns or robot names (default: every topic)')
     parser.add_argument('-x', '--exclude', action='append', default=[], metavar='PATTERN',
@@ -184,6 +189,12 @@ def parse_args(argv):
     parser.add_argument('--split-seconds', type=float, default=10.0,
                         help='finish a file and start the next this often, wall time (10)')
     args = parser.parse_args(argv)
+    if args.wav is not None:
+        if args.output is not None or len(args.targets) != 1:
+            parser.error('--wav DIR takes one bag and no -o: --wav DIR BAG')
+        return args, None, parser
+    if args.output is None:
+        parser.error('the following arguments are required: -o/--output')
     if not 0.1 <= args.split_seconds <= 86400:
         parser.error('--split-seconds must be within 0.1 and 86400')
     try:
@@ -196,6 +207,14 @@ def parse_args(argv):
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
     args, selection, parser = parse_args(user_args(argv, NODE_NAME))
+    if args.wav is not None:
+        try:
+            for path, seconds, skipped in export_wav(args.targets[0], args.wav):
+                print(f'{path}: {seconds:.2f} s' + (f' ({skipped} bad blocks skipped)'
+                                                    if skipped else ''), flush=True)
+        except WavError as err:
+            parser.exit(1, f'{parser.prog}: error: {err}\n')
+        return 0
     try:
         bag = SplitBag(args.output, split_s=args.split_seconds)
     except BagError as err:
