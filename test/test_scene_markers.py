@@ -75,9 +75,9 @@ def test_the_layout_is_sent_again_when_the_leds_change():
     world = SimWorld('empty')
     markers = SceneMarkers(world)
     markers.layout()
-    assert not markers.colours_changed()
+    assert not markers.layout_changed()
     world.robot.set_illum([0xFFFF0000] * 6)
-    assert markers.colours_changed()
+    assert markers.layout_changed()
     red = [m for m in markers.layout().markers if m.text.startswith('led_')]
     assert len(red) == 6 and all((m.color.r, m.color.g) == (1.0, 0.0) for m in red)
     world.close()

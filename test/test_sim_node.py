@@ -340,6 +340,31 @@ def test_the_microphones_hear_the_speaker_40_blocks_a_second_and_stream_reports_
     assert any(m.data[0] < size for m in room)
 
 
+def test_sounds_are_played_and_stopped_through_the_simulator_and_shown_in_the_scene(
+        sim_node, probe, executor):
+    from std_msgs.msg import String
+    from visualization_msgs.msg import MarkerArray
+    scene = probe.watch(MarkerArray, SIM.scene)
+    play = probe.publisher(String, SIM.sound)
+    stop = probe.publisher(String, SIM.sound_off)
+    assert spin_until(executor, lambda: play.get_subscription_count()
+                      and stop.get_subscription_count())
+    play.publish(String(data='[[sound]]\nname = "radio"\nposition = [1, 2, 0.3]\n'
+                             'tone = 440\nlevel = -20\n'))
+    play.publish(String(data='[[sound]]\nnoise = "loud"\n'))  # refused, in one warning
+    acoustics = sim_node.sim.acoustics
+    assert spin_until(executor, lambda: 'radio' in acoustics.sounds)
+    run(sim_node, executor, 0.6)
+
+    def sounds_shown():
+        return [(m.text, m.pose.position.x, m.pose.position.y) for msg in scene for m in
+                msg.markers if m.ns == 'sound']
+    assert spin_until(executor, lambda: ('radio', 1.0, 2.0) in sounds_shown())
+    assert list(acoustics.sounds) == ['radio']
+    stop.publish(String(data='radio'))
+    assert spin_until(executor, lambda: not acoustics.sounds)
+
+
 def test_a_stream_is_one_row_and_its_producer(make_sim, probe, executor, monkeypatch):
     """What adding a stream takes (docs/development.md): a row of the interface table with
     its rate, and a producer; the simulator publishes it at that rate of simulated time."""

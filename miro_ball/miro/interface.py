@@ -296,6 +296,17 @@ class SimTopics:
         return self.topic('touches')
 
     @property
+    def sound(self):
+        """std_msgs/String: [[sound]] tables of a world file (TOML) to play now; one of the
+        same name is replaced."""
+        return self.topic('sound')
+
+    @property
+    def sound_off(self):
+        """std_msgs/String: the name of a sound to stop."""
+        return self.topic('sound_off')
+
+    @property
     def set_pose(self):
         """geometry_msgs/PoseStamped in: move the object or robot named in header.frame_id."""
         return self.topic('set_pose')

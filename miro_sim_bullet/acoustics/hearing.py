@@ -81,13 +81,14 @@ class Acoustics:
         return row
 
     def add_sound(self, sound):
-        """A world sound (scene.sounds.Sound) starts to play; its name replaces one of the
-        same name. ValueError when MAX_SOUNDS already play."""
+        """A world sound (scene.sounds.Sound) starts to play, its start and stop counted
+        from now; its name replaces one of the same name. ValueError when MAX_SOUNDS
+        already play."""
         self.remove_sound(sound.name)
         if len(self.sounds) >= MAX_SOUNDS:
             raise ValueError(f'at most {MAX_SOUNDS} sounds play at once')
         self.sounds[sound.name] = (self._take_row('sound', sound.name),
-                                   WorldSource(sound, (self.seed, 0, len(self.sounds))))
+                                   WorldSource(sound, (self.seed, 0, len(self.sounds)), self.sent))
 
     def remove_sound(self, name):
         """Silence a world sound at once (what it sent is still on its way: not heard)."""

@@ -25,15 +25,16 @@ def rms_scale(level_db):
 
 
 class WorldSource:
-    """A [[sound]] of the world file (scene.sounds.Sound), playing at its position."""
+    """A [[sound]] of the world file (scene.sounds.Sound), playing at its position; its
+    start and stop count from sample ``since`` (a sound added while the world runs)."""
 
-    def __init__(self, sound, seed):
+    def __init__(self, sound, seed, since=0):
         self.sound = sound
         self.position = np.array(sound.position, float)
         self._noise = Noise(seed)
         self._hiss_state = None
-        self._first = round(sound.start * FS)
-        self._last = round(min(sound.stop, 1e9) * FS)  # one past it
+        self._first = since + round(sound.start * FS)
+        self._last = since + round(min(sound.stop, 1e9) * FS)  # one past it
         self._scale = rms_scale(sound.level_db)
         self._samples = _read(sound.file) if sound.kind == 'file' else None
         if self._samples is not None and not sound.loop:

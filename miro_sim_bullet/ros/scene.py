@@ -4,11 +4,12 @@ Two kinds of message go out on the one topic, each from a publisher of its own t
 its newest message for late subscribers (transient local), so a viewer that joins at any
 time gets both:
 
-- the layout: every static shape and picture in frame ``world``, and every robot's LEDs
-  in their link frames (``<robot>/led_lf``, ..., frame-locked: /tf moves them) in the
+- the layout: every static shape and picture in frame ``world``, every sound playing
+  (namespace ``sound``, an orange sphere named in ``text``), and every robot's LEDs in
+  their link frames (``<robot>/led_lf``, ..., frame-locked: /tf moves them) in the
   colours control/illum gives them. The robots themselves are drawn from their
-  robot_description (the URDF). Sent at the start, after a reset and when a robot's LEDs
-  change;
+  robot_description (the URDF). Sent at the start, after a reset, when a robot's LEDs
+  change and when a sound starts or stops;
 - the movers: every movable object (the ball, named boxes) in frame ``world``, sent at up
   to SCENE_RATE_HZ of simulated time, only when one of them has moved.
 
@@ -45,6 +46,8 @@ _TYPES = {'box': Marker.CUBE, 'sphere': Marker.SPHERE, 'cylinder': Marker.CYLIND
 # top-left); texture coordinates with v up, as OpenGL and three.js take them.
 _PICTURE_CORNERS = (0, 1, 2, 0, 2, 3)
 _PICTURE_UV = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
+SOUND_MARKER_M = 0.08  # across
+SOUND_COLOUR = ColorRGBA(r=1.0, g=0.55, b=0.1, a=1.0)
 
 
 def _shape_marker(mesh, scale, colour, frame, ns, marker_id):
@@ -69,6 +72,18 @@ def _place(marker, rotation, position):
     p, o = marker.pose.position, marker.pose.orientation
     p.x, p.y, p.z = (float(v) for v in position)
     o.x, o.y, o.z, o.w = (float(v) for v in matrix_quaternions(rotation)[0])
+    return marker
+
+
+def sound_marker(name, position, marker_id):
+    """A sound playing at ``position``: a small orange ball, its name in ``text``."""
+    marker = Marker(ns='sound', id=marker_id, type=Marker.SPHERE, action=Marker.ADD,
+                    text=name, color=SOUND_COLOUR)
+    marker.header.frame_id = WORLD_FRAME
+    marker.scale.x = marker.scale.y = marker.scale.z = SOUND_MARKER_M
+    marker.pose.orientation.w = 1.0
+    p = marker.pose.position
+    p.x, p.y, p.z = (float(v) for v in position)
     return marker
 
 
@@ -100,7 +115,7 @@ class SceneMarkers:
         self.robot_bodies = {robot.body_id: name for name, robot in world.robots.items()}
         self.movers = {body: ns for body, (ns, kind) in self.labels.items() if kind == 'mover'}
         self._sent = {}  # mover body -> its base's (position, quaternion) last sent
-        self._colours = None
+        self._shown = None
 
     # -- the layout ---------------------------------------------------------------------------
     def layout(self):
@@ -120,8 +135,15 @@ class SceneMarkers:
                 markers += self._robot_markers(ns, visuals)
         for index, picture in enumerate(getattr(self.world.description, 'pictures', ())):
             markers.append(picture_marker(picture, index))
-        self._colours = self.robot_colours()
+        for index, (name, position) in enumerate(self.sounds()):
+            markers.append(sound_marker(name, position, index))
+        self._shown = self.layout_state()
         return MarkerArray(markers=markers)
+
+    def sounds(self):
+        """[(name, position)] of the world's sounds playing now."""
+        return [(name, tuple(source.position)) for name, (_, source)
+                in self.world.acoustics.sounds.items()]
 
     def _robot_markers(self, robot, visuals):
         """A robot's LEDs in their link frames, frame-locked: /tf moves them. A shade larger
@@ -136,12 +158,13 @@ class SceneMarkers:
             markers.append(_place(marker, visuals.rot[k], visuals.offset[k]))
         return markers
 
-    def robot_colours(self):
-        """What sets the robots' colours now: their LEDs."""
-        return tuple(tuple(robot.illum) for robot in self.world.robots.values())
+    def layout_state(self):
+        """What changes the layout while the world runs: the robots' LEDs, the sounds."""
+        return (tuple(tuple(robot.illum) for robot in self.world.robots.values()),
+                tuple(self.sounds()))
 
-    def colours_changed(self):
-        return self.robot_colours() != self._colours
+    def layout_changed(self):
+        return self.layout_state() != self._shown
 
     # -- the movers ---------------------------------------------------------------------------
     def movers_if_moved(self):

@@ -1,7 +1,7 @@
 """The scene on ROS: /miro_sim/scene (markers; the robots move on /tf, see tf.py).
 
 The node calls publish() at SCENE_RATE_HZ of simulated time. What goes out (scene.py,
-the layout whenever it changed (the start, a reset, a robot's LEDs) and the movable
+the layout whenever it changed (the start, a reset, a robot's LEDs, a sound) and the movable
 objects when one moved. With nobody listening it costs a look at the movers' poses, 30
 times a simulated second.
 """
@@ -39,7 +39,7 @@ class SceneInterface:
         if self.generation != self.world.generation:
             self._rebuild()
         elif self.world.time - self.layout_sent >= LAYOUT_MIN_PERIOD_S \
-                and self.markers.colours_changed():
+                and self.markers.layout_changed():
             self.pub_layout.publish(self.markers.layout())
             self.layout_sent = self.world.time
         movers = self.markers.movers_if_moved()

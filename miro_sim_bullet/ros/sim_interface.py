@@ -1,13 +1,14 @@
 """The simulator's own ROS interface under /miro_sim/ (SimTopics), beside each robot's.
 
 Ground truth of every movable object and robot in the 'world' frame, the overhead
-view, set_pose, and the reset, pause and step services. What these do to time (a
+view, set_pose, the sounds played and stopped, and the reset, pause and step services. What these do to time (a
 reset starts the schedule over, a step advances it) belongs to the node that paces
 the world, so the services call the functions it hands in.
 """
 from geometry_msgs.msg import PointStamped, PoseStamped
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CompressedImage
+from std_msgs.msg import String
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.interface import SimTopics
@@ -15,6 +16,7 @@ from miro_sim_bullet.render.overhead import overhead_camera
 from miro_sim_bullet.render.eye_images import jpeg_bytes
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.endpoints import send_if_listened
+from miro_sim_bullet.scene.world_file import load_sounds, WorldError
 
 # ROS's default keeps 10 requests: a burst of 200 clients lost 190 answers.
 SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
@@ -42,6 +44,8 @@ class SimInterface:
                             for name in (*world.objects, *world.robots)}
         self.pub_overhead = ros.publisher(CompressedImage, t.overhead, 2)
         self.sub_set_pose = ros.subscription(PoseStamped, t.set_pose, self._on_set_pose, 10)
+        self.sub_sound = ros.subscription(String, t.sound, self._on_sound, 10)
+        self.sub_sound_off = ros.subscription(String, t.sound_off, self._on_sound_off, 10)
         self.srvs = [
             ros.service(Trigger, t.reset, self._on_reset, qos_profile=SERVICE_QOS),
             ros.service(SetBool, t.pause, self._on_pause, qos_profile=SERVICE_QOS),
@@ -59,6 +63,19 @@ class SimInterface:
             self._warn('set_pose_name', f'set_pose ignored: no object or robot named '
                        f'{msg.header.frame_id!r} (header.frame_id); there are '
                        f'{", ".join(self.pub_objects)}')
+
+    def _on_sound(self, msg):
+        try:
+            for sound in load_sounds(msg.data, SimTopics().sound):
+                self.world.acoustics.add_sound(sound)
+        except (WorldError, ValueError) as err:
+            self._warn('sound', f'sound ignored: {err}')
+
+    def _on_sound_off(self, msg):
+        if msg.data not in self.world.acoustics.sounds:
+            self._warn('sound_off', f'sound_off ignored: no sound {msg.data[:64]!r} plays; '
+                       f'there are {", ".join(self.world.acoustics.sounds) or "none"}')
+        self.world.acoustics.remove_sound(msg.data)
 
     def _on_reset(self, request, response):
         self._reset()

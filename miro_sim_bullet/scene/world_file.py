@@ -180,6 +180,22 @@ def load_world(name_or_path):
     return _Parser(source, folder).world(data, Path(source).stem)
 
 
+def load_sounds(text, source):
+    """The [[sound]] tables of a TOML text (what /miro_sim/sound carries) as Sounds; a
+    WorldError in one line as for a world file (``source`` names it)."""
+    if len(text) > MAX_FILE_BYTES:
+        raise WorldError(f'{source}: larger than {MAX_FILE_BYTES} bytes')
+    try:
+        data = tomllib.loads(text)
+    except ValueError as err:
+        raise WorldError(f'{source}: not valid TOML: {err}') from None
+    except RecursionError:
+        raise WorldError(f'{source}: nested too deeply') from None
+    parser = _Parser(source)
+    parser.keys('top level', data, {'sound'})
+    return parse_sounds(parser, data.get('sound', []))
+
+
 def bundled_pictures():
     """File names of the pictures installed with the package (worlds/pictures/)."""
     return sorted(p.name for p in (_bundled() / 'pictures').iterdir()
