@@ -479,9 +479,38 @@ def test_speed_menu_sets_the_simulators_real_time_factor_and_tones_are_heard(rig
     assert rig.until(lambda: rig.sim.get_parameter('real_time_factor').value == 2.0)
     rig.sim.set_parameters([Parameter('real_time_factor', value=1.0)])
     page.locator('#sound').click()  # a click: browsers let a page make sound after one
+    page.locator('#listen').check()
     page.locator('#tone_play').click()
     assert rig.until(lambda: page.evaluate(
         'miroGui.tones.some((t) => t.played && t.hz === 440 && t.ticks === 50)')), \
         'the tone MiRo was asked to play was not played in the page'
+    # Played through the simulation: MiRo's own microphones hear it, the page shows their
+    # levels and the tone's band in the spectrum, and plays what the left ear hears.
+    assert rig.until(lambda: min(page.evaluate('miroGui.mics ? miroGui.mics.levels : [-100]'))
+                     > -40), 'the tone was not heard by the microphones shown in the page'
+    spectrum = page.evaluate('miroGui.mics.spectrum')
+    top = page.evaluate('miroGui.mics.top_hz')
+    assert abs((spectrum.index(max(spectrum)) + 0.5) * top / len(spectrum) - 440) < top / 64
+    assert rig.until(lambda: page.evaluate(
+        "miroGui.audio.some((a) => a.played && a.source === 'mic' && a.rate === 20000)"))
+    page.close()
+    assert not rig.errors
+
+
+def test_a_click_in_the_world_view_places_a_sound_and_a_click_on_it_stops_it(rig):
+    page = world_page(rig)
+    page.select_option('#world_mode', 'sound')
+    acoustics = rig.sim.sim.acoustics
+    x, y = screen(page, (0.5, 0.5, 0.0))
+    page.mouse.click(x, y)
+    assert rig.until(lambda: acoustics.sounds), 'no sound placed in the simulator'
+    (name, (_, source)), = acoustics.sounds.items()
+    assert math.dist(source.position[:2], (0.5, 0.5)) < 0.05
+    assert rig.until(lambda: page.evaluate(
+        "[...miroGui.world.markers.values()].some(({ data }) => data.ns === 'sound')"))
+    redrawn(rig, page)
+    x, y = screen(page, tuple(source.position))
+    page.mouse.click(x, y)
+    assert rig.until(lambda: not acoustics.sounds), f'{name} still plays'
     page.close()
     assert not rig.errors

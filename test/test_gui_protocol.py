@@ -77,6 +77,9 @@ def test_the_world_views_messages():
         (p.Touch('head', 0.25, 1.0), ['v'])
     assert parse({'t': 'rtf', 'value': 0})[0] == p.SetRtf(0.0)
     assert parse({'t': 'rtf', 'value': 5000})[0] == p.SetRtf(p.MAX_RTF)
+    assert parse({'t': 'hear', 'mic': 3, 'listen': True})[0] == p.Hear(3, True)
+    assert parse({'t': 'sound', 'x': 1, 'y': 2, 'kind': 'tone'})[0] == p.PlaceSound(1.0, 2.0, 'tone')
+    assert parse({'t': 'unsound', 'name': 'gui_sound1'})[0] == p.StopSound('gui_sound1')
 
 
 @pytest.mark.parametrize('text', [
@@ -114,6 +117,10 @@ def test_the_world_views_messages():
     '{"t": "touch", "part": "tail", "u": 0, "v": 0}',
     '{"t": "touch", "part": ["head"], "u": 0, "v": 0}',
     '{"t": "rtf", "value": NaN}',
+    '{"t": "hear", "mic": 4, "listen": true}', '{"t": "hear", "mic": 0, "listen": 1}',
+    '{"t": "hear", "mic": 0.5, "listen": false}',
+    '{"t": "sound", "x": 0, "y": 0, "kind": "bang"}', '{"t": "sound", "x": 0, "y": NaN, "kind": "tone"}',
+    '{"t": "unsound", "name": "\\n[[sound]]"}',
 ])
 def test_malformed_messages_are_rejected_with_a_one_line_reason(text):
     with pytest.raises(p.Rejected) as err:
@@ -378,3 +385,26 @@ def test_a_page_that_shows_the_world_gets_it_whole_then_what_moved_and_its_pictu
     assert png[:2] == (200, 'image/png') and png[2].startswith(b'\x89PNG')
     assert missing == [404, 404, 404]
     assert tone == {'t': 'tone', 'hz': 440, 'volume': 100, 'ticks': 5}
+
+
+def test_the_pages_hearing_levels_spectrum_and_sound():
+    import base64
+
+    import numpy as np
+
+    from miro_ball.gui.hearing import BANDS, MAX_AUDIO_SAMPLES, MicMeter, speaker_message
+
+    meter = MicMeter()
+    meter.mic, meter.listen = 1, True
+    t = np.arange(2000) / 20000
+    tone = (np.sin(2 * np.pi * 2500 * t) * 3276.8).astype(np.int16)  # RMS -23 dB
+    blocks = [np.stack([np.zeros(500), tone[k:k + 500], np.zeros(500), np.zeros(500)])
+              .astype(np.int16) for k in range(0, 2000, 500)]
+    assert [meter.add(b) for b in blocks[:3]] == [[], [], []]
+    shown, heard = (json.loads(text) for text in meter.add(blocks[3]))
+    assert shown['levels'][1] == pytest.approx(-23.0, abs=0.2) and shown['levels'][0] == -100
+    peak = int(np.argmax(shown['spectrum']))
+    assert len(shown['spectrum']) == BANDS and peak == int(2500 / (10000 / BANDS))
+    assert np.array_equal(np.frombuffer(base64.b64decode(heard['data']), '<i2'), tone)
+    text, cut = speaker_message(np.ones(MAX_AUDIO_SAMPLES + 5, np.int16))
+    assert cut and len(base64.b64decode(json.loads(text)['data'])) == 2 * MAX_AUDIO_SAMPLES

@@ -344,6 +344,14 @@ class GuiBridge(Node):
         self.sim.place(command.name, command.x, command.y)
         return False
 
+    def _play_sound(self, page, command, owner):
+        self.sim.play_sound(command.kind, command.x, command.y)
+        return False
+
+    def _stop_sound(self, page, command, owner):
+        self.sim.stop_sound(command.name)
+        return False
+
     def _on_tick(self):
         """Once per platform tick: each robot part's drive, stop and touches go out."""
         now = time.monotonic()
@@ -396,6 +404,8 @@ _PAGE_COMMANDS = {
     p.SimAction: GuiBridge._sim_action,
     p.SetRtf: GuiBridge._set_rtf,
     p.Place: GuiBridge._place,
+    p.PlaceSound: GuiBridge._play_sound,
+    p.StopSound: GuiBridge._stop_sound,
 }
 
 # Commands for the robot the page watches (besides PUBLISHED, one message each):
@@ -404,6 +414,7 @@ _ROBOT_COMMANDS = {
     p.Drive: lambda watch, c, owner: watch.drive(c.linear, c.angular, owner),
     p.Stop: lambda watch, c, owner: watch.let_go(owner, 'stopped by the page'),
     p.Touch: lambda watch, c, owner: watch.touch(c.part, pads_at(c.u, c.v)),
+    p.Hear: lambda watch, c, owner: watch.hear(c.mic, c.listen),
 }
 
 

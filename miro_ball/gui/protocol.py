@@ -5,7 +5,7 @@ it into a command with every value checked and clamped to what MiRo accepts (the
 simulator's own clamps), or raises Rejected saying why in one line. Nothing here
 knows about ROS or the web server, so it is tested on its own.
 
-Server -> page: JSON text for the readouts, the scene and the tones, and images as
+Server -> page: JSON text for the readouts, the scene, the tones and the sound, and images as
 binary messages: a FRAME_HEADER (channel number, stamp in seconds) followed by the
 JPEG bytes as the robot sent them (the browser decodes them; the server never does).
 """
@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from miro_ball.miro.constants import (COSMETIC_CALIB, DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX,
                                       JOINT_LIMITS_RAD, LIFT, LIFT_RAD_CALIB, PITCH,
                                       PLATFORM_TICK_S, TILT_RAD, WHEEL_MAX_SPEED_M_PER_S, YAW)
+from miro_ball.miro.body import MICS
 from miro_ball.miro.interface import TOUCH_PARTS, check_name
 from miro_ball.miro.kinematics import (clamp_wheel_speeds, cmd_vel2wheel_speed,
                                        wheel_speed2cmd_vel)
@@ -38,6 +39,7 @@ SIM_ACTIONS = ('pause', 'resume', 'step', 'reset')
 MAX_RTF = 1000.0  # the simulator's own range of real_time_factor
 MAX_PLACE_M = 100.0  # farther than any world reaches: the simulator says if it is off its floor
 BATTERY_MARKS_V = (4.6, 4.8)  # the MDK GUI's battery bar: low, high
+SOUND_KINDS = ('noise', 'tone')  # what a click in the world view plays
 
 
 class Rejected(ValueError):
@@ -113,6 +115,24 @@ class Touch:
     part: str  # 'head' or 'body'
     u: float  # 0 front .. 1 back
     v: float  # 0 left .. 1 right
+
+
+@dataclass(frozen=True)
+class Hear:
+    mic: int  # the microphone whose spectrum the page shows (MIC_L, MIC_R, MIC_C, MIC_T)
+    listen: bool  # its samples to the page, to play
+
+
+@dataclass(frozen=True)
+class PlaceSound:
+    x: float  # m, world frame, on the floor
+    y: float
+    kind: str  # one of SOUND_KINDS
+
+
+@dataclass(frozen=True)
+class StopSound:
+    name: str  # of a sound playing
 
 
 @dataclass(frozen=True)
@@ -232,6 +252,32 @@ def _place(msg, clamped):
                  float(_number(msg, 'y', -MAX_PLACE_M, MAX_PLACE_M, clamped)))
 
 
+def _hear(msg, clamped):
+    listen = msg.get('listen')
+    if not isinstance(listen, bool):
+        raise Rejected('listen must be true or false')
+    out_of_range = []
+    mic = _integer(msg, 'mic', 0, len(MICS) - 1, out_of_range)
+    if out_of_range:
+        raise Rejected(f'mic must be 0..{len(MICS) - 1} ({", ".join(MICS)})')
+    return Hear(mic, listen)
+
+
+def _sound(msg, clamped):
+    kind = msg.get('kind')
+    if not isinstance(kind, str) or kind not in SOUND_KINDS:
+        raise Rejected(f'kind must be one of {", ".join(SOUND_KINDS)}')
+    return PlaceSound(float(_number(msg, 'x', -MAX_PLACE_M, MAX_PLACE_M, clamped)),
+                      float(_number(msg, 'y', -MAX_PLACE_M, MAX_PLACE_M, clamped)), kind)
+
+
+def _unsound(msg, clamped):
+    try:
+        return StopSound(check_name(msg.get('name'), 'sound name'))
+    except ValueError as err:
+        raise Rejected(str(err)) from None
+
+
 def _touch(msg, clamped):
     part = msg.get('part')
     if not isinstance(part, str) or part not in TOUCH_PARTS:
@@ -258,6 +304,9 @@ KINDS = {
     'view': (('channels', 'world'), _view),
     'place': (('name', 'x', 'y'), _place),
     'touch': (('part', 'u', 'v'), _touch),
+    'hear': (('mic', 'listen'), _hear),
+    'sound': (('x', 'y', 'kind'), _sound),
+    'unsound': (('name',), _unsound),
     'rtf': (('value',), lambda msg, clamped: SetRtf(
         float(_number(msg, 'value', 0.0, MAX_RTF, clamped)))),
 }
@@ -302,7 +351,8 @@ def page_config():
             'tone': {'hz': TONE_HZ, 'volume': TONE_VOLUME, 'ticks': TONE_TICKS},
             'tick_s': PLATFORM_TICK_S,
             'touch': {'rows': TOUCH_ROWS, 'columns': TOUCH_COLUMNS},
-            'battery_marks': list(BATTERY_MARKS_V)}
+            'battery_marks': list(BATTERY_MARKS_V), 'mics': MICS,
+            'sound_kinds': SOUND_KINDS}
 
 
 def frame_message(channel, stamp, jpeg):

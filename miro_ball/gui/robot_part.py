@@ -12,7 +12,7 @@ from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import BatteryState, CameraInfo, Imu, JointState, Range
-from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32, \
+from std_msgs.msg import Float32MultiArray, Int16MultiArray, UInt16, UInt16MultiArray, UInt32, \
     UInt32MultiArray
 
 from miro_ball.common.messages import drive_command, message_class
@@ -20,9 +20,12 @@ from miro_ball.common.qos import profile
 from miro_ball.controller.names import debug_topic
 from miro_ball.gui import protocol as p
 from miro_ball.gui import readouts as r
+from miro_ball.gui.hearing import MicMeter, speaker_message
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_NAMES
-from miro_ball.miro.interface import CONTROL_QOS, EYE_QOS, EYES, RobotTopics, SENSOR_QOS, TOPIC
+from miro_ball.miro.hearing import mic_window
+from miro_ball.miro.interface import CONTROL_QOS, EYE_QOS, EYES, MIC_QOS, RobotTopics, \
+    SENSOR_QOS, TOPIC
 from miro_ball.miro.rotations import yaw_of
 
 NODE_NAME = 'miro_gui'
@@ -127,6 +130,7 @@ class RobotPart(Node):
         self._control_pubs = {}
         self._sensor_subs = []
         self._image_subs = {}  # channel number: its subscriptions
+        self.meter = MicMeter()
 
     # -- what it reads ------------------------------------------------------------------------
     def watch_sensors(self, on):
@@ -147,9 +151,15 @@ class RobotPart(Node):
                 self.create_subscription(msg_type, _topic(self.topics, where),
                                          self._wrap(handler), profile(SENSOR_QOS))
                 for msg_type, where, handler in READOUTS]
-        # A tone anyone asks MiRo for (this GUI's pages too) is heard in the pages.
-        self._sensor_subs.append(self.create_subscription(
-            UInt16MultiArray, self.topics.tone, self._on_tone, profile(CONTROL_QOS)))
+        # A tone or a stream anyone asks MiRo for (this GUI's pages too) is heard in the
+        # pages; its microphones are shown.
+        self._sensor_subs += [
+            self.create_subscription(UInt16MultiArray, self.topics.tone, self._on_tone,
+                                     profile(CONTROL_QOS)),
+            self.create_subscription(Int16MultiArray, self.topics.stream, self._on_stream,
+                                     profile(CONTROL_QOS)),
+            self.create_subscription(Int16MultiArray, self.topics.mics, self._on_mics,
+                                     profile(MIC_QOS))]
 
     def show(self, channels):
         """Subscribe to exactly these image channels (numbers) of the robot."""
@@ -187,6 +197,26 @@ class RobotPart(Node):
                       'values not played (frequency, volume, ticks)')
             return
         self.tell_pages(self.robot, p.tone_message(values))
+
+    def _on_stream(self, msg):
+        text, cut = speaker_message(msg.data)
+        if cut:
+            self.warn(f'stream:{self.robot}', f'{self.robot}: a stream message of '
+                      f'{len(msg.data)} samples: the page plays its first second')
+        self.tell_pages(self.robot, text)
+
+    def _on_mics(self, msg):
+        try:
+            block = (mic_window(msg.data) * 32768).astype(int)
+        except ValueError as err:
+            self.warn(f'mics:{self.robot}', f'{self.robot}: microphones ignored: {err}')
+            return
+        for text in self.meter.add(block):
+            self.tell_pages(self.robot, text)
+
+    def hear(self, mic, listen):
+        """The microphone the pages show the spectrum of, and whether they hear it."""
+        self.meter.mic, self.meter.listen = mic, listen
 
     def _wrap(self, handler):
         def on_message(msg):

@@ -108,6 +108,8 @@ def marker_json(marker):
            'frame': _frame(marker.header.frame_id, 'frame_id'), 'kind': kind,
            'p': _xyz(pose.position), 'q': _quaternion(pose.orientation),
            'scale': _xyz(marker.scale, what='a scale'), 'colour': _rgba(marker.color)}
+    if marker.text:  # a sound's name: the page stops it by name
+        out['text'] = _name(marker.text, 'text')
     texture = None
     if kind in ('cube_list', 'picture'):
         if len(marker.points) > MAX_POINTS:

@@ -11,7 +11,7 @@ from geometry_msgs.msg import PoseStamped
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rosgraph_msgs.msg import Clock
-from std_msgs.msg import UInt16
+from std_msgs.msg import String, UInt16
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.common.clock_watch import clock_publishers, ClockWatch, shared_domain_line
@@ -20,6 +20,7 @@ from miro_ball.common.stamps import seconds
 from miro_ball.miro.interface import CLOCK, CONTROL_QOS, SimTopics
 
 RTF_PARAMETER = 'real_time_factor'
+GUI_SOUND_DB = -30.0  # a sound placed from the page: its RMS 1 m away, dB of full scale
 RTF_WINDOW_S = 2.0  # the real-time factor shown is measured over this much wall time
 
 
@@ -39,6 +40,7 @@ class SimLink:
         self._clock_samples = []  # (wall, sim) of the last RTF_WINDOW_S of /clock
         self._clock_watch = ClockWatch(node)
         self._pubs = {}
+        self._sounds = 0  # placed from the pages so far (their names' numbers)
         node.create_subscription(Clock, CLOCK, self._on_clock, 10)
         self.clients = {'reset': node.create_client(Trigger, self.topics.reset),
                         'step': node.create_client(Trigger, self.topics.step),
@@ -75,6 +77,18 @@ class SimLink:
         o = msg.pose.orientation
         o.x = o.y = o.z = o.w = 0.0
         self._publisher(PoseStamped, self.topics.set_pose).publish(msg)
+
+    def play_sound(self, kind, x, y):
+        """A sound of ``kind`` (protocol.SOUND_KINDS) on the floor at x, y, named by the
+        GUI ('gui_sound<N>'), as a world file's [[sound]] says it."""
+        self._sounds += 1
+        what = 'tone = 440' if kind == 'tone' else 'noise = true'
+        text = (f'[[sound]]\nname = "gui_sound{self._sounds}"\n'
+                f'position = [{x:.3f}, {y:.3f}, 0.1]\n{what}\nlevel = {GUI_SOUND_DB}\n')
+        self._publisher(String, self.topics.sound).publish(String(data=text))
+
+    def stop_sound(self, name):
+        self._publisher(String, self.topics.sound_off).publish(String(data=name))
 
     def touch(self, robot, part, pads):
         self._publisher(UInt16, self.topics.touch(robot, part)).publish(UInt16(data=pads))

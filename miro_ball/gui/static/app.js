@@ -18,7 +18,7 @@ const $ = (id) => document.getElementById(id);
 
 // What tests and the benchmark read: frames drawn per channel, and when.
 const gui = window.miroGui = { frames: {}, drawn: [], state: null, config: null, connected: false,
-                               world: null, tones: [] };
+                               world: null, tones: [], mics: null, audio: [] };
 
 let ws = null;
 let channels = [];
@@ -56,6 +56,8 @@ function onText(message) {
   else if (message.t === 'scene') { if (gui.world) gui.world.applyScene(message); }
   else if (message.t === 'tf') { if (gui.world) gui.world.applyTf(message); }
   else if (message.t === 'tone') playTone(message);
+  else if (message.t === 'mics') showMics(message);
+  else if (message.t === 'audio') playAudio(message);
 }
 
 // ---- what this page shows -------------------------------------------------------------------
@@ -96,6 +98,8 @@ async function startWorld() {
     const { WorldView } = await import('./world_view.js');
     gui.world = new WorldView($('world-view'), $('world-labels'), {
       place: (name, x, y) => send({ t: 'place', name, x: round3(x), y: round3(y) }),
+      sound: (x, y) => send({ t: 'sound', x: round3(x), y: round3(y), kind: $('sound_kind').value }),
+      unsound: (name) => send({ t: 'unsound', name }),
       touch: touchAt, untouch, hint });
   } catch (err) {
     $('world_note').textContent = `This browser cannot draw the world view (${err.message}): `
@@ -237,6 +241,64 @@ function playTone(message) {
   osc.connect(gain).connect(audio.destination);
   osc.start(start);
   osc.stop(start + seconds + 0.02);
+}
+
+// ---- hearing: the microphones' levels and spectrogram, what MiRo hears and says ----------
+const LEVEL_FLOOR_DB = -90;
+let audioAt = 0;  // when the next piece of sound starts playing (AudioContext time)
+
+function setUpHearing(config) {
+  $('mic').replaceChildren(...config.mics.map((name, i) => new Option(name, i)));
+  $('sound_kind').replaceChildren(...config.sound_kinds.map((kind) => new Option(kind, kind)));
+  $('miclevels').replaceChildren(...config.mics.map((name) => {
+    const row = document.createElement('div');
+    row.innerHTML = `<span>${name}</span><meter min="${LEVEL_FLOOR_DB}" max="0"></meter><output></output>`;
+    return row;
+  }));
+  const tell = () => send({ t: 'hear', mic: Number($('mic').value), listen: $('listen').checked });
+  $('mic').addEventListener('change', tell);
+  $('listen').addEventListener('change', tell);
+}
+
+function showMics(message) {
+  const { levels, spectrum } = message;
+  if (!Array.isArray(levels) || !Array.isArray(spectrum)) return;
+  gui.mics = message;
+  $('miclevels').querySelectorAll('div').forEach((row, i) => {
+    row.querySelector('meter').value = levels[i];
+    row.querySelector('output').textContent = `${fixed(levels[i], 0)} dB`;
+  });
+  // The spectrogram scrolls left a column a message; loud is bright.
+  const canvas = $('spectrogram');
+  const ctx = canvas.getContext('2d');
+  ctx.drawImage(canvas, -2, 0);
+  const h = canvas.height / spectrum.length;
+  spectrum.forEach((db, k) => {
+    const light = Math.round(100 * Math.min(Math.max((db - LEVEL_FLOOR_DB) / -LEVEL_FLOOR_DB, 0), 1));
+    ctx.fillStyle = `hsl(${240 - 2.4 * light}, 90%, ${light * 0.6}%)`;
+    ctx.fillRect(canvas.width - 2, canvas.height - (k + 1) * h, 2, Math.ceil(h));
+  });
+}
+
+// Sound from the server, int16 little-endian in base64, played back to back.
+function playAudio(message) {
+  const { rate, source, data } = message;
+  if (!Number.isFinite(rate) || rate < 3000 || rate > 48000 || typeof data !== 'string') return;
+  const bytes = Uint8Array.from(atob(data), (c) => c.charCodeAt(0));
+  const samples = new Int16Array(bytes.buffer, 0, bytes.length >> 1);
+  gui.audio.push({ source, rate, samples: samples.length, played: soundOn });
+  if (gui.audio.length > 100) gui.audio.shift();
+  if (!soundOn || !audio || !samples.length) return;
+  const buffer = audio.createBuffer(1, samples.length, rate);
+  const channel = buffer.getChannelData(0);
+  for (let i = 0; i < samples.length; i++) channel[i] = samples[i] / 32768;
+  const node = audio.createBufferSource();
+  node.buffer = buffer;
+  node.connect(audio.destination);
+  // Late pieces start now; a queue of more than half a second is dropped to catch up.
+  if (audioAt < audio.currentTime || audioAt > audio.currentTime + 0.5) audioAt = audio.currentTime + 0.05;
+  node.start(audioAt);
+  audioAt += buffer.duration;
 }
 
 // ---- images --------------------------------------------------------------------------------
@@ -544,6 +606,7 @@ function setUp(config) {
   channels = config.channels;
   if ($('headsliders').childElementCount) return;  // a reconnection: the controls are there
   batteryMarks(config.battery_marks);
+  setUpHearing(config);
   if (config.touch && config.touch.rows > 0 && config.touch.columns > 0) {
     touchGrid = { rows: config.touch.rows, columns: config.touch.columns };
     drawBodyMap();

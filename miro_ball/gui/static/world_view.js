@@ -13,7 +13,7 @@ const WORLD = 'world';
 // world frame is a named object, which the simulator's set_pose can move (a named static
 // one it refuses to move: the page shows it back where the simulator says on release).
 const STATIC_TABLES = new Set(['wall', 'ring', 'table', 'box', 'cylinder', 'sphere', 'ground',
-                               'picture']);
+                               'picture', 'sound']);
 const TOUCH_LINKS = new Set(['head', 'body']);
 const PLACE_PERIOD_MS = 40;  // 25 places a second while dragging (the server takes 30)
 const HOLD_PERIOD_MS = 100;  // a held drag keeps re-placing: a robot stays under the pointer
@@ -37,7 +37,7 @@ function finite(list, n) {
 
 export class WorldView {
   // canvas: the <canvas>; labels: a <div> over it; hooks: {place(name, x, y),
-  // touch(part, u, v), untouch(), hint(text)}.
+  // sound(x, y), unsound(name), touch(part, u, v), untouch(), hint(text)}.
   constructor(canvas, labels, hooks) {
     this.canvas = canvas;
     this.labelBox = labels;
@@ -511,6 +511,17 @@ export class WorldView {
   onDown(e) {
     if (e.button !== 0 || !e.isPrimary) return;
     const hit = this.pick(e);
+    if (this.mode === 'sound') {  // a click on a sound stops it, anywhere else places one
+      e.stopImmediatePropagation();
+      if (hit && hit.m.ns === 'sound' && hit.m.text) {
+        this.hooks.unsound(hit.m.text);
+        return;
+      }
+      const floor = new THREE.Plane(new THREE.Vector3(0, 0, 1), 0);
+      const at = this.rayFrom(e).intersectPlane(floor, new THREE.Vector3());
+      if (at) this.hooks.sound(at.x, at.y);
+      return;
+    }
     if (!hit) return;
     const robot = this.robotOf(hit.m);
     if (this.mode === 'stroke') {
