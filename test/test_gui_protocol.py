@@ -404,7 +404,7 @@ def test_the_pages_hearing_levels_spectrum_and_sound():
     shown, heard = (json.loads(text) for text in meter.add(blocks[3]))
     assert shown['levels'][1] == pytest.approx(-23.0, abs=0.2) and shown['levels'][0] == -100
     peak = int(np.argmax(shown['spectrum']))
-    assert len(shown['spectrum']) == BANDS and peak == int(2500 / (10000 / BANDS))
+    assert len(shown["spectrum"]) == BANDS and peak == int((2500 / 10 - 1) / (1000 / BANDS))
     assert np.array_equal(np.frombuffer(base64.b64decode(heard['data']), '<i2'), tone)
     text, cut = speaker_message(np.ones(MAX_AUDIO_SAMPLES + 5, np.int16))
     assert cut and len(base64.b64decode(json.loads(text)['data'])) == 2 * MAX_AUDIO_SAMPLES
