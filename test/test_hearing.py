@@ -3,6 +3,7 @@ each other's speakers and of a world's sounds, block by block, and where the dir
 library says a sound comes from."""
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -114,12 +115,16 @@ def test_noise_from_the_left_reaches_the_left_ear_first_and_louder_less_so_facin
         world.close()
 
 
-@pytest.mark.parametrize('distance', (1.0, 3.0))
-def test_the_direction_library_finds_a_sound_within_15_degrees(distance):
+TUNE = str(Path(__file__).parents[1] / 'worlds' / 'sounds' / 'radio_tune.ogg')
+
+
+@pytest.mark.parametrize('distance, kind', [(1.0, 'noise'), (3.0, 'noise'), (2.0, 'file')])
+def test_the_direction_library_finds_a_sound_within_15_degrees(distance, kind):
     angles = (0, 60, 90, 150, 180, -120, -90)  # in front, to the sides, behind
     for angle in angles:
         a = math.radians(angle)
-        sound = Sound('s', (distance * math.cos(a), distance * math.sin(a), 0.3), 'noise', -35.0)
+        sound = Sound('s', (distance * math.cos(a), distance * math.sin(a), 0.3), kind, -35.0,
+                      file=TUNE if kind == 'file' else '', loop=kind == 'file')
         world = SimWorld(dataclasses.replace(EMPTY, sounds=(sound,)))
         try:
             world.run(0.2)

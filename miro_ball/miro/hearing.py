@@ -2,15 +2,13 @@
 
 ``locate(window)`` takes a window of ``sensors/mics`` (channels x samples, one block or
 several joined) and gives the azimuth of the loudest sound in MiRo's head frame and its
-level. It measures how much later each microphone hears the sound than another (GCC-PHAT:
-the cross-correlation of the two signals' spectra with their magnitudes taken away, whose
-peak is the lag) and finds the direction in the head's horizontal plane whose lags fit
-best, from where the microphones are for the given joint angles: the two ears give
-left/right, the head and tail microphones front/back. A far sound is assumed (a plane
-wave). The four microphones lie in one plane (the ears' axis and the line from the tail to
-the head), so the lags leave one thing open, which side of that plane the sound is on:
-the direction nearer the horizontal is taken (sounds come from around MiRo, rarely from
-far above or below it).
+level. It cross-correlates every pair of microphones (GCC with the spectra partly
+whitened, PHAT_BETA: the lag of a broadband sound stands out as with GCC-PHAT, a tune's
+harmonics do not outweigh it) and then steers (SRP): for each direction around MiRo, a
+source AT_M away at the head's height, the lags each pair would hear, from where the
+microphones are at the given joint angles, and the sum of the correlations there. The
+direction with the largest sum wins: the ears give left and right, the head and tail
+microphones front and back.
 """
 import math
 from dataclasses import dataclass
@@ -23,9 +21,13 @@ from miro_ball.miro.constants import (KIN_CALIB_RAD, MIC_BLOCK_SAMPLES, MIC_C, M
                                       SPEED_OF_SOUND_M_S)
 from miro_ball.miro.kc import BODY, FOOT, HEAD, KinematicChain
 
-PAIRS = ((MIC_L, MIC_R), (MIC_C, MIC_T), (MIC_L, MIC_T), (MIC_R, MIC_T))
+PAIRS = ((MIC_L, MIC_R), (MIC_C, MIC_T), (MIC_L, MIC_T), (MIC_R, MIC_T), (MIC_L, MIC_C),
+         (MIC_R, MIC_C))
 QUIET_DB = -50.0  # below this nothing is located (the MDK's demo skips below ~-40 dB)
-UPSAMPLE = 16  # the correlation is read at 1/16 of a sample
+UPSAMPLE = 8  # the correlation is read at 1/8 of a sample
+PHAT_BETA = 0.5  # 1 is GCC-PHAT (all frequencies alike), 0 plain cross-correlation
+AT_M = 1.5  # the distance a source is taken to be at (the MDK's demo takes 1.5 m)
+DIRECTIONS = 360  # steered over, a degree apart
 
 
 @dataclass(frozen=True)
@@ -33,6 +35,7 @@ class Heard:
     azimuth: float  # rad in the head frame: 0 ahead, + to the left, +-pi behind
     level_db: float  # RMS of the loudest microphone, dB of full scale
     lags: tuple  # samples each pair of PAIRS hears it later at its second microphone
+    #              (each pair's own best lag)
 
 
 def mic_window(data, blocks=1):
@@ -61,16 +64,21 @@ def mic_positions(joints=KIN_CALIB_RAD, frame=HEAD):
                                             frame, LINK[mic].xyz) for mic in MICS], float)
 
 
-def gcc_phat_lag(first, second, max_lag):
-    """Samples by which ``second`` hears the sound after ``first`` (negative: before),
-    within +-max_lag, to 1/UPSAMPLE of a sample."""
-    n = len(first) + len(second)
-    cross = np.fft.rfft(second, n) * np.conj(np.fft.rfft(first, n))
-    cross /= np.maximum(np.abs(cross), 1e-12)
-    correlation = np.fft.irfft(cross, n * UPSAMPLE)
+def correlations(window, max_lag):
+    """{pair: (lags, correlation)} of every pair of PAIRS, within +-max_lag samples, at
+    1/UPSAMPLE of a sample: how well the second microphone's signal matches the first's
+    that many samples later."""
+    n = 2 * window.shape[1]
+    spectra = np.fft.rfft(window, n)
     reach = int(math.ceil(max_lag * UPSAMPLE))
-    around = np.concatenate([correlation[-reach:], correlation[:reach + 1]])
-    return (int(np.argmax(around)) - reach) / UPSAMPLE
+    lags = np.arange(-reach, reach + 1) / UPSAMPLE
+    out = {}
+    for a, b in PAIRS:
+        cross = spectra[b] * np.conj(spectra[a])
+        cross /= np.maximum(np.abs(cross), 1e-12) ** PHAT_BETA
+        full = np.fft.irfft(cross, n * UPSAMPLE)
+        out[a, b] = (lags, np.concatenate([full[-reach:], full[:reach + 1]]))
+    return out
 
 
 def locate(window, joints=KIN_CALIB_RAD, quiet_db=QUIET_DB):
@@ -80,21 +88,19 @@ def locate(window, joints=KIN_CALIB_RAD, quiet_db=QUIET_DB):
     level = max(level_db(channel) for channel in window)
     if level < quiet_db:
         return None
-    # Worked out on the level FOOT frame (z up), the direction then turned into the head's.
+    # Steered on the level FOOT frame (z up), the winner turned into the head's frame.
     positions = mic_positions(joints, FOOT)
-    spans = np.array([positions[a] - positions[b] for a, b in PAIRS])
-    max_lags = np.linalg.norm(spans, axis=1) / SPEED_OF_SOUND_M_S * MIC_SAMPLE_RATE_HZ
-    lags = np.array([gcc_phat_lag(window[a], window[b], reach + 1)
-                     for (a, b), reach in zip(PAIRS, max_lags)])
-    # A plane wave from direction u reaches microphone a (a - b) . u / c before b: the lags
-    # fix u within the microphones' plane; its unit length, how far out of it.
-    in_plane, *_ = np.linalg.lstsq(spans, lags / MIC_SAMPLE_RATE_HZ * SPEED_OF_SOUND_M_S,
-                                   rcond=None)
-    normal = np.linalg.svd(spans)[2][-1]
-    length = np.linalg.norm(in_plane)
-    if length > 1:
-        in_plane /= length
-    off = math.sqrt(max(0.0, 1 - min(length, 1.0) ** 2))
-    u = min((in_plane + off * normal, in_plane - off * normal), key=lambda v: abs(v[2]))
-    x, y, _ = KinematicChain(joints).change_frame_rel(FOOT, HEAD, u)
-    return Heard(math.atan2(y, x), level, tuple(float(lag) for lag in lags))
+    centre = positions[[MIC_L, MIC_R]].mean(axis=0)
+    angles = np.linspace(-math.pi, math.pi, DIRECTIONS, endpoint=False)
+    ways = np.stack([np.cos(angles), np.sin(angles), np.zeros(DIRECTIONS)], axis=1)
+    delays = np.linalg.norm(centre + AT_M * ways[:, None, :] - positions[None], axis=2) \
+        / SPEED_OF_SOUND_M_S * MIC_SAMPLE_RATE_HZ  # (directions, mics)
+    span = np.max(np.linalg.norm(positions[:, None] - positions[None], axis=2))
+    pairs = correlations(window, span / SPEED_OF_SOUND_M_S * MIC_SAMPLE_RATE_HZ + 1)
+    power = np.zeros(DIRECTIONS)
+    for (a, b), (lags, correlation) in pairs.items():
+        power += np.interp(delays[:, b] - delays[:, a], lags, correlation)
+    best = ways[int(np.argmax(power))]
+    x, y, _ = KinematicChain(joints).change_frame_rel(FOOT, HEAD, best)
+    measured = tuple(float(pairs[pair][0][np.argmax(pairs[pair][1])]) for pair in PAIRS)
+    return Heard(math.atan2(y, x), level, measured)

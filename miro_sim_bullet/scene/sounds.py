@@ -1,11 +1,13 @@
 """A world file's sounds: ``[[sound]]`` sources and the ``[hearing]`` options (docs/worlds.md).
 
-A sound plays from a point: a sound file (WAV, FLAC, OGG: what libsndfile reads), a tone
+A sound plays from a point: a sound file (WAV, FLAC, OGG: what libsndfile reads; a bare
+name is one of the bundled sounds in worlds/sounds/, else a file next to the world file), a tone
 or white noise, at a level (its RMS 1 m away, in dB of the microphones' full scale), from
 ``start`` seconds of simulated time until ``stop`` (or for ever), a file once or looped.
 A file that is missing, not audio, or too long is refused when the world loads, in one
 line, as every other mistake in a world file.
 """
+import importlib.resources
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -96,7 +98,10 @@ def _sound_file(parser, where, value):
     if not isinstance(value, str) or not value or '\0' in value:
         parser.fail(where, f'must be the name of a sound file, got {value!r}'[:120])
     path = Path(value)
-    if parser.folder is not None and not path.is_absolute():
+    bundled = importlib.resources.files('miro_sim_bullet.worlds') / 'sounds' / value
+    if path.name == value and bundled.is_file():
+        path = Path(str(bundled))
+    elif parser.folder is not None and not path.is_absolute():
         path = parser.folder / path
     try:
         info = soundfile.info(str(path))
