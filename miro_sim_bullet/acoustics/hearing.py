@@ -27,12 +27,20 @@ BLOCKS_KEPT = 40  # heard blocks waiting to be taken: 1 s (a reader that never t
 _QUIET_AFTER = HISTORY - 2 * MIC_BLOCK_SAMPLES  # a source silent this long is heard no more
 
 
+def _ring_slices(n0, count):
+    """The ring buffer's slices of samples n0 .. n0 + count - 1 (two where it wraps)."""
+    start = n0 & (HISTORY - 1)
+    if start + count <= HISTORY:
+        return (slice(start, start + count),)
+    return slice(start, HISTORY), slice(0, start + count - HISTORY)
+
+
 class _Row:
     """One source's place in the ring buffers: what it is and when it last sounded."""
 
     def __init__(self, kind, owner):
         self.kind, self.owner = kind, owner  # 'sound' | 'speaker' | 'wheels', name
-        self.loud_until = -1  # one past the last sample it sent that was not silence
+        self.loud_until = -HISTORY  # one past the last sample it sent that was not silence
         self.state = np.zeros(len(LOW_PASS[1]) - 1)
 
 
@@ -114,17 +122,22 @@ class Acoustics:
             speed = sum(abs(v) for v in self.robots[name].wheel_out) / 2
             chunks.append((row, None if speed == 0 else self._wheel_noise[name](n0, TICK)
                            * rms_scale(WHEEL_NOISE_DB) * speed / WHEEL_MAX_SPEED_M_PER_S))
-        at = np.arange(n0, n0 + TICK) & (HISTORY - 1)
+        at = _ring_slices(n0, TICK)
         for row, samples in chunks:
             info = self._rows[row]
             if samples is None:
-                if info.loud_until > n0 - _QUIET_AFTER:
-                    self.history[row, at] = 0.0
-                    self.low[row, at], info.state = low_band(np.zeros(TICK), info.state)
-                continue
-            self.history[row, at] = samples
-            self.low[row, at], info.state = low_band(samples, info.state)
-            info.loud_until = n0 + TICK
+                if info.loud_until <= n0 - _QUIET_AFTER:
+                    continue  # silent for long: its ring holds zeros already
+                samples = np.zeros(TICK)
+            else:
+                info.loud_until = n0 + TICK
+            low, info.state = low_band(samples, info.state)
+            done = 0
+            for part in at:
+                width = part.stop - part.start
+                self.history[row, part] = samples[done:done + width]
+                self.low[row, part] = low[done:done + width]
+                done += width
         self.sent = n0 + TICK
         while (self.next_block + 1) * MIC_BLOCK_SAMPLES <= self.sent:
             self._hear_block()
@@ -142,12 +155,13 @@ class Acoustics:
     def _hear_block(self):
         block = self.next_block
         self.next_block += 1
+        heard = [name for name in self.robots if self.listened(name)]
+        if not heard:  # nothing worked out; the next heard block starts from where it is
+            self._before = None
+            return
         now = self._geometry()
         before = self._before if self._before is not None else now
         self._before = now
-        heard = [name for name in self.robots if self.listened(name)]
-        if not heard:
-            return
         n0 = block * MIC_BLOCK_SAMPLES
         rows = [row for row, info in enumerate(self._rows)
                 if info is not None and info.loud_until > n0 - _QUIET_AFTER]

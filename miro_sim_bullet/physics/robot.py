@@ -82,7 +82,7 @@ class MiroRobot:
     def place(self, x, y, yaw, floor=None):
         """Move the robot to rest at (x, y, yaw), on its own floor unless given one."""
         self.model.place(x, y, yaw, floor=self.spec.floor if floor is None else floor)
-        self.sensors = self._read_sensors(self._read_cliff())
+        self._sense()
 
     # -- commands ---------------------------------------------------------------------------
     def set_cmd_vel(self, linear, angular):
@@ -157,7 +157,7 @@ class MiroRobot:
     # -- the 50 Hz platform tick ------------------------------------------------------------
     def tick(self):
         """What MiRo's platform does at 50 Hz: sense, then timeout, cliff reflex, motors."""
-        cliff = self._read_cliff()
+        cliff = self._sense_frames()
         left, right = self.wheel_cmd
         if self.clock() - self.last_cmd_time > CMD_TIMEOUT_S:
             left = right = 0.0
@@ -171,6 +171,15 @@ class MiroRobot:
             forces=[WHEEL_TORQUE_NM] * 2, **self._kw())
         self.sound = self.speaker.tick(self.clock())
         self.sensors = self._read_sensors(cliff)
+
+    def _sense_frames(self):
+        """The head's and the body's frames now (the tick's: for the sonar, the cliff
+        sensors and the microphones), and the cliff readings."""
+        self.frames = {'head': self.link_frame(rb.HEAD), 'body': self.link_frame(-1)}
+        return self._read_cliff()
+
+    def _sense(self):
+        self.sensors = self._read_sensors(self._sense_frames())
 
     # -- ground truth -----------------------------------------------------------------------
     def pose(self):
@@ -199,7 +208,7 @@ class MiroRobot:
         return pb.rayTestBatch(starts, ends, collisionFilterMask=self.ray_mask, **self._kw())
 
     def _read_cliff(self):
-        pos, rot = self.link_frame(-1)
+        pos, rot = self.frames['body']
         down = rb.CLIFF_PITCH_DOWN
         ray_dir = rot @ np.array([math.cos(down), 0.0, -math.sin(down)])
         x, y, z = rb.CLIFF_IN_BODY
@@ -209,7 +218,7 @@ class MiroRobot:
                      for h in hits)
 
     def _read_sonar(self):
-        pos, rot = self.link_frame(rb.HEAD)
+        pos, rot = self.frames['head']
         start = pos + rot @ np.array(SONAR_IN_HEAD)
         lo, hi = rb.SONAR_RANGE
         ends = start + hi * SONAR_DIRECTIONS @ rot.T

@@ -106,6 +106,8 @@ class SimNode(Node):
         ros = Endpoints.of(self)
         self.robots = {name: RobotInterface(name, ros, self._robot_lookup(name), self.warn)
                        for name in self.sim.robots}
+        # A robot's microphones are worked out only while someone subscribes to them.
+        self.sim.listened = lambda name: self.robots[name].hears()
         self.sim_interface = self.scene = None
         if privileged:
             self.sim_interface = SimInterface(ros, self.sim, self.cameras, reset=self.reset,

@@ -7,7 +7,10 @@ warning. The robot is looked up each time, so a world reset (which rebuilds
 every robot) needs nothing from here.
 """
 import array
+import functools
 import math
+
+import numpy as np
 
 from std_msgs.msg import Int16MultiArray, MultiArrayDimension, UInt16
 
@@ -22,7 +25,20 @@ from miro_ball.miro.touch import ALL_PADS
 from miro_sim_bullet.render.eye_images import EyeWants
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.endpoints import send_if_listened
+from miro_sim_bullet.ros.refill import prefix
 from miro_sim_bullet.ros.streams import PRODUCERS
+
+@functools.cache
+def _mics_prefix(channels, count):
+    """sensors/mics' bytes before its samples, its layout [channels, samples] (serialised
+    once: building the message took ~10 us a block, 40 blocks a second a robot)."""
+    zeros = np.zeros((channels, count), '<i2')
+    msg = Int16MultiArray(data=array.array('h', zeros.tobytes()))
+    msg.layout.dim = [MultiArrayDimension(label='channels', size=channels,
+                                          stride=channels * count),
+                      MultiArrayDimension(label='samples', size=count, stride=count)]
+    return prefix(msg, zeros.tobytes())
+
 
 # An eye's three rows, in the order of pub_eyes[eye].
 EYE_ROWS = ('eye_compressed', 'eye_raw', 'camera_info')
@@ -166,14 +182,7 @@ class RobotInterface:
 
     def publish_mics(self, samples):
         """One block of the microphones, int16 (channels, samples), channel by channel."""
-        data = array.array('h')
-        data.frombytes(samples.tobytes())
-        channels, count = samples.shape
-        msg = Int16MultiArray(data=data)
-        msg.layout.dim = [MultiArrayDimension(label='channels', size=channels,
-                                              stride=channels * count),
-                          MultiArrayDimension(label='samples', size=count, stride=count)]
-        self.pub_mics.publish(msg)
+        self.pub_mics.publish(_mics_prefix(*samples.shape) + samples.astype('<i2').tobytes())
 
     def wanted_eyes(self):
         """[(eye, side, EyeWants)] of the eyes someone subscribes to (images or only
