@@ -165,5 +165,6 @@ def test_blocks_are_heard_only_for_robots_someone_listens_to_and_stay_aligned(th
         three.listened = lambda name: True
     assert blocks and all(set(heard) == {'c'} for _, heard in blocks)
     assert all(heard['c'].shape == (4, MIC_BLOCK_SAMPLES) for _, heard in blocks)
-    # Block k covers samples 500 k .. 500 k + 499 of simulated time, whoever listens.
-    assert blocks[-1][0] == three.acoustics.sent // MIC_BLOCK_SAMPLES - 1
+    # Block k covers samples 500 k .. 500 k + 499 of simulated time, whoever listens: the
+    # last is the one that ended at the last platform tick.
+    assert blocks[-1][0] == int(three.time * MIC_SAMPLE_RATE_HZ) // MIC_BLOCK_SAMPLES - 1

@@ -6,8 +6,9 @@ turns, round after round: each case may change the world (``enter``) and names t
 listener in a process of its own subscribes to (as Foxglove, RViz or a client would be).
 The listener takes the messages' bytes only, so what is measured is the simulator's side.
 With ``eyes`` the listener also watches every robot's two eyes in every case (the world as
-a lab runs it). Figures: the medians of the rounds' real-time factors, their ratios to the
-first case, the simulator's own time in the functions named ``timed``, and the listener's
+a lab runs it). Each round starts with the next case (no case is always first or always
+follows the same one). Figures: the medians of the rounds' real-time factors, their ratios
+to the first case, the simulator's own time in the functions named ``timed``, and the listener's
 CPU.
 """
 import json
@@ -154,7 +155,8 @@ def compare(prog, world, cases, *, rounds, seconds, eyes, timed, salt):
     figures = {case.label: [] for case in cases}
     try:
         for k in range(rounds):
-            for case in cases:
+            # Each round starts with another case: no case always follows the same one.
+            for case in cases[k % len(cases):] + cases[:k % len(cases)]:
                 if case.enter is not None:
                     case.enter(sim)
                 command('on ' + json.dumps(case.topics))

@@ -13,26 +13,20 @@ import collections
 
 import numpy as np
 
-from miro_ball.miro.constants import MIC_BLOCK_SAMPLES, MIC_FULL_SCALE, MIC_SAMPLE_RATE_HZ, \
+from miro_ball.miro.constants import MIC_BLOCK_SAMPLES, MIC_FULL_SCALE, \
     PLATFORM_TICK_S, WHEEL_MAX_SPEED_M_PER_S
-from miro_sim_bullet.acoustics.propagation import HISTORY, low_band, LOW_PASS, render
-from miro_sim_bullet.acoustics.sources import Noise, rms_scale, WorldSource
+from miro_sim_bullet.acoustics.propagation import HISTORY, low_band, OVERSAMPLE, RATE, render, \
+    WIDTH, write
+from miro_sim_bullet.acoustics.sources import Hiss, Noise, rms_scale, WorldSource
 from miro_sim_bullet.scene.sounds import Hearing, MAX_SOUNDS
 
-TICK = round(PLATFORM_TICK_S * MIC_SAMPLE_RATE_HZ)
+TICK = round(PLATFORM_TICK_S * RATE)  # ring samples a source sends a tick
+BLOCK = OVERSAMPLE * MIC_BLOCK_SAMPLES  # ring samples of a microphone block
 SELF_NOISE_DB = -60.0  # each microphone's own noise floor, RMS
 WHEEL_NOISE_DB = -50.0  # the wheels at full speed, RMS 1 m away
 BLOCKS_KEPT = 40  # heard blocks waiting to be taken: 1 s (a reader that never takes loses
 #                   the oldest, memory stays bounded)
-_QUIET_AFTER = HISTORY - 2 * MIC_BLOCK_SAMPLES  # a source silent this long is heard no more
-
-
-def _ring_slices(n0, count):
-    """The ring buffer's slices of samples n0 .. n0 + count - 1 (two where it wraps)."""
-    start = n0 & (HISTORY - 1)
-    if start + count <= HISTORY:
-        return (slice(start, start + count),)
-    return slice(start, HISTORY), slice(0, start + count - HISTORY)
+_QUIET_AFTER = HISTORY - 2 * BLOCK  # a source silent this long (ring samples) is heard no more
 
 
 class _Row:
@@ -41,7 +35,6 @@ class _Row:
     def __init__(self, kind, owner):
         self.kind, self.owner = kind, owner  # 'sound' | 'speaker' | 'wheels', name
         self.loud_until = -HISTORY  # one past the last sample it sent that was not silence
-        self.state = np.zeros(len(LOW_PASS[1]) - 1)
 
 
 class Acoustics:
@@ -57,12 +50,11 @@ class Acoustics:
         self.hearing = hearing
         self.seed = seed
         self.listened = listened
-        self.sent = 0  # samples every source has sent
+        self.sent = 0  # ring samples every source has sent
         self.next_block = 0
         self._blocks = collections.deque(maxlen=BLOCKS_KEPT)
         capacity = MAX_SOUNDS + 2 * len(robots)
-        self.history = np.zeros((capacity, HISTORY))
-        self.low = np.zeros((capacity, HISTORY))
+        self.history = np.zeros((capacity, WIDTH), np.float32)
         self._rows = [None] * capacity
         self.sounds = {}  # name -> (row, WorldSource)
         for sound in sounds:
@@ -71,8 +63,9 @@ class Acoustics:
         self._wheel_rows = {name: self._take_row('wheels', name) for name in robots} \
             if hearing.wheel_noise else {}
         self._noise = {name: Noise((seed, 1, index)) for index, name in enumerate(robots)}
-        self._wheel_noise = {name: Noise((seed, 2, index)) for index, name in enumerate(robots)}
+        self._wheel_noise = {name: Hiss((seed, 2, index)) for index, name in enumerate(robots)}
         self._before = None  # the geometry at the last block's end
+        self._shadow_state = {}  # robot -> (its last block heard, its shadow filter's state)
         # The surfaces that echo (axis, coordinate): the ground, and the room's walls and
         # ceiling; an echo keeps sqrt(1 - absorption) of the pressure.
         self._planes = [(2, ground)]
@@ -85,7 +78,7 @@ class Acoustics:
     def _take_row(self, kind, owner):
         row = self._rows.index(None)  # ValueError: full (the world file's limit keeps it not)
         self._rows[row] = _Row(kind, owner)
-        self.history[row] = self.low[row] = 0.0
+        self.history[row] = 0.0
         return row
 
     def add_sound(self, sound):
@@ -122,7 +115,6 @@ class Acoustics:
             speed = sum(abs(v) for v in self.robots[name].wheel_out) / 2
             chunks.append((row, None if speed == 0 else self._wheel_noise[name](n0, TICK)
                            * rms_scale(WHEEL_NOISE_DB) * speed / WHEEL_MAX_SPEED_M_PER_S))
-        at = _ring_slices(n0, TICK)
         for row, samples in chunks:
             info = self._rows[row]
             if samples is None:
@@ -131,15 +123,9 @@ class Acoustics:
                 samples = np.zeros(TICK)
             else:
                 info.loud_until = n0 + TICK
-            low, info.state = low_band(samples, info.state)
-            done = 0
-            for part in at:
-                width = part.stop - part.start
-                self.history[row, part] = samples[done:done + width]
-                self.low[row, part] = low[done:done + width]
-                done += width
+            write(self.history, row, n0, samples)
         self.sent = n0 + TICK
-        while (self.next_block + 1) * MIC_BLOCK_SAMPLES <= self.sent:
+        while (self.next_block + 1) * BLOCK <= self.sent:
             self._hear_block()
 
     def _geometry(self):
@@ -164,15 +150,21 @@ class Acoustics:
         self._before = now
         n0 = block * MIC_BLOCK_SAMPLES
         rows = [row for row, info in enumerate(self._rows)
-                if info is not None and info.loud_until > n0 - _QUIET_AFTER]
+                if info is not None and info.loud_until > OVERSAMPLE * n0 - _QUIET_AFTER]
         gains, start = self._images(rows, before, now, heard)
         _, end = self._images(rows, now, now, heard)
         echoes = len(self._planes) if self.hearing.reflections else 0
-        pressure = render(self.history, self.low, rows * (1 + echoes), gains, n0,
-                          MIC_BLOCK_SAMPLES, start, end)
+        high, rest = render(self.history, rows * (1 + echoes), gains, n0, MIC_BLOCK_SAMPLES,
+                            start, end)
         out = {}
         for index, name in enumerate(heard):
-            mics = pressure[4 * index:4 * index + 4]
+            part = slice(4 * index, 4 * index + 4)
+            # The shadow's low-pass carries on from the robot's last block if that was the one
+            # before (else it starts from rest).
+            last, state = self._shadow_state.get(name, (None, None))
+            low, state = low_band(rest[part], state if last == block - 1 else np.zeros((4, 1)))
+            self._shadow_state[name] = (block, state)
+            mics = high[part] + low
             mics += rms_scale(SELF_NOISE_DB) * self._noise[name](block, 4 * MIC_BLOCK_SAMPLES
                                                                  ).reshape(4, -1)
             out[name] = np.clip(np.rint(mics * MIC_FULL_SCALE), -MIC_FULL_SCALE,

@@ -1,19 +1,30 @@
 """How sound gets from its sources to MiRo's microphones (pure numpy, no simulator).
 
 Each source's recent past is a ring buffer of what it sent, as the pressure 1 m from it
-(the microphones' full-scale units), and of that signal's low band. A microphone at
-distance d hears a source d / 343 s late (a fractional delay, read between two samples)
-and 1/d as loud, and an ear on the far side of MiRo's head hears less, the high band more
-so (the head's shadow). Over a block the delays and gains move linearly from their values
-at the block's start to those at its end, which are the next block's start: a moving
-source or head makes no click.
+(the microphones' full-scale units), at twice the microphones' rate (RATE, 40 kHz; every
+source sends nothing above 10 kHz). A microphone at distance d hears a source d / 343 s
+late (a fractional delay: a straight line between two of the ring's samples, which at twice
+the rate loses at most 0.7 dB up to 5 kHz) and 1/d as loud, and an ear on the far
+side of MiRo's head hears less, the high band more so (the head's shadow: its low band
+(below the crossover) loses less than the rest). Over a block the delays and gains move
+linearly from their values at the block's start to those at its end, which are the next
+block's start: a moving source or head makes no click.
+
+The shadow's two bands are split after the sources are summed: a microphone hears
+sum(high gain x signal) + low-pass(sum((low gain - high gain) x signal)), which is the
+same as splitting each source's signal (the low-pass is linear) but for the gains' slow
+change within a block, and costs one filter a microphone instead of one a source.
 """
 import numpy as np
 from scipy.signal import lfilter
 
 from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ, SPEED_OF_SOUND_M_S
 
-HISTORY = 1 << 14  # samples of each source kept: 0.82 s, sound's travel over 280 m
+OVERSAMPLE = 2
+RATE = OVERSAMPLE * MIC_SAMPLE_RATE_HZ  # of the sources' ring buffers
+HISTORY = 1 << 15  # samples of each source kept: 0.82 s, sound's travel over 280 m
+PAD = 1  # a row's first sample again after its end (the interpolation's second tap)
+WIDTH = HISTORY + PAD
 NEAR_M = 0.05  # nearer than this a source is as loud as at this distance (no 1/0)
 # The head's shadow on an ear whose outward side faces away from the source (full at 180
 # degrees, none facing it): a little in the low band, more above the crossover. Measured
@@ -21,15 +32,26 @@ NEAR_M = 0.05  # nearer than this a source is as loud as at this distance (no 1/
 SHADOW_LOW_DB = 2.0
 SHADOW_HIGH_DB = 8.0
 CROSSOVER_HZ = 2000.0
-# One-pole low-pass at the crossover: the low band each source keeps beside its signal.
+# One-pole low-pass at the crossover (see the module's docstring).
 _POLE = np.exp(-2 * np.pi * CROSSOVER_HZ / MIC_SAMPLE_RATE_HZ)
 LOW_PASS = ([1.0 - _POLE], [1.0, -_POLE])
 _MASK = HISTORY - 1
 
 
 def low_band(samples, state):
-    """(low band of samples, new state): the one-pole low-pass, carried across calls."""
-    return lfilter(*LOW_PASS, samples, zi=state)
+    """(low band of samples (..., n), new state (..., 1)): the one-pole low-pass, carried
+    across calls."""
+    return lfilter(*LOW_PASS, samples, axis=-1, zi=state)
+
+
+def write(ring, row, n0, samples):
+    """Put ring samples n0 .. n0 + len - 1 of a source into its row of a ring buffer."""
+    start = n0 & _MASK
+    first = min(len(samples), HISTORY - start)
+    ring[row, start:start + first] = samples[:first]
+    ring[row, :len(samples) - first] = samples[first:]
+    if start < PAD or start + len(samples) > HISTORY:  # the copy after the end
+        ring[row, HISTORY:] = ring[row, :PAD]
 
 
 def shadow_gains(outward, direction):
@@ -40,51 +62,49 @@ def shadow_gains(outward, direction):
 
 
 def _paths(sources, mics, outward):
-    """Delay (samples), low and high gains of every (mic, source) pair: (M, S) each."""
+    """Delay (ring samples), low and high gains of every (mic, source) pair: (M, S) each."""
     between = sources[None, :, :] - mics[:, None, :]
     distance = np.linalg.norm(between, axis=-1)
     direction = between / np.maximum(distance, 1e-9)[..., None]
     low, high = shadow_gains(outward[:, None, :], direction)
     spreading = 1.0 / np.maximum(distance, NEAR_M)
-    return distance / SPEED_OF_SOUND_M_S * MIC_SAMPLE_RATE_HZ, spreading * low, spreading * high
+    return distance / SPEED_OF_SOUND_M_S * RATE, spreading * low, spreading * high
 
 
-def render(history, low, rows, gains, n0, count, start, end):
-    """What M microphones hear over samples n0 .. n0 + count - 1: (M, count).
+def render(history, rows, gains, n0, count, start, end):
+    """What M microphones hear over their samples n0 .. n0 + count - 1 (at the
+    microphones' rate), as (the high band's part, the part to low-pass and add), each
+    (M, count) (see the module's docstring).
 
-    history, low: (S_all, HISTORY) ring buffers of what the sources sent and its low band
-    (sample n at n % HISTORY); rows: the S sources to hear (their rows, a row again for
-    each of its echoes), gains: (S,) what each loses besides spreading; start, end:
-    (source positions (S, 3), mic positions (M, 3), mic outward normals (M, 3)) at the
-    block's first sample and one past its last.
+    history: (S_all, WIDTH) float32 ring buffers of what the sources sent (ring sample n at
+    n % HISTORY, the first PAD again at the end; see write); rows: the S sources to hear
+    (their rows, a row again for each of its echoes), gains: (S,) what each loses besides
+    spreading; start, end: (source positions (S, 3), mic positions (M, 3), mic outward
+    normals (M, 3)) at the block's first sample and one past its last.
     """
     if not len(rows):
-        return np.zeros((len(start[1]), count))
+        return np.zeros((2, len(start[1]), count))
     delay0, low0, high0 = _paths(*start)
     delay1, low1, high1 = _paths(*end)
     # Beyond the ring's reach a source is too far to matter: read from the oldest it holds.
-    np.minimum(delay0, HISTORY - 2 * count, out=delay0)
-    np.minimum(delay1, HISTORY - 2 * count, out=delay1)
+    np.minimum(delay0, HISTORY - 2 * OVERSAMPLE * count, out=delay0)
+    np.minimum(delay1, HISTORY - 2 * OVERSAMPLE * count, out=delay1)
     low0, high0, low1, high1 = (g * gains for g in (low0, high0, low1, high1))
-    ramp = np.arange(count) / count
-    delay = delay0[..., None] + (delay1 - delay0)[..., None] * ramp
-    back = np.arange(count) - delay  # (M, S, count), relative to n0
+    # float32 and int32 from here: the per-sample arrays are (M, S, count) (18,000 numbers
+    # for three robots and three sources), and half the bytes are half the time.
+    ramp = np.arange(count, dtype=np.float32) / count
+    back = (OVERSAMPLE * np.arange(count, dtype=np.float32)
+            - delay0.astype(np.float32)[..., None])
+    back -= (delay1 - delay0).astype(np.float32)[..., None] * ramp  # from ring sample 2 n0
     whole = np.floor(back)
     frac = back - whole
-    base = whole.astype(np.int64) + n0
-    offset = (np.asarray(rows, np.int64) * HISTORY)[None, :, None]
-
-    def tap(k):  # indices of sample whole + k, within each source's own row
-        return ((base + k) & _MASK) + offset
-
-    # The signal between samples by Catmull-Rom (4 taps: within 1.1 dB up to 5 kHz,
-    # where 2 would lose 3 dB), its low band (below 2 kHz) by a straight line.
-    f2, f3 = frac * frac, frac * frac * frac
-    full = (history.take(tap(-1)) * (-0.5 * f3 + f2 - 0.5 * frac)
-            + history.take(tap(0)) * (1.5 * f3 - 2.5 * f2 + 1)
-            + history.take(tap(1)) * (-1.5 * f3 + 2 * f2 + 0.5 * frac)
-            + history.take(tap(2)) * (0.5 * f3 - 0.5 * f2))
-    lows = low.take(tap(0)) * (1 - frac) + low.take(tap(1)) * frac
-    low_gain = low0[..., None] + (low1 - low0)[..., None] * ramp
-    high_gain = high0[..., None] + (high1 - high0)[..., None] * ramp
-    return (low_gain * lows + high_gain * (full - lows)).sum(axis=1)
+    # The two taps in the flat buffers: each row is HISTORY + PAD wide, its first sample
+    # again at its end, so the second tap never wraps.
+    first = (whole.astype(np.int32) + np.int32((OVERSAMPLE * n0) & _MASK)) & _MASK
+    first += (np.asarray(rows, np.int32) * WIDTH)[None, :, None]
+    full = history.take(first)
+    full += (history.take(first + 1) - full) * frac
+    high_gain = (high0[..., None] + (high1 - high0)[..., None] * ramp).astype(np.float32)
+    extra = ((low0 - high0)[..., None] + (low1 - low0 - high1 + high0)[..., None] * ramp
+             ).astype(np.float32)
+    return (high_gain * full).sum(axis=1), (extra * full).sum(axis=1)

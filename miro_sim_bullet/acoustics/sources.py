@@ -1,8 +1,9 @@
 """What each kind of world sound sends, sample by sample (pure numpy, seeded).
 
-A source's ``emit(n0, count)`` gives its samples n0 .. n0 + count - 1 at the microphones'
-rate, as the pressure 1 m away in full-scale units, or None when it is silent then. The
-samples depend on n0 only: the same world gives the same sound, whoever listens.
+A source's ``emit(n0, count)`` gives its samples n0 .. n0 + count - 1 at the ring buffers'
+rate (propagation.RATE, twice the microphones'), as the pressure 1 m away in full-scale
+units, nothing above the microphones' Nyquist frequency, or None when it is silent then.
+The samples depend on n0 only: the same world gives the same sound, whoever listens.
 """
 import functools
 import math
@@ -12,12 +13,13 @@ import soundfile
 from scipy.signal import butter, resample_poly, sosfilt
 
 from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ
+from miro_sim_bullet.acoustics.propagation import RATE
 
-FS = MIC_SAMPLE_RATE_HZ
+FS = RATE
 # A world's noise is hiss below 5 kHz (a fan, a radio between stations), scaled back to RMS
 # 1 after the filter.
 _HISS = butter(4, 5000.0, fs=FS, output='sos')
-_HISS_GAIN = math.sqrt(FS / 2 / 5000.0)
+_HISS_GAIN = math.sqrt(FS / 2 / 5000.0)  # white noise of RMS 1 over FS / 2, kept below 5 kHz
 
 
 def rms_scale(level_db):
@@ -32,8 +34,7 @@ class WorldSource:
     def __init__(self, sound, seed, since=0):
         self.sound = sound
         self.position = np.array(sound.position, float)
-        self._noise = Noise(seed)
-        self._hiss_state = None
+        self._hiss = Hiss(seed)
         self._first = since + round(sound.start * FS)
         self._last = since + round(min(sound.stop, 1e9) * FS)  # one past it
         self._scale = rms_scale(sound.level_db)
@@ -58,22 +59,16 @@ class WorldSource:
         return out * self._scale
 
 
-    def _hiss(self, n0, count):
-        """Noise below 5 kHz; the filter's state carries on from the last call (emit is
-        called for consecutive samples)."""
-        if self._hiss_state is None:
-            self._hiss_state = np.zeros((_HISS.shape[0], 2))
-        hiss, self._hiss_state = sosfilt(_HISS, self._noise(n0, count), zi=self._hiss_state)
-        return hiss * _HISS_GAIN
-
-
 def _read(path):
-    """A sound file as one channel at FS with RMS 1 (its level is the world file's)."""
+    """A sound file as one channel at FS with RMS 1 (its level is the world file's):
+    resampled to the microphones' rate (which takes away what they cannot hear), then
+    to FS."""
     data, rate = soundfile.read(path, dtype='float64', always_2d=True)
     mono = data.mean(axis=1)
-    if rate != FS:
-        divisor = math.gcd(int(rate), FS)
-        mono = resample_poly(mono, FS // divisor, int(rate) // divisor)
+    if rate != MIC_SAMPLE_RATE_HZ:
+        divisor = math.gcd(int(rate), MIC_SAMPLE_RATE_HZ)
+        mono = resample_poly(mono, MIC_SAMPLE_RATE_HZ // divisor, int(rate) // divisor)
+    mono = resample_poly(mono, FS // MIC_SAMPLE_RATE_HZ, 1)
     rms = math.sqrt(float(np.mean(mono ** 2)))
     return mono / rms if rms > 0 else mono
 
@@ -84,6 +79,19 @@ NOISE_TABLE = 1 << 20  # samples of white noise made once: 52 s at 20 kHz before
 @functools.cache
 def _noise_table():
     return np.random.default_rng(20000).standard_normal(NOISE_TABLE).astype(np.float32)
+
+
+class Hiss:
+    """Noise below 5 kHz of RMS 1 (a fan, a radio between stations, wheels), the same for
+    the same seed and n0 when called for consecutive samples (its filter carries on)."""
+
+    def __init__(self, seed):
+        self._noise = Noise(seed)
+        self._state = np.zeros((_HISS.shape[0], 2))
+
+    def __call__(self, n0, count):
+        hiss, self._state = sosfilt(_HISS, self._noise(n0, count), zi=self._state)
+        return hiss * _HISS_GAIN
 
 
 class Noise:

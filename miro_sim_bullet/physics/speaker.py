@@ -5,8 +5,8 @@ samples it is sent, and the sound it makes (plain Python, simulated time passed 
 8 kHz samples to a buffer that the speaker plays at its own pace, one platform tick's worth
 (160 samples) a tick. The buffer is bounded: what does not fit is dropped and counted, as a
 client that sends faster than the speaker plays must learn (``sensors/stream`` reports the
-room left). Each tick the speaker sends its sound into the world at the microphones' rate
-(20 kHz): the stream upsampled, plus the tone.
+room left). Each tick the speaker sends its sound into the world at twice the microphones'
+rate (40 kHz, the acoustics' own): the stream upsampled, plus the tone.
 """
 from dataclasses import dataclass
 
@@ -20,15 +20,16 @@ from miro_ball.miro.constants import (MIC_SAMPLE_RATE_HZ, PLATFORM_TICK_S,
 BUFFER_S = 4.0  # what the platform holds ahead of the speaker
 BUFFER_SAMPLES = int(BUFFER_S * SPEAKER_SAMPLE_RATE_HZ)
 TICK_SAMPLES = int(round(PLATFORM_TICK_S * SPEAKER_SAMPLE_RATE_HZ))
-TICK_OUT = int(round(PLATFORM_TICK_S * MIC_SAMPLE_RATE_HZ))  # samples sent into the world a tick
+# The sound goes into the world at the acoustics' rate (twice the microphones').
+OUT_RATE = 2 * MIC_SAMPLE_RATE_HZ
+TICK_OUT = int(round(PLATFORM_TICK_S * OUT_RATE))  # samples sent into the world a tick
 # The sound pressure 1 m in front of the speaker at full volume (a full-scale stream, a tone
 # of volume 255), in the microphones' full-scale units: another MiRo 1 m away hears it at
 # -23 dBFS, MiRo's own ears (14 cm away) just below clipping.
 PEAK_AT_1M = 0.1
-# 8 kHz -> 20 kHz: 5 up (zeros between), a low-pass below the old Nyquist frequency, 2 down.
-_UP, _DOWN = 5, 2
-_HIGH_RATE = SPEAKER_SAMPLE_RATE_HZ * _UP
-_TAPS = firwin(121, 3600.0, fs=_HIGH_RATE) * _UP
+# 8 kHz -> 40 kHz: 5 up (zeros between) and a low-pass below the old Nyquist frequency.
+_UP = OUT_RATE // SPEAKER_SAMPLE_RATE_HZ
+_TAPS = firwin(121, 3600.0, fs=OUT_RATE) * _UP
 QUIET = 1e-6  # below this the upsampler's memory is silence
 
 
@@ -83,14 +84,14 @@ class Speaker:
     def tick(self, now):
         """One platform tick, the one that ends at ``now``: the speaker plays the next tick's
         samples and the tone. Returns the sound it sent into the world over the tick,
-        TICK_OUT samples at 20 kHz as pressure 1 m away, or None when it was silent."""
+        TICK_OUT samples at OUT_RATE as pressure 1 m away, or None when it was silent."""
         self.playing, self._buffer = self._buffer[:TICK_SAMPLES], self._buffer[TICK_SAMPLES:]
         sound = self._stream_sound()
         tone = self.tone
         if tone is not None:
             start = now - PLATFORM_TICK_S
-            times = start + np.arange(TICK_OUT) / MIC_SAMPLE_RATE_HZ
-            step = 2 * np.pi * tone.frequency / MIC_SAMPLE_RATE_HZ
+            times = start + np.arange(TICK_OUT) / OUT_RATE
+            step = 2 * np.pi * tone.frequency / OUT_RATE
             phases = self._phase + step * np.arange(TICK_OUT)
             self._phase = (self._phase + step * TICK_OUT) % (2 * np.pi)
             wave = tone.volume * PEAK_AT_1M * np.sin(phases) * (times < tone.until)
@@ -100,7 +101,7 @@ class Speaker:
         return sound
 
     def _stream_sound(self):
-        """The tick's stream samples at 20 kHz (None once it and the filter are quiet)."""
+        """The tick's stream samples at OUT_RATE (None once it and the filter are quiet)."""
         if not len(self.playing) and not np.any(np.abs(self._filter) > QUIET):
             return None
         stream = np.zeros(TICK_SAMPLES)
@@ -108,4 +109,4 @@ class Speaker:
         stuffed = np.zeros(TICK_SAMPLES * _UP)
         stuffed[::_UP] = stream
         high, self._filter = lfilter(_TAPS, 1.0, stuffed, zi=self._filter)
-        return high[::_DOWN]
+        return high
