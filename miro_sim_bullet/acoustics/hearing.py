@@ -15,8 +15,8 @@ import numpy as np
 
 from miro_ball.miro.constants import MIC_BLOCK_SAMPLES, MIC_FULL_SCALE, \
     PLATFORM_TICK_S, WHEEL_MAX_SPEED_M_PER_S
-from miro_sim_bullet.acoustics.propagation import HISTORY, low_band, OVERSAMPLE, RATE, render, \
-    WIDTH, write
+from miro_sim_bullet.acoustics.propagation import HISTORY, low_band, OVERSAMPLE, paths, RATE, \
+    render, WIDTH, write
 from miro_sim_bullet.acoustics.sources import Hiss, Noise, rms_scale, WorldSource
 from miro_sim_bullet.scene.sounds import Hearing, MAX_SOUNDS
 
@@ -66,6 +66,7 @@ class Acoustics:
         self._wheel_noise = {name: Hiss((seed, 2, index)) for index, name in enumerate(robots)}
         self._before = None  # the geometry at the last block's end
         self._shadow_state = {}  # robot -> (its last block heard, its shadow filter's state)
+        self._kept_paths = (None, None)  # (key, the paths at the last block's end)
         # The surfaces that echo (axis, coordinate): the ground, and the room's walls and
         # ceiling; an echo keeps sqrt(1 - absorption) of the pressure.
         self._planes = [(2, ground)]
@@ -151,25 +152,38 @@ class Acoustics:
         n0 = block * MIC_BLOCK_SAMPLES
         rows = [row for row, info in enumerate(self._rows)
                 if info is not None and info.loud_until > OVERSAMPLE * n0 - _QUIET_AFTER]
-        gains, start = self._images(rows, before, now, heard)
-        _, end = self._images(rows, now, now, heard)
         echoes = len(self._planes) if self.hearing.reflections else 0
-        high, rest = render(self.history, rows * (1 + echoes), gains, n0, MIC_BLOCK_SAMPLES,
-                            start, end)
+        high, rest = render(self.history, rows * (1 + echoes), n0, MIC_BLOCK_SAMPLES,
+                            self._paths(rows, before, now, heard),
+                            self._paths(rows, now, now, heard))
+        # The shadow's low-pass of each robot carries on from its last block if that was the
+        # one before (else it starts from rest); all the robots' microphones at once.
+        states = np.concatenate([self._shadow_state[name][1]
+                                 if self._shadow_state.get(name, (None,))[0] == block - 1
+                                 else np.zeros((4, 1)) for name in heard])
+        low, states = low_band(rest, states)
+        size = 4 * MIC_BLOCK_SAMPLES
+        noise = np.concatenate([self._noise[name](block * size, size) for name in heard])
+        mics = high + low + rms_scale(SELF_NOISE_DB) * noise.reshape(-1, MIC_BLOCK_SAMPLES)
+        samples = np.clip(np.rint(mics * MIC_FULL_SCALE), -MIC_FULL_SCALE,
+                          MIC_FULL_SCALE - 1).astype(np.int16)
         out = {}
         for index, name in enumerate(heard):
-            part = slice(4 * index, 4 * index + 4)
-            # The shadow's low-pass carries on from the robot's last block if that was the one
-            # before (else it starts from rest).
-            last, state = self._shadow_state.get(name, (None, None))
-            low, state = low_band(rest[part], state if last == block - 1 else np.zeros((4, 1)))
-            self._shadow_state[name] = (block, state)
-            mics = high[part] + low
-            mics += rms_scale(SELF_NOISE_DB) * self._noise[name](block, 4 * MIC_BLOCK_SAMPLES
-                                                                 ).reshape(4, -1)
-            out[name] = np.clip(np.rint(mics * MIC_FULL_SCALE), -MIC_FULL_SCALE,
-                                MIC_FULL_SCALE - 1).astype(np.int16)
+            self._shadow_state[name] = (block, states[4 * index:4 * index + 4])
+            out[name] = samples[4 * index:4 * index + 4]
         self._blocks.append((block, out))
+
+    def _paths(self, rows, geometry, now, heard):
+        """propagation.paths of the block's sources and listened microphones at
+        ``geometry``; those at a block's end are its next block's start (kept)."""
+        key = (geometry, tuple(rows), tuple(heard))
+        kept_key, kept = self._kept_paths
+        if kept_key is not None and kept_key[0] is geometry and kept_key[1:] == key[1:]:
+            return kept
+        gains, where = self._images(rows, geometry, now, heard)
+        found = paths(*where, gains, MIC_BLOCK_SAMPLES)
+        self._kept_paths = (key, found)
+        return found
 
     def _images(self, rows, geometry, now, heard):
         """(gains, (source positions, mic positions, outward normals)) of the sources of

@@ -61,35 +61,33 @@ def shadow_gains(outward, direction):
     return 10 ** (-SHADOW_LOW_DB * away / 20), 10 ** (-SHADOW_HIGH_DB * away / 20)
 
 
-def _paths(sources, mics, outward):
-    """Delay (ring samples), low and high gains of every (mic, source) pair: (M, S) each."""
+def paths(sources, mics, outward, gains, count):
+    """(delay in ring samples, low-band gain, high-band gain) of every (mic, source) pair,
+    (M, S) each: sources (S, 3), mics (M, 3) and their outward normals (M, 3), gains (S,)
+    what each source loses besides spreading, for blocks of ``count`` samples."""
     between = sources[None, :, :] - mics[:, None, :]
     distance = np.linalg.norm(between, axis=-1)
     direction = between / np.maximum(distance, 1e-9)[..., None]
     low, high = shadow_gains(outward[:, None, :], direction)
-    spreading = 1.0 / np.maximum(distance, NEAR_M)
-    return distance / SPEED_OF_SOUND_M_S * RATE, spreading * low, spreading * high
+    spreading = gains / np.maximum(distance, NEAR_M)
+    # Beyond the ring's reach a source is too far to matter: read from the oldest it holds.
+    delay = np.minimum(distance / SPEED_OF_SOUND_M_S * RATE, HISTORY - 2 * OVERSAMPLE * count)
+    return delay, spreading * low, spreading * high
 
 
-def render(history, rows, gains, n0, count, start, end):
+def render(history, rows, n0, count, start, end):
     """What M microphones hear over their samples n0 .. n0 + count - 1 (at the
     microphones' rate), as (the high band's part, the part to low-pass and add), each
     (M, count) (see the module's docstring).
 
     history: (S_all, WIDTH) float32 ring buffers of what the sources sent (ring sample n at
     n % HISTORY, the first PAD again at the end; see write); rows: the S sources to hear
-    (their rows, a row again for each of its echoes), gains: (S,) what each loses besides
-    spreading; start, end: (source positions (S, 3), mic positions (M, 3), mic outward
-    normals (M, 3)) at the block's first sample and one past its last.
+    (their rows, a row again for each of its echoes); start, end: their paths (paths())
+    at the block's first sample and one past its last.
     """
+    (delay0, low0, high0), (delay1, low1, high1) = start, end
     if not len(rows):
-        return np.zeros((2, len(start[1]), count))
-    delay0, low0, high0 = _paths(*start)
-    delay1, low1, high1 = _paths(*end)
-    # Beyond the ring's reach a source is too far to matter: read from the oldest it holds.
-    np.minimum(delay0, HISTORY - 2 * OVERSAMPLE * count, out=delay0)
-    np.minimum(delay1, HISTORY - 2 * OVERSAMPLE * count, out=delay1)
-    low0, high0, low1, high1 = (g * gains for g in (low0, high0, low1, high1))
+        return np.zeros((2, len(delay0), count))
     # float32 and int32 from here: the per-sample arrays are (M, S, count) (18,000 numbers
     # for three robots and three sources), and half the bytes are half the time.
     ramp = np.arange(count, dtype=np.float32) / count
