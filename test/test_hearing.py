@@ -168,3 +168,34 @@ def test_blocks_are_heard_only_for_robots_someone_listens_to_and_stay_aligned(th
     # Block k covers samples 500 k .. 500 k + 499 of simulated time, whoever listens: the
     # last is the one that ended at the last platform tick.
     assert blocks[-1][0] == int(three.time * MIC_SAMPLE_RATE_HZ) // MIC_BLOCK_SAMPLES - 1
+
+
+def test_echoes_and_wheels_are_heard_when_the_world_asks_for_them():
+    """The ground's echo (and the walls', in a room) adds to what a microphone hears, a few
+    samples after the sound itself; turning wheels whirr."""
+    from miro_sim_bullet.scene.sounds import Hearing
+
+    sound = Sound('s', (2.0, 0.0, 0.3), 'noise', -30.0)
+
+    def heard(hearing, sounds=(sound,), drive=False):
+        world = SimWorld(dataclasses.replace(EMPTY, sounds=sounds, hearing=hearing))
+        try:
+            world.run(0.3)
+            if drive:
+                world.robot.set_cmd_vel(0.3, 0.0)
+                world.run(0.3)
+            return hear(world, 0.5)['miro'][MIC_L]
+        finally:
+            world.close()
+
+    free = heard(Hearing())
+    echoed = heard(Hearing(reflections=True, absorption=0.2,
+                           room=(-3.0, -3.0, 3.0, 3.0, 2.5)))
+    assert level_db(echoed) > level_db(free) + 1.0
+    # The ground's echo: its path 2 * 0.3 m higher through the floor, ~6 samples later; the
+    # echo shows as a second peak in what was heard, after the first.
+    correlation = [float(np.dot(echoed[:-20], echoed[k:len(echoed) - 20 + k]))
+                   for k in range(20)]
+    assert max(correlation[3:12]) > 0.15 * correlation[0]
+    wheels = Hearing(wheel_noise=True)
+    assert level_db(heard(wheels, (), drive=True)) > level_db(heard(wheels, ())) + 6
