@@ -146,15 +146,31 @@ class Acoustics:
         if not heard:  # nothing worked out; the next heard block starts from where it is
             self._before = None
             return
-        now = self._geometry()
-        before = self._before if self._before is not None else now
-        self._before = now
         n0 = block * MIC_BLOCK_SAMPLES
         rows = [row for row, info in enumerate(self._rows)
                 if info is not None and info.loud_until > OVERSAMPLE * n0 - _QUIET_AFTER]
+        if rows:
+            sound = self._hear_sources(block, rows, heard)
+        else:  # silence but for the microphones' own noise (the usual block: cheap)
+            self._before = None
+            sound = np.zeros((len(heard) * 4, MIC_BLOCK_SAMPLES))
+        size = 4 * MIC_BLOCK_SAMPLES
+        noise = np.concatenate([self._noise[name](block * size, size) for name in heard])
+        mics = sound + rms_scale(SELF_NOISE_DB) * noise.reshape(-1, MIC_BLOCK_SAMPLES)
+        samples = np.clip(np.rint(mics * MIC_FULL_SCALE), -MIC_FULL_SCALE,
+                          MIC_FULL_SCALE - 1).astype(np.int16)
+        self._blocks.append((block, {name: samples[4 * index:4 * index + 4]
+                                     for index, name in enumerate(heard)}))
+
+    def _hear_sources(self, block, rows, heard):
+        """(4 x robots heard, 500): what the listened robots' microphones hear of the
+        sources of ``rows`` over the block."""
+        now = self._geometry()
+        before = self._before if self._before is not None else now
+        self._before = now
         echoes = len(self._planes) if self.hearing.reflections else 0
-        high, rest = render(self.history, rows * (1 + echoes), n0, MIC_BLOCK_SAMPLES,
-                            self._paths(rows, before, now, heard),
+        high, rest = render(self.history, rows * (1 + echoes), block * MIC_BLOCK_SAMPLES,
+                            MIC_BLOCK_SAMPLES, self._paths(rows, before, now, heard),
                             self._paths(rows, now, now, heard))
         # The shadow's low-pass of each robot carries on from its last block if that was the
         # one before (else it starts from rest); all the robots' microphones at once.
@@ -162,16 +178,9 @@ class Acoustics:
                                  if self._shadow_state.get(name, (None,))[0] == block - 1
                                  else np.zeros((4, 1)) for name in heard])
         low, states = low_band(rest, states)
-        size = 4 * MIC_BLOCK_SAMPLES
-        noise = np.concatenate([self._noise[name](block * size, size) for name in heard])
-        mics = high + low + rms_scale(SELF_NOISE_DB) * noise.reshape(-1, MIC_BLOCK_SAMPLES)
-        samples = np.clip(np.rint(mics * MIC_FULL_SCALE), -MIC_FULL_SCALE,
-                          MIC_FULL_SCALE - 1).astype(np.int16)
-        out = {}
         for index, name in enumerate(heard):
             self._shadow_state[name] = (block, states[4 * index:4 * index + 4])
-            out[name] = samples[4 * index:4 * index + 4]
-        self._blocks.append((block, out))
+        return high + low
 
     def _paths(self, rows, geometry, now, heard):
         """propagation.paths of the block's sources and listened microphones at

@@ -86,8 +86,6 @@ def render(history, rows, n0, count, start, end):
     at the block's first sample and one past its last.
     """
     (delay0, low0, high0), (delay1, low1, high1) = start, end
-    if not len(rows):
-        return np.zeros((2, len(delay0), count))
     # float32 and int32 from here: the per-sample arrays are (M, S, count) (18,000 numbers
     # for three robots and three sources), and half the bytes are half the time.
     ramp = np.arange(count, dtype=np.float32) / count
