@@ -479,6 +479,7 @@ def test_speed_menu_sets_the_simulators_real_time_factor_and_tones_are_heard(rig
     assert rig.until(lambda: rig.sim.get_parameter('real_time_factor').value == 2.0)
     rig.sim.set_parameters([Parameter('real_time_factor', value=1.0)])
     page.locator('#sound').click()  # a click: browsers let a page make sound after one
+    page.locator('#hearing summary').click()
     page.locator('#listen').check()
     page.locator('#tone_play').click()
     assert rig.until(lambda: page.evaluate(

@@ -77,7 +77,8 @@ def test_the_world_views_messages():
         (p.Touch('head', 0.25, 1.0), ['v'])
     assert parse({'t': 'rtf', 'value': 0})[0] == p.SetRtf(0.0)
     assert parse({'t': 'rtf', 'value': 5000})[0] == p.SetRtf(p.MAX_RTF)
-    assert parse({'t': 'hear', 'mic': 3, 'listen': True})[0] == p.Hear(3, True)
+    assert parse({'t': 'hear', 'mic': 3, 'listen': True, 'shown': True})[0] == \
+        p.Hear(3, True, True)
     assert parse({'t': 'sound', 'x': 1, 'y': 2, 'kind': 'tone'})[0] == p.PlaceSound(1.0, 2.0, 'tone')
     assert parse({'t': 'unsound', 'name': 'gui_sound1'})[0] == p.StopSound('gui_sound1')
 
@@ -117,8 +118,10 @@ def test_the_world_views_messages():
     '{"t": "touch", "part": "tail", "u": 0, "v": 0}',
     '{"t": "touch", "part": ["head"], "u": 0, "v": 0}',
     '{"t": "rtf", "value": NaN}',
-    '{"t": "hear", "mic": 4, "listen": true}', '{"t": "hear", "mic": 0, "listen": 1}',
-    '{"t": "hear", "mic": 0.5, "listen": false}',
+    '{"t": "hear", "mic": 4, "listen": true, "shown": true}',
+    '{"t": "hear", "mic": 0, "listen": 1, "shown": true}',
+    '{"t": "hear", "mic": 0.5, "listen": false, "shown": true}',
+    '{"t": "hear", "mic": 0, "listen": false}',
     '{"t": "sound", "x": 0, "y": 0, "kind": "bang"}', '{"t": "sound", "x": 0, "y": NaN, "kind": "tone"}',
     '{"t": "unsound", "name": "\\n[[sound]]"}',
 ])

@@ -101,7 +101,7 @@ def test_noise_from_the_left_reaches_the_left_ear_first_and_louder_less_so_facin
     world = SimWorld(dataclasses.replace(EMPTY, sounds=(sound,)))
     try:
         world.run(0.3)
-        ears = hear(world, 0.5)['miro']
+        ears = hear(world, 0.5)[world.robot.name]
         lead = locate(ears).lags[0]  # samples the right ear hears it after the left
         assert 3 <= lead <= 9
         assert level_db(ears[MIC_L]) - level_db(ears[MIC_R]) >= 1
@@ -109,7 +109,7 @@ def test_noise_from_the_left_reaches_the_left_ear_first_and_louder_less_so_facin
         turned[YAW] = math.radians(55)  # the head turned to the left, towards it
         world.robot.set_kinematic_targets(turned)
         world.run(1.0)
-        ears = hear(world, 0.5)['miro']
+        ears = hear(world, 0.5)[world.robot.name]
         assert 0 < locate(ears).lags[0] < lead - 1
     finally:
         world.close()
@@ -128,7 +128,7 @@ def test_the_direction_library_finds_a_sound_within_15_degrees(distance, kind):
         world = SimWorld(dataclasses.replace(EMPTY, sounds=(sound,)))
         try:
             world.run(0.2)
-            found = locate(hear(world, 0.1)['miro'])
+            found = locate(hear(world, 0.1)[world.robot.name])
             head, rotation = world.robot.link_frame(rb.HEAD)
             x, y, _ = rotation.T @ (np.array(sound.position) - head)
             error = (found.azimuth - math.atan2(y, x) + math.pi) % (2 * math.pi) - math.pi
@@ -184,7 +184,7 @@ def test_echoes_and_wheels_are_heard_when_the_world_asks_for_them():
             if drive:
                 world.robot.set_cmd_vel(0.3, 0.0)
                 world.run(0.3)
-            return hear(world, 0.5)['miro'][MIC_L]
+            return hear(world, 0.5)[world.robot.name][MIC_L]
         finally:
             world.close()
 

@@ -62,6 +62,7 @@ class _Page:
     robot: str
     channels: frozenset = DEFAULT_VIEW[0]
     world: bool = DEFAULT_VIEW[1]
+    hearing: bool = False  # its Hearing panel is open
 
 
 @dataclass(frozen=True)
@@ -213,6 +214,8 @@ class GuiBridge(Node):
             if not watching and watch.out.drive is not None:
                 watch.stop('no page watches it')
             watch.watch_sensors(watching)
+            watch.watch_mics(any(page.hearing for page in self.pages.values()
+                                 if page.robot == name))
             watch.show({ch for ch in shown.get(name, ()) if p.CHANNELS[ch] != 'overhead'})
             if not watching and name not in self.robots:
                 self._drop_watch(name)  # not running, not watched: nothing left to do
@@ -344,6 +347,13 @@ class GuiBridge(Node):
         self.sim.place(command.name, command.x, command.y)
         return False
 
+    def _hear(self, page, command, owner):
+        page.hearing = command.shown
+        watch = self.watches.get(page.robot)
+        if watch is not None:
+            watch.hear(command.mic, command.listen)
+        return True
+
     def _play_sound(self, page, command, owner):
         self.sim.play_sound(command.kind, command.x, command.y)
         return False
@@ -404,6 +414,7 @@ _PAGE_COMMANDS = {
     p.SimAction: GuiBridge._sim_action,
     p.SetRtf: GuiBridge._set_rtf,
     p.Place: GuiBridge._place,
+    p.Hear: GuiBridge._hear,
     p.PlaceSound: GuiBridge._play_sound,
     p.StopSound: GuiBridge._stop_sound,
 }
@@ -414,7 +425,6 @@ _ROBOT_COMMANDS = {
     p.Drive: lambda watch, c, owner: watch.drive(c.linear, c.angular, owner),
     p.Stop: lambda watch, c, owner: watch.let_go(owner, 'stopped by the page'),
     p.Touch: lambda watch, c, owner: watch.touch(c.part, pads_at(c.u, c.v)),
-    p.Hear: lambda watch, c, owner: watch.hear(c.mic, c.listen),
 }
 
 

@@ -121,6 +121,7 @@ class Touch:
 class Hear:
     mic: int  # the microphone whose spectrum the page shows (MIC_L, MIC_R, MIC_C, MIC_T)
     listen: bool  # its samples to the page, to play
+    shown: bool  # the page shows its Hearing panel (the microphones are read only then)
 
 
 @dataclass(frozen=True)
@@ -253,14 +254,14 @@ def _place(msg, clamped):
 
 
 def _hear(msg, clamped):
-    listen = msg.get('listen')
-    if not isinstance(listen, bool):
-        raise Rejected('listen must be true or false')
+    listen, shown = msg.get('listen'), msg.get('shown')
+    if not isinstance(listen, bool) or not isinstance(shown, bool):
+        raise Rejected('listen and shown must be true or false')
     out_of_range = []
     mic = _integer(msg, 'mic', 0, len(MICS) - 1, out_of_range)
     if out_of_range:
         raise Rejected(f'mic must be 0..{len(MICS) - 1} ({", ".join(MICS)})')
-    return Hear(mic, listen)
+    return Hear(mic, listen, shown)
 
 
 def _sound(msg, clamped):
@@ -304,7 +305,7 @@ KINDS = {
     'view': (('channels', 'world'), _view),
     'place': (('name', 'x', 'y'), _place),
     'touch': (('part', 'u', 'v'), _touch),
-    'hear': (('mic', 'listen'), _hear),
+    'hear': (('mic', 'listen', 'shown'), _hear),
     'sound': (('x', 'y', 'kind'), _sound),
     'unsound': (('name',), _unsound),
     'rtf': (('value',), lambda msg, clamped: SetRtf(

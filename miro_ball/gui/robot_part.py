@@ -131,6 +131,7 @@ class RobotPart(Node):
         self._sensor_subs = []
         self._image_subs = {}  # channel number: its subscriptions
         self.meter = MicMeter()
+        self._mics_sub = None
 
     # -- what it reads ------------------------------------------------------------------------
     def watch_sensors(self, on):
@@ -152,14 +153,24 @@ class RobotPart(Node):
                                          self._wrap(handler), profile(SENSOR_QOS))
                 for msg_type, where, handler in READOUTS]
         # A tone or a stream anyone asks MiRo for (this GUI's pages too) is heard in the
-        # pages; its microphones are shown.
+        # pages.
         self._sensor_subs += [
             self.create_subscription(UInt16MultiArray, self.topics.tone, self._on_tone,
                                      profile(CONTROL_QOS)),
             self.create_subscription(Int16MultiArray, self.topics.stream, self._on_stream,
-                                     profile(CONTROL_QOS)),
-            self.create_subscription(Int16MultiArray, self.topics.mics, self._on_mics,
-                                     profile(MIC_QOS))]
+                                     profile(CONTROL_QOS))]
+
+    def watch_mics(self, on):
+        """Subscribe to the microphones (while a page shows its Hearing panel), or not: the
+        simulator works them out only for a subscriber."""
+        if on == (self._mics_sub is not None):
+            return
+        if on:
+            self._mics_sub = self.create_subscription(Int16MultiArray, self.topics.mics,
+                                                      self._on_mics, profile(MIC_QOS))
+        else:
+            self.destroy_subscription(self._mics_sub)
+            self._mics_sub = None
 
     def show(self, channels):
         """Subscribe to exactly these image channels (numbers) of the robot."""

@@ -255,9 +255,11 @@ function setUpHearing(config) {
     row.innerHTML = `<span>${name}</span><meter min="${LEVEL_FLOOR_DB}" max="0"></meter><output></output>`;
     return row;
   }));
-  const tell = () => send({ t: 'hear', mic: Number($('mic').value), listen: $('listen').checked });
+  const tell = () => send({ t: 'hear', mic: Number($('mic').value), listen: $('listen').checked,
+                            shown: $('hearing').open });
   $('mic').addEventListener('change', tell);
   $('listen').addEventListener('change', tell);
+  $('hearing').addEventListener('toggle', tell);  // the microphones are read only while open
 }
 
 function showMics(message) {
