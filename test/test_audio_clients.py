@@ -10,30 +10,13 @@ from miro_ball.examples import client_audio, client_drive_voice, client_hear, cl
 from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ
 from miro_ball.miro.interface import default_robot_name
 from miro_sim_bullet.scene.sounds import Sound
-from rostools import advance_ticks
+from test_clients import run_client
 
 NAME = default_robot_name()
-CLASSES = {client_audio: client_audio.Audio, client_drive_voice: client_drive_voice.DriveVoice,
-           client_hear: client_hear.Hear, client_stream: client_stream.Stream}
-
-
-def run_client(module, args, sim, executor, context, limit_s):
-    """Step the world until the client is done; its exit code (None: not done by limit_s)."""
-    client = CLASSES[module](module.build_parser().parse_args(args), context=context)
-    executor.add_node(client)
-    try:
-        for _ in range(round(limit_s / 0.02)):
-            advance_ticks(sim, executor, rounds=12)
-    except SystemExit as done:
-        return done.code or 0
-    finally:
-        executor.remove_node(client)
-        client.destroy_node()
-    return None
 
 
 def place_sound(sim, bearing_deg, distance, level=-30.0):
-    """White-ish noise at ``bearing_deg`` from where the robot faces, ``distance`` away."""
+    """A hiss at ``bearing_deg`` from where the robot faces, ``distance`` away."""
     x, y, yaw = sim.sim.robots[NAME].pose()
     a = yaw + math.radians(bearing_deg)
     sim.sim.acoustics.add_sound(Sound('voice', (x + distance * math.cos(a),

@@ -13,8 +13,9 @@ from geometry_msgs.msg import TwistStamped
 
 from miro_ball.common.isolation import isolated_env
 from miro_ball.common.robots import missing_robot
-from miro_ball.examples import client_follower, client_minimal, client_read_battery, \
-    client_show, client_test, client_tf, client_video
+from miro_ball.examples import client_audio, client_drive_voice, client_follower, client_hear, \
+    client_minimal, client_read_battery, client_show, client_stream, client_test, client_tf, \
+    client_video
 from miro_ball.miro.constants import DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
 from miro_ball.miro.interface import RobotTopics, default_robot_name
 from rostools import Probe, advance_ticks, advance_until, kill_if_running, spin_until
@@ -28,7 +29,9 @@ CLIENTS = ('client_minimal', 'client_video', 'client_show', 'client_follower', '
 CLASSES = {client_minimal: client_minimal.Minimal, client_show: client_show.Show,
            client_follower: client_follower.Follower, client_test: client_test.Bench,
            client_video: client_video.Video, client_read_battery: client_read_battery.ReadBattery,
-           client_tf: client_tf.WhereIsTheBall}
+           client_tf: client_tf.WhereIsTheBall, client_audio: client_audio.Audio,
+           client_drive_voice: client_drive_voice.DriveVoice, client_hear: client_hear.Hear,
+           client_stream: client_stream.Stream}
 
 
 def run_client(module, args, paused_sim, executor, context, limit_s, each_tick=None):

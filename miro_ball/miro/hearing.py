@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from miro_ball.miro.body import LINK, MICS, TAIL_MIC_IN_BODY
+from miro_ball.miro.body import LINK, MICS
 from miro_ball.miro.constants import (KIN_CALIB_RAD, MIC_BLOCK_SAMPLES, MIC_C, MIC_FULL_SCALE,
                                       MIC_L, MIC_R, MIC_SAMPLE_RATE_HZ, MIC_T,
                                       SPEED_OF_SOUND_M_S)
