@@ -15,8 +15,8 @@ import numpy as np
 
 from miro_ball.miro.constants import MIC_BLOCK_SAMPLES, MIC_FULL_SCALE, \
     PLATFORM_TICK_S, WHEEL_MAX_SPEED_M_PER_S
-from miro_sim_bullet.acoustics.propagation import HISTORY, low_band, OVERSAMPLE, paths, RATE, \
-    render, WIDTH, write
+from miro_sim_bullet.acoustics.propagation import HISTORY, OVERSAMPLE, paths, RATE, render, \
+    Shadow, WIDTH, write
 from miro_sim_bullet.acoustics.sources import Hiss, Noise, rms_scale, WorldSource
 from miro_sim_bullet.scene.sounds import Hearing, MAX_SOUNDS
 
@@ -65,7 +65,8 @@ class Acoustics:
         self._noise = {name: Noise((seed, 1, index)) for index, name in enumerate(robots)}
         self._wheel_noise = {name: Hiss((seed, 2, index)) for index, name in enumerate(robots)}
         self._before = None  # the geometry at the last block's end
-        self._shadow_state = {}  # robot -> (its last block heard, its shadow filter's state)
+        # robot -> [its last block heard, its Shadow (the filters that carry on from it)]
+        self._shadow = {name: [None, Shadow()] for name in robots}
         self._kept_paths = (None, None)  # (key, the paths at the last block's end)
         # The surfaces that echo (axis, coordinate): the ground, and the room's walls and
         # ceiling; an echo keeps sqrt(1 - absorption) of the pressure.
@@ -153,6 +154,8 @@ class Acoustics:
             sound = self._hear_sources(block, rows, heard)
         else:  # silence but for the microphones' own noise (the usual block: cheap)
             self._before = None
+            for name in heard:
+                self._shadow[name][0] = None  # the filters' memory is of before: dropped
             sound = np.zeros((len(heard) * 4, MIC_BLOCK_SAMPLES))
         size = 4 * MIC_BLOCK_SAMPLES
         noise = np.concatenate([self._noise[name](block * size, size) for name in heard])
@@ -172,15 +175,17 @@ class Acoustics:
         high, rest = render(self.history, rows * (1 + echoes), block * MIC_BLOCK_SAMPLES,
                             MIC_BLOCK_SAMPLES, self._paths(rows, before, now, heard),
                             self._paths(rows, now, now, heard))
-        # The shadow's low-pass of each robot carries on from its last block if that was the
-        # one before (else it starts from rest); all the robots' microphones at once.
-        states = np.concatenate([self._shadow_state[name][1]
-                                 if self._shadow_state.get(name, (None,))[0] == block - 1
-                                 else np.zeros((4, 1)) for name in heard])
-        low, states = low_band(rest, states)
+        # Each robot's shadow filters carry on from its last block if that was the one before
+        # (else they start from rest).
+        out = np.empty_like(high)
         for index, name in enumerate(heard):
-            self._shadow_state[name] = (block, states[4 * index:4 * index + 4])
-        return high + low
+            kept = self._shadow[name]
+            if kept[0] != block - 1:
+                kept[1].reset()
+            kept[0] = block
+            part = slice(4 * index, 4 * index + 4)
+            out[part] = kept[1](high[part], rest[part])
+        return out
 
     def _paths(self, rows, geometry, now, heard):
         """propagation.paths of the block's sources and listened microphones at

@@ -13,12 +13,14 @@ block's start: a moving source or head makes no click.
 The shadow's two bands are split after the sources are summed: a microphone hears
 sum(high gain x signal) + low-pass(sum((low gain - high gain) x signal)), which is the
 same as splitting each source's signal (the low-pass is linear) but for the gains' slow
-change within a block, and costs one filter a microphone instead of one a source.
+change within a block, and costs one filter a microphone instead of one a source. The
+low-pass is a linear-phase FIR (fir.py), SHADOW_DELAY samples late: the whole microphone
+signal is delayed as much (0.75 ms, as an ADC's filter would), so both bands stay aligned.
 """
 import numpy as np
-from scipy.signal import lfilter
 
 from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ, SPEED_OF_SOUND_M_S
+from miro_sim_bullet.acoustics.fir import lowpass, Stream
 
 OVERSAMPLE = 2
 RATE = OVERSAMPLE * MIC_SAMPLE_RATE_HZ  # of the sources' ring buffers
@@ -32,16 +34,28 @@ NEAR_M = 0.05  # nearer than this a source is as loud as at this distance (no 1/
 SHADOW_LOW_DB = 2.0
 SHADOW_HIGH_DB = 8.0
 CROSSOVER_HZ = 2000.0
-# One-pole low-pass at the crossover (see the module's docstring).
-_POLE = np.exp(-2 * np.pi * CROSSOVER_HZ / MIC_SAMPLE_RATE_HZ)
-LOW_PASS = ([1.0 - _POLE], [1.0, -_POLE])
+SHADOW_TAPS = 31
+SHADOW_DELAY = (SHADOW_TAPS - 1) // 2  # microphone samples
+_SHADOW_LOW = lowpass(CROSSOVER_HZ, MIC_SAMPLE_RATE_HZ, SHADOW_TAPS)
+_DELAY = np.eye(SHADOW_TAPS)[SHADOW_DELAY]
 _MASK = HISTORY - 1
 
 
-def low_band(samples, state):
-    """(low band of samples (..., n), new state (..., 1)): the one-pole low-pass, carried
-    across calls."""
-    return lfilter(*LOW_PASS, samples, axis=-1, zi=state)
+class Shadow:
+    """One robot's four microphones' split of the shadow's bands (see the module's
+    docstring): ``(high, rest)`` of a block in, the microphones' signal out, both bands
+    SHADOW_DELAY samples late; its filters carry on from block to block."""
+
+    def __init__(self, mics=4):
+        self.low = Stream(_SHADOW_LOW, (mics,))
+        self.delay = Stream(_DELAY, (mics,))
+
+    def __call__(self, high, rest):
+        return self.delay(high) + self.low(rest)
+
+    def reset(self):
+        self.low.reset()
+        self.delay.reset()
 
 
 def write(ring, row, n0, samples):

@@ -9,17 +9,16 @@ import functools
 import math
 
 import numpy as np
-import soundfile
-from scipy.signal import butter, lfilter, resample_poly
 
 from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ
+from miro_sim_bullet.acoustics.fir import lowpass, Stream
 from miro_sim_bullet.acoustics.propagation import RATE
 
 FS = RATE
 # A world's noise is hiss below 5 kHz (a fan, a radio between stations), scaled back to RMS
 # 1 after the filter.
-_HISS = butter(4, 5000.0, fs=FS)  # (b, a): lfilter takes a quarter of sosfilt's time
-_HISS_GAIN = math.sqrt(FS / 2 / 5000.0)  # white noise of RMS 1 over FS / 2, kept below 5 kHz
+_HISS = lowpass(5000.0, FS, 63)
+_HISS /= math.sqrt(np.sum(_HISS ** 2))  # white noise of RMS 1 stays of RMS 1
 
 
 def rms_scale(level_db):
@@ -63,6 +62,9 @@ def _read(path):
     """A sound file as one channel at FS with RMS 1 (its level is the world file's):
     resampled to the microphones' rate (which takes away what they cannot hear), then
     to FS."""
+    import soundfile  # here, as scipy.signal: only a world with a sound file pays their import
+    from scipy.signal import resample_poly
+
     data, rate = soundfile.read(path, dtype='float64', always_2d=True)
     mono = data.mean(axis=1)
     if rate != MIC_SAMPLE_RATE_HZ:
@@ -87,11 +89,10 @@ class Hiss:
 
     def __init__(self, seed):
         self._noise = Noise(seed)
-        self._state = np.zeros(len(_HISS[1]) - 1)
+        self._filter = Stream(_HISS)
 
     def __call__(self, n0, count):
-        hiss, self._state = lfilter(*_HISS, self._noise(n0, count), zi=self._state)
-        return hiss * _HISS_GAIN
+        return self._filter(self._noise(n0, count))
 
 
 class Noise:

@@ -11,11 +11,11 @@ rate (40 kHz, the acoustics' own): the stream upsampled, plus the tone.
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import firwin, lfilter
 
 from miro_ball.miro.constants import (MIC_SAMPLE_RATE_HZ, PLATFORM_TICK_S,
                                       SPEAKER_SAMPLE_RATE_HZ, TONE_FREQUENCY_RANGE_HZ,
                                       TONE_VOLUME_MAX)
+from miro_sim_bullet.acoustics.fir import lowpass, Stream
 
 BUFFER_S = 4.0  # what the platform holds ahead of the speaker
 BUFFER_SAMPLES = int(BUFFER_S * SPEAKER_SAMPLE_RATE_HZ)
@@ -29,8 +29,7 @@ TICK_OUT = int(round(PLATFORM_TICK_S * OUT_RATE))  # samples sent into the world
 PEAK_AT_1M = 0.1
 # 8 kHz -> 40 kHz: 5 up (zeros between) and a low-pass below the old Nyquist frequency.
 _UP = OUT_RATE // SPEAKER_SAMPLE_RATE_HZ
-_TAPS = firwin(121, 3600.0, fs=OUT_RATE) * _UP
-QUIET = 1e-6  # below this the upsampler's memory is silence
+_TAPS = lowpass(3600.0, OUT_RATE, 121) * _UP
 
 
 @dataclass(frozen=True)
@@ -50,7 +49,7 @@ class Speaker:
         self.playing = np.zeros(0, np.int16)
         self.dropped = 0
         self._phase = 0.0  # the tone's, carried from tick to tick: no click
-        self._filter = np.zeros(len(_TAPS) - 1)
+        self._filter = Stream(_TAPS)
 
     def play_tone(self, frequency, volume, ticks, now):
         """[frequency Hz, volume 0..255, duration in platform ticks], as control/tone says
@@ -102,11 +101,10 @@ class Speaker:
 
     def _stream_sound(self):
         """The tick's stream samples at OUT_RATE (None once it and the filter are quiet)."""
-        if not len(self.playing) and not np.any(np.abs(self._filter) > QUIET):
+        if not len(self.playing) and self._filter.quiet:
             return None
         stream = np.zeros(TICK_SAMPLES)
         stream[:len(self.playing)] = self.playing / 32768.0 * PEAK_AT_1M
         stuffed = np.zeros(TICK_SAMPLES * _UP)
         stuffed[::_UP] = stream
-        high, self._filter = lfilter(_TAPS, 1.0, stuffed, zi=self._filter)
-        return high
+        return self._filter(stuffed)
