@@ -33,7 +33,7 @@ from miro_ball.common.cli import user_args
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.recording.bag import BagError, SplitBag, TYPESTORE, describe, offered_qos
-from miro_ball.recording.wav import export_wav, WavError
+
 from miro_ball.recording.selection import Progress, Selection, cdr_stamp_ns, has_stamp, \
     import_name, log_time_ns
 from miro_ball.miro.interface import CLOCK, DEFAULT_ROBOT_NAME, RobotTopics
@@ -208,6 +208,7 @@ def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
     args, selection, parser = parse_args(user_args(argv, NODE_NAME))
     if args.wav is not None:
+        from miro_ball.recording.wav import export_wav, WavError  # (soundfile: only here)
         try:
             for path, seconds, skipped in export_wav(args.targets[0], args.wav):
                 print(f'{path}: {seconds:.2f} s' + (f' ({skipped} bad blocks skipped)'
