@@ -149,8 +149,13 @@ def compare(prog, world, cases, *, rounds, seconds, eyes, timed, salt):
         listener.stdin.write(line + '\n')
         listener.stdin.flush()
 
+    every = {topic for case in cases for _, topic, _ in case.topics}
+
     def matched(topics):
-        return all(sim.count_subscribers(topic) > 0 for _, topic, _ in topics)
+        """The case's topics listened to, and no other: the simulator sees a subscription
+        that has just gone for a while, and works for it."""
+        wanted = {topic for _, topic, _ in topics}
+        return all((sim.count_subscribers(topic) > 0) == (topic in wanted) for topic in every)
 
     figures = {case.label: [] for case in cases}
     try:
