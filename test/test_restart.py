@@ -110,13 +110,14 @@ def test_controller_starts_over_and_kicks_after_the_simulator_is_killed(
 
 def test_wheels_stop_after_the_command_timeout_when_the_controller_is_killed(
         nodes, executor, probe):
-    nodes('miro_sim', 'sim')
+    # Stepped until the controller drives: free-running, a busy machine let the simulator
+    # run on for seconds before the pause below (a kick, or commands after it).
+    nodes('miro_sim', 'paused sim')
     monitor = Monitor(probe.node, [ROBOT])
     wheels = probe.watch(Float32MultiArray, TOPICS.wheel_speed_cmd)
     odometry = probe.watch(Odometry, TOPICS.odom)  # stamped: the exact simulated time
     controller = nodes('controller_1', 'controller')
-    assert spin_until(executor, lambda: wheels and any(wheels[-1].data), HANG_GUARD_S), \
-        'the controller never drove'
+    step_until(executor, probe, lambda: wheels and any(wheels[-1].data))
     # Paused, the simulator takes whatever command is still on its way at this very
     # instant: so no command can reach it later than the pause.
     assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True)).success
