@@ -396,13 +396,14 @@ def test_the_pages_hearing_levels_spectrum_and_sound():
     import numpy as np
 
     from miro_ball.gui.hearing import BANDS, MAX_AUDIO_SAMPLES, MicMeter, speaker_message
+    from miro_ball.miro.hearing import mic_window
 
     meter = MicMeter()
     meter.mic, meter.listen = 1, True
     t = np.arange(2000) / 20000
     tone = (np.sin(2 * np.pi * 2500 * t) * 3276.8).astype(np.int16)  # RMS -23 dB
-    blocks = [np.stack([np.zeros(500), tone[k:k + 500], np.zeros(500), np.zeros(500)])
-              .astype(np.int16) for k in range(0, 2000, 500)]
+    blocks = [mic_window(np.stack([np.zeros(500), tone[k:k + 500], np.zeros(500),
+                                   np.zeros(500)]).astype(np.int16)) for k in range(0, 2000, 500)]
     assert [meter.add(b) for b in blocks[:3]] == [[], [], []]
     shown, heard = (json.loads(text) for text in meter.add(blocks[3]))
     assert shown['levels'][1] == pytest.approx(-23.0, abs=0.2) and shown['levels'][0] == -100

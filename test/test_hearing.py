@@ -3,7 +3,6 @@ each other's speakers and of a world's sounds, block by block, and where the dir
 library says a sound comes from."""
 import dataclasses
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +12,7 @@ from miro_ball.miro.constants import (KIN_CALIB_RAD, MIC_BLOCK_SAMPLES, MIC_L, M
 from miro_ball.miro.hearing import level_db, locate, mic_window
 from miro_sim_bullet.physics import model as rb
 from miro_sim_bullet.physics.world import SimWorld
-from miro_sim_bullet.scene.sounds import Sound
+from miro_sim_bullet.scene.sounds import bundled_sound, Sound
 from miro_sim_bullet.scene.world_file import load_world, RobotSpec
 
 FS = MIC_SAMPLE_RATE_HZ
@@ -115,7 +114,7 @@ def test_noise_from_the_left_reaches_the_left_ear_first_and_louder_less_so_facin
         world.close()
 
 
-TUNE = str(Path(__file__).parents[1] / 'worlds' / 'sounds' / 'radio_tune.ogg')
+TUNE = str(bundled_sound('radio_tune.ogg'))
 
 
 @pytest.mark.parametrize('distance, kind', [(1.0, 'noise'), (3.0, 'noise'), (2.0, 'file')])

@@ -17,14 +17,14 @@ import sys
 
 from miro_ball.bench.listened import bench_parser, Case, checked, compare, own_difference
 from miro_ball.miro.interface import default_robot_name, RobotTopics, TOPIC
-from miro_sim_bullet.scene.sounds import Sound
+from miro_sim_bullet.scene.sounds import bundled_sound, Sound
 from miro_sim_bullet.scene.world_file import load_world
 
 BUDGET = {'miro': 0.10, 'football_pitch': 0.20}  # the issue's: of the real-time factor
 PITCH_SOUNDS = (Sound('hiss', (0.0, 1.5, 0.3), 'noise', -35.0),
                 Sound('whistle', (-1.0, -1.0, 0.3), 'tone', -35.0, frequency=1200.0),
-                Sound('radio', (1.5, 0.0, 0.3), 'file', -35.0, file='radio_tune.ogg',
-                      loop=True))
+                Sound('radio', (1.5, 0.0, 0.3), 'file', -35.0,
+                      file=str(bundled_sound('radio_tune.ogg')), loop=True))
 
 
 def main(argv=None):
@@ -47,7 +47,7 @@ def main(argv=None):
             if args.pitch and on:
                 for sound in PITCH_SOUNDS:
                     if sound.name not in acoustics.sounds:
-                        acoustics.add_sound(_bundled(sound))
+                        acoustics.add_sound(sound)
         return enter
 
     cases = [Case('without hearing', enter=hearing(False)),
@@ -77,16 +77,6 @@ def main(argv=None):
           f'(nobody listening: {100 * own_difference(figures, cases[1].label, cases[0].label):.1f}'
           f' %); the listener got {medians[cases[2].label][3]:.0f} KB per simulated second')
     return 0
-
-
-def _bundled(sound):
-    """The sound with its bundled file found as a world file finds it."""
-    if sound.kind != 'file':
-        return sound
-    from miro_sim_bullet.scene.world_file import load_sounds
-    return load_sounds(f'[[sound]]\nname = "{sound.name}"\nfile = "{sound.file}"\nloop = true\n'
-                       f'position = {list(sound.position)}\nlevel = {sound.level_db}\n',
-                       'hearing_bench')[0]
 
 
 if __name__ == '__main__':

@@ -48,13 +48,13 @@ class MicMeter:
         self._blocks = []
 
     def add(self, block):
-        """One block, int16 (4, 500); [JSON text] for the pages (none until BLOCKS came)."""
+        """One block, (4, 500) of full scale (miro.hearing.mic_window); [JSON text] for the
+        pages (none until BLOCKS came)."""
         self._blocks.append(block)
         if len(self._blocks) < BLOCKS:
             return []
-        samples = np.concatenate(self._blocks, axis=1)
+        scaled = np.concatenate(self._blocks, axis=1)
         self._blocks = []
-        scaled = samples / MIC_FULL_SCALE
         levels = _db(np.mean(scaled ** 2, axis=1))
         power = np.abs(np.fft.rfft(scaled[self.mic] * _WINDOW)) ** 2 / len(_WINDOW)
         bands = np.array_split(power[1:], BANDS)
@@ -64,5 +64,6 @@ class MicMeter:
                            'spectrum': [round(float(v), 1) for v in spectrum],
                            'top_hz': MIC_SAMPLE_RATE_HZ / 2})]
         if self.listen:
-            out.append(audio_message(samples[self.mic], MIC_SAMPLE_RATE_HZ, 'mic'))
+            out.append(audio_message(np.rint(scaled[self.mic] * MIC_FULL_SCALE),
+                                     MIC_SAMPLE_RATE_HZ, 'mic'))
         return out

@@ -218,7 +218,7 @@ class RobotPart(Node):
 
     def _on_mics(self, msg):
         try:
-            block = (mic_window(msg.data) * 32768).astype(int)
+            block = mic_window(msg.data)
         except ValueError as err:
             self.warn(f'mics:{self.robot}', f'{self.robot}: microphones ignored: {err}')
             return

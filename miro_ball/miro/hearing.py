@@ -38,13 +38,14 @@ class Heard:
     #              (each pair's own best lag)
 
 
-def mic_window(data, blocks=1):
-    """sensors/mics data (blocks of 4 x 500 int16, channel by channel) as floats of full
-    scale, shaped (4, samples); ValueError in one line when it is not that long."""
+def mic_window(data):
+    """sensors/mics data (a block of 4 x 500 int16, channel by channel; or int16 (4, n) of
+    blocks joined) as floats of full scale, shaped (4, samples); ValueError in one line
+    when a block is not that long."""
     samples = np.asarray(data, dtype=float)
     if samples.ndim == 2 and samples.shape[0] == len(MICS):
         return samples / MIC_FULL_SCALE
-    if samples.size != len(MICS) * MIC_BLOCK_SAMPLES * blocks:
+    if samples.size != len(MICS) * MIC_BLOCK_SAMPLES:
         raise ValueError(f'a microphone block has {len(MICS) * MIC_BLOCK_SAMPLES} samples '
                          f'(4 channels x {MIC_BLOCK_SAMPLES}), got {samples.size}')
     return samples.reshape(len(MICS), -1) / MIC_FULL_SCALE

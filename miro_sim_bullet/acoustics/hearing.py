@@ -29,19 +29,12 @@ BLOCKS_KEPT = 40  # heard blocks waiting to be taken: 1 s (a reader that never t
 _QUIET_AFTER = HISTORY - 2 * BLOCK  # a source silent this long (ring samples) is heard no more
 
 
-class _Row:
-    """One source's place in the ring buffers: what it is and when it last sounded."""
-
-    def __init__(self, kind, owner):
-        self.kind, self.owner = kind, owner  # 'sound' | 'speaker' | 'wheels', name
-        self.loud_until = -HISTORY  # one past the last sample it sent that was not silence
-
-
 class Acoustics:
     """Sound for ``robots`` ({name: MiroRobot}) and the world's ``sounds`` (scene.sounds)
     with ``hearing`` (scene.sounds.Hearing); ``seed`` makes every noise.
 
-    ``listened(name)`` says whether a robot's microphones are wanted now; ``take()`` gives the blocks heard since the last take.
+    ``listened(name)`` says whether a robot's microphones are wanted now; ``take()`` gives
+    the blocks heard since the last take.
     """
 
     def __init__(self, robots, sounds=(), hearing=Hearing(), seed=0, ground=0.0,
@@ -55,12 +48,14 @@ class Acoustics:
         self._blocks = collections.deque(maxlen=BLOCKS_KEPT)
         capacity = MAX_SOUNDS + 2 * len(robots)
         self.history = np.zeros((capacity, WIDTH), np.float32)
-        self._rows = [None] * capacity
+        # Each row's source: None while the row is free, else one past the last ring sample
+        # it sent that was not silence.
+        self._loud_until = [None] * capacity
         self.sounds = {}  # name -> (row, WorldSource)
         for sound in sounds:
             self.add_sound(sound)
-        self._speaker_rows = {name: self._take_row('speaker', name) for name in robots}
-        self._wheel_rows = {name: self._take_row('wheels', name) for name in robots} \
+        self._speaker_rows = {name: self._take_row() for name in robots}
+        self._wheel_rows = {name: self._take_row() for name in robots} \
             if hearing.wheel_noise else {}
         self._noise = {name: Noise((seed, 1, index)) for index, name in enumerate(robots)}
         self._wheel_noise = {name: Hiss((seed, 2, index)) for index, name in enumerate(robots)}
@@ -77,9 +72,9 @@ class Acoustics:
         self._reflected = (1.0 - hearing.absorption) ** 0.5
 
     # -- sources ------------------------------------------------------------------------------
-    def _take_row(self, kind, owner):
-        row = self._rows.index(None)  # ValueError: full (the world file's limit keeps it not)
-        self._rows[row] = _Row(kind, owner)
+    def _take_row(self):
+        row = self._loud_until.index(None)  # ValueError: full (the limit keeps it not)
+        self._loud_until[row] = -HISTORY  # never sounded
         self.history[row] = 0.0
         return row
 
@@ -90,14 +85,14 @@ class Acoustics:
         self.remove_sound(sound.name)
         if len(self.sounds) >= MAX_SOUNDS:
             raise ValueError(f'at most {MAX_SOUNDS} sounds play at once')
-        self.sounds[sound.name] = (self._take_row('sound', sound.name),
+        self.sounds[sound.name] = (self._take_row(),
                                    WorldSource(sound, (self.seed, 0, len(self.sounds)), self.sent))
 
     def remove_sound(self, name):
         """Silence a world sound at once (what it sent is still on its way: not heard)."""
         if name in self.sounds:
             row, _ = self.sounds.pop(name)
-            self._rows[row] = None
+            self._loud_until[row] = None
 
     def source_positions(self):
         """{name: world position} of every world sound and every robot's speaker (the
@@ -118,21 +113,19 @@ class Acoustics:
             chunks.append((row, None if speed == 0 else self._wheel_noise[name](n0, TICK)
                            * rms_scale(WHEEL_NOISE_DB) * speed / WHEEL_MAX_SPEED_M_PER_S))
         for row, samples in chunks:
-            info = self._rows[row]
             if samples is None:
-                if info.loud_until <= n0 - _QUIET_AFTER:
+                if self._loud_until[row] <= n0 - _QUIET_AFTER:
                     continue  # silent for long: its ring holds zeros already
                 samples = np.zeros(TICK)
             else:
-                info.loud_until = n0 + TICK
+                self._loud_until[row] = n0 + TICK
             write(self.history, row, n0, samples)
         self.sent = n0 + TICK
         while (self.next_block + 1) * BLOCK <= self.sent:
             self._hear_block()
 
     def _geometry(self):
-        """[(mics (4, 3), outward normals (4, 3))] of the robots, and {row: position} of
-        the sources."""
+        """({robot: its hearing_frame()}, {row: position of its source}) now."""
         frames = {name: robot.hearing_frame() for name, robot in self.robots.items()}
         sources = {row: source.position for row, source in self.sounds.values()}
         sources.update({self._speaker_rows[name]: frame[2] for name, frame in frames.items()})
@@ -148,8 +141,8 @@ class Acoustics:
             self._before = None
             return
         n0 = block * MIC_BLOCK_SAMPLES
-        rows = [row for row, info in enumerate(self._rows)
-                if info is not None and info.loud_until > OVERSAMPLE * n0 - _QUIET_AFTER]
+        rows = [row for row, loud_until in enumerate(self._loud_until)
+                if loud_until is not None and loud_until > OVERSAMPLE * n0 - _QUIET_AFTER]
         if rows:
             sound = self._hear_sources(block, rows, heard)
         else:  # silence but for the microphones' own noise (the usual block: cheap)

@@ -75,7 +75,7 @@ def _read(path):
     return mono / rms if rms > 0 else mono
 
 
-NOISE_TABLE = 1 << 20  # samples of white noise made once: 52 s at 20 kHz before it repeats
+NOISE_TABLE = 1 << 20  # samples of white noise made once: 26 s at 40 kHz before it repeats
 
 
 @functools.cache

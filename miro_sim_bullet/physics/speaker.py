@@ -12,16 +12,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from miro_ball.miro.constants import (MIC_SAMPLE_RATE_HZ, PLATFORM_TICK_S,
-                                      SPEAKER_SAMPLE_RATE_HZ, TONE_FREQUENCY_RANGE_HZ,
-                                      TONE_VOLUME_MAX)
+from miro_ball.miro.constants import (PLATFORM_TICK_S, SPEAKER_SAMPLE_RATE_HZ,
+                                      TONE_FREQUENCY_RANGE_HZ, TONE_VOLUME_MAX)
 from miro_sim_bullet.acoustics.fir import lowpass, Stream
+from miro_sim_bullet.acoustics.propagation import RATE as OUT_RATE  # the acoustics' rate
 
 BUFFER_S = 4.0  # what the platform holds ahead of the speaker
 BUFFER_SAMPLES = int(BUFFER_S * SPEAKER_SAMPLE_RATE_HZ)
 TICK_SAMPLES = int(round(PLATFORM_TICK_S * SPEAKER_SAMPLE_RATE_HZ))
-# The sound goes into the world at the acoustics' rate (twice the microphones').
-OUT_RATE = 2 * MIC_SAMPLE_RATE_HZ
 TICK_OUT = int(round(PLATFORM_TICK_S * OUT_RATE))  # samples sent into the world a tick
 # The sound pressure 1 m in front of the speaker at full volume (a full-scale stream, a tone
 # of volume 255), in the microphones' full-scale units: another MiRo 1 m away hears it at

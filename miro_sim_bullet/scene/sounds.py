@@ -92,15 +92,21 @@ def _sound(parser, where, index, table):
                  kind=kind, level_db=level, loop=loop, start=start, stop=stop, **extra)
 
 
+def bundled_sound(name):
+    """The path of a bundled sound file (worlds/sounds/), or None when there is none."""
+    bundled = importlib.resources.files('miro_sim_bullet.worlds') / 'sounds' / name
+    return Path(str(bundled)) if bundled.is_file() else None
+
+
 def _sound_file(parser, where, value):
     """The absolute path of a sound file that libsndfile reads, not too long."""
     import soundfile  # here: a world without sound files loads with the standard library only
     if not isinstance(value, str) or not value or '\0' in value:
         parser.fail(where, f'must be the name of a sound file, got {value!r}'[:120])
     path = Path(value)
-    bundled = importlib.resources.files('miro_sim_bullet.worlds') / 'sounds' / value
-    if path.name == value and bundled.is_file():
-        path = Path(str(bundled))
+    bundled = bundled_sound(value) if path.name == value else None
+    if bundled is not None:
+        path = bundled
     elif parser.folder is not None and not path.is_absolute():
         path = parser.folder / path
     try:
