@@ -589,7 +589,7 @@ def test_run_time_parameters_apply_or_are_refused_with_a_reason(make_rig):
     for name, value, reason in [('hough_param2', 0.0, 'hough_param2'), ('blur', 8, 'odd'),
                                 ('tick', 0.05, 'restart'),
                                 ('slow', 'fast', 'number'),
-                                ('mode', 'test_contract:NeedsAFace', "no detector named 'face'")]:
+                                ('mode', 'test_contract:NeedsASmell', "no detector named 'smell'")]:
         result = node.set_parameters([Parameter(name, value=value)])[0]
         assert not result.successful and reason in result.reason, (name, result.reason)
     assert node.detection_params.blur == 7 and node.config.tick == pytest.approx(0.02)

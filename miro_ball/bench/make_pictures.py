@@ -8,7 +8,9 @@ made again and checked (test_pictures compares them with what this script draws)
   with one, OpenCV's takes the poster's edge and the tag's for one candidate and
   misses the tag);
 - ``miro_lab_logo.png``: the arena's panel logo, the wall panel's 0.65 x 0.30 shape;
-- ``face_poster.png``: a simple drawn face, for demos that look for one.
+- ``face_poster.png``: a simple drawn face, for demos that look for one;
+- ``face_photo.png``: a photographed face for real face detectors (demo mode's): the face of
+  scikit-image's ``astronaut`` (a NASA portrait, public domain), cropped, no blue in it.
 
 No blue anywhere: the controller looks for the blue ball.
 """
@@ -95,11 +97,22 @@ def face():
     return image
 
 
+FACE_PHOTO_CROP = (slice(40, 210), slice(150, 300))  # rows, columns of astronaut()
+
+
+def face_photo():
+    """The astronaut's face, BGR (scikit-image ships the photo)."""
+    from skimage import data
+
+    return cv2.cvtColor(data.astronaut()[FACE_PHOTO_CROP], cv2.COLOR_RGB2BGR)
+
+
 def pictures():
     """{file name: BGR or greyscale image} of every bundled picture."""
     drawn = {f'apriltag36h11_{tag_id}.png': apriltag(tag_id) for tag_id in TAG_IDS}
     drawn['miro_lab_logo.png'] = logo()
     drawn['face_poster.png'] = face()
+    drawn['face_photo.png'] = face_photo()
     return drawn
 
 

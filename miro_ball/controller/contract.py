@@ -6,7 +6,7 @@ A controller is any object with
     act(percepts) -> Action
 
 and optionally ``waits_for_head = True`` (wheels still while the node holds the start
-head pose). The node (node.py) builds the Percepts from MiRo's sensor topics and
+head pose) and ``hears = True`` (the node listens to the microphones for it). The node (node.py) builds the Percepts from MiRo's sensor topics and
 publishes each field of the Action that is not None on its control topic. Both values
 are plain frozen data: a controller is tested without ROS by calling act() on Percepts
 made by hand.
@@ -42,7 +42,10 @@ class Percepts:
     touch_head: Optional[int] = None  # a bit per pad touched now
     touch_body: Optional[int] = None
     light: Optional[Tuple[float, ...]] = None  # four light sensors, 0..1
-    sound_bearing: Optional[float] = None  # rad, + = left; for hearing, not measured yet
+    joints: Optional[Tuple[float, float, float, float]] = None  # tilt, lift, yaw, pitch, rad
+    # The latest sound heard (miro.hearing.Heard: azimuth in the head frame, level), for a
+    # controller with ``hears = True`` (the node listens to the mics only for one).
+    sound: Optional[Any] = None
 
     def __post_init__(self):
         if len(self.eyes) != len(EYES):
@@ -68,5 +71,6 @@ class Action:
     cosmetic: Optional[Tuple[float, ...]] = None  # droop, wag, eyelid l/r, ear l/r, 0..1
     illum: Optional[Tuple[int, ...]] = None  # six LEDs, 0xAARRGGBB
     tone: Optional[Tuple[int, int, int]] = None  # frequency Hz, volume 0..255, ticks
+    stream: Optional[Tuple[int, ...]] = None  # 16-bit samples at 8 kHz for the speaker
     state: str = ''  # a name for what the controller is doing, for logs and watchers
     messages: Tuple[str, ...] = ()  # said once each in the node's log

@@ -64,6 +64,23 @@ class DetectionParams:
                                                  'range': (1, 999)})
     max_radius: int = field(default=50, metadata={'help': 'largest ball radius (px @640)',
                                                   'range': (2, 1000)})
+    # The other detectors (sights.py), for controllers that ask for them.
+    face_every: int = field(default=4, metadata={
+        'help': 'faces: look in one frame of this many per eye (a look costs ~40 ms)',
+        'range': (1, 100)})
+    face_width: int = field(default=320, metadata={
+        'help': 'faces: frames scaled down to this width first, px', 'range': (64, 1280)})
+    face_min_px: int = field(default=20, metadata={
+        'help': 'faces: the smallest face looked for, px at face_width', 'range': (12, 200)})
+    tag_width: int = field(default=640, metadata={
+        'help': 'AprilTags: frames scaled down to this width first, px', 'range': (64, 1280)})
+    motion_width: int = field(default=160, metadata={
+        'help': 'motion: frames scaled down to this width first, px', 'range': (32, 1280)})
+    motion_threshold: int = field(default=25, metadata={
+        'help': 'motion: a grey level change above this is motion', 'range': (1, 255)})
+    motion_min_area: float = field(default=0.002, metadata={
+        'help': 'motion: the smallest moving region, fraction of the frame',
+        'range': (0.0, 1.0)})
 
     def __post_init__(self):
         if len(self.target_rgb) != 3:

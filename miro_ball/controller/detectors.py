@@ -3,8 +3,10 @@
 A detector factory gets the node's DetectionParams and returns a callable
 ``detect(image, camera) -> result or None`` (image: BGR frame, camera: the eye's
 CameraModel at the frame's size). The result lands in ``Eye.detections[name]`` of
-the next Percepts. "ball" is the tutorial's blue-ball detector; face, AprilTag,
-motion and sound detectors register here the same way.
+the next Percepts. The node makes each detector once per eye (one may remember the
+eye's previous frame). "ball" is the tutorial's blue-ball detector (a Ball or None);
+"face" and "tag" find faces and AprilTags (tuples of sights.Sight), "motion" the
+largest moving region (a Sight or None).
 """
 from typing import Any, Callable, Dict
 
@@ -33,4 +35,16 @@ def _ball(params):
     return lambda image, camera: detector.detect(image)
 
 
+def _sight(name):
+    def factory(params):
+        from miro_ball.controller import sights  # scikit-image only for who asks for faces
+
+        detector = getattr(sights, name)(params)
+        return lambda image, camera: detector.detect(image)
+    return factory
+
+
 register('ball', _ball)
+register('face', _sight('FaceDetector'))
+register('tag', _sight('TagDetector'))
+register('motion', _sight('MotionDetector'))

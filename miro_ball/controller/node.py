@@ -30,7 +30,8 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import CameraInfo, CompressedImage, JointState, Range
-from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32MultiArray
+from std_msgs.msg import (Float32MultiArray, Int16MultiArray, UInt16, UInt16MultiArray,
+                          UInt32MultiArray)
 
 from miro_ball.common.checks import finite
 from miro_ball.common.cli import user_args
@@ -51,7 +52,8 @@ from miro_ball.controller.detectors import make_detectors
 from miro_ball.controller.names import DEBUG_TOPIC, NODE_NAME
 from miro_ball.controller.params import ControllerParams, GROUPS
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES
+from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES, KIN_CALIB_RAD
+from miro_ball.miro.hearing import locate, mic_window
 from miro_ball.miro.interface import (CLOCK, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
                                       robot_namespace, robot_of_namespace, RobotTopics,
                                       SENSOR, TOPIC, TOUCH_PARTS)
@@ -113,6 +115,8 @@ class Latest:
 
 
 class KickBlueBall(Node):
+    NAME = NODE_NAME
+
     """The controller. Attributes for tests and embedding:
 
     state             the controller's state name ('startup' while holding the head)
@@ -125,7 +129,7 @@ class KickBlueBall(Node):
     last_action       the controller's latest Action (contract.Action)
     last_tick         node time (s) of the latest control tick, None before the first
     robot             the robot it drives: the last part of its namespace
-    controller, detectors ({name: detect}), detection_params, config (ControllerParams),
+    controller, detectors ([{name: detect}] per eye), detection_params, config (ControllerParams),
     pub_twist
 
     robot (a name) picks the namespace, as --robot does; a remapped __ns wins.
@@ -134,16 +138,11 @@ class KickBlueBall(Node):
     def __init__(self, *, context=None, parameter_overrides=None, save_debug=None, robot=None,
                  args=None):
         # Simulated time unless args (the command line, default sys.argv) say otherwise.
-        super().__init__(NODE_NAME, context=context, namespace=robot_namespace(robot),
+        super().__init__(self.NAME, context=context, namespace=robot_namespace(robot),
                          parameter_overrides=sim_time_overrides(parameter_overrides or (), args))
         self.robot = robot_of_namespace(self.get_namespace())
-        self.config = params.declare(self, ControllerParams)
-        self.detection_params = params.declare(self, DetectionParams)
-        self._behaviour_params = params.declare(self, BehaviourParams)
         # The topics and the timer are made once; every tunable applies at run time.
-        self._live = params.LiveParams(
-            self, (self.config, self.detection_params, self._behaviour_params), self._apply,
-            fixed=('tick',))
+        self._live = params.LiveParams(self, self._declare(), self._apply, fixed=('tick',))
         self.save_debug = save_debug
         self._debug_folder = save_debug and DebugFolder(save_debug, self.config.save_debug_keep)
         self.frames_processed = 0
@@ -155,7 +154,9 @@ class KickBlueBall(Node):
         self._clock_watch = guard_clock(self, self._warn)
         self.eyes = [Latest() for _ in EYES]  # (frame, {detector: result}) of each eye
         self.cliff = Latest()
-        self.readings = {key: Latest() for key in ('sonar', 'light') + TOUCH_PARTS}
+        self.readings = {key: Latest() for key in ('sonar', 'light', 'joints', 'sound')
+                         + TOUCH_PARTS}
+        self._mics = None  # the microphones' subscription, while the controller hears
         self.cameras = list(DEFAULT_CAMERAS)
         # Each eye's pinhole at the size of the frame its latest detection came from.
         self._frame_cameras = list(DEFAULT_CAMERAS)
@@ -172,6 +173,8 @@ class KickBlueBall(Node):
         self.create_subscription(Range, names.sonar, self._on_sonar, profile(TOPIC['sonar'].qos))
         self.create_subscription(Float32MultiArray, names.light, self._on_light,
                                  profile(TOPIC['light'].qos))
+        self.create_subscription(JointState, names.kinematic_joints, self._on_joints,
+                                 profile(TOPIC['kinematic_joints'].qos))
         for part in TOUCH_PARTS:
             self.create_subscription(UInt16, names.touch(part), partial(self._on_touch, part),
                                      profile(TOPIC['touch'].qos))
@@ -185,6 +188,9 @@ class KickBlueBall(Node):
                                                profile(TOPIC['illum'].qos))
         self.pub_tone = self.create_publisher(UInt16MultiArray, names.tone,
                                               profile(TOPIC['tone'].qos))
+        self.pub_stream = self.create_publisher(Int16MultiArray, names.stream,
+                                                profile(TOPIC['stream'].qos))
+        self._listen()
         self.pub_debug = [self.create_publisher(CompressedImage, DEBUG_TOPIC.format(eye=cam),
                                                 eyes)
                           for cam in EYES]
@@ -195,19 +201,29 @@ class KickBlueBall(Node):
             JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-1),
                           on_clock_change=False),
             post_callback=lambda jump: self.timer.reset())
-        self.get_logger().info("mode '%s', robot '%s' (topics under %s), tick %g s"
-                               % (self.config.mode, self.robot, self.get_namespace(),
+        self.get_logger().info("%s, robot '%s' (topics under %s), tick %g s"
+                               % (self._describe(), self.robot, self.get_namespace(),
                                   self.config.tick))
         # On sim time nothing ticks until /clock arrives: say once what we wait for.
         self._no_clock_timer = self.create_timer(
             NO_CLOCK_NOTICE_S, self._on_no_clock, clock=Clock(clock_type=ClockType.STEADY_TIME))
+
+    def _declare(self):
+        """Declare the node's parameters: the groups, for the live changes."""
+        self.config = params.declare(self, ControllerParams)
+        self.detection_params = params.declare(self, DetectionParams)
+        self._behaviour_params = params.declare(self, BehaviourParams)
+        return self.config, self.detection_params, self._behaviour_params
+
+    def _describe(self):
+        return "mode '%s'" % self.config.mode
 
     def _apply(self, values):
         """A set_parameters change that passed the checks: detection changes take effect
         at the next frame; a behaviour or mode change starts the controller over."""
         if isinstance(values, DetectionParams):
             self.detection_params = values
-            self.detectors = make_detectors(self.controller.detectors, values)
+            self._make_detectors()
         elif isinstance(values, BehaviourParams):
             self._behaviour_params = values
             self._new_controller()
@@ -218,10 +234,29 @@ class KickBlueBall(Node):
                 self._debug_folder.keep = values.save_debug_keep
             if mode_changed:
                 self._new_controller()
+                self._listen()
 
     def _new_controller(self):
         self.controller = make_controller(self.config.mode, self._behaviour_params)
-        self.detectors = make_detectors(self.controller.detectors, self.detection_params)
+        self._make_detectors()
+
+    def _listen(self):
+        """Subscribe to the microphones while the controller hears (hearing costs the
+        simulator only while someone listens), and only then."""
+        hears = getattr(self.controller, 'hears', False)
+        if hears and self._mics is None:
+            self._mics = self.create_subscription(
+                Int16MultiArray, RobotTopics().mics, self._on_mics, profile(TOPIC['mics'].qos))
+        elif not hears and self._mics is not None:
+            self.destroy_subscription(self._mics)
+            self._mics = None
+            self.readings['sound'].clear()
+
+    def _make_detectors(self):
+        """Each eye's own detectors, as the controller asks (one may remember its eye's
+        previous frame)."""
+        self.detectors = [make_detectors(self.controller.detectors, self.detection_params)
+                          for _ in EYES]
 
     def _on_no_clock(self):
         self._no_clock_timer.cancel()
@@ -276,7 +311,7 @@ class KickBlueBall(Node):
         # camera_info may describe another resolution than the frames (a resized stream).
         height, width = frame.shape[:2]
         camera = self._frame_cameras[eye] = self.cameras[eye].scaled_to(width, height)
-        found = {name: detect(frame, camera) for name, detect in self.detectors.items()}
+        found = {name: detect(frame, camera) for name, detect in self.detectors[eye].items()}
         self.frames_processed += 1
         self.eyes[eye].set(now, (frame, found))
         self._debug_image(eye, msg.header, frame, found.get('ball'))
@@ -313,6 +348,23 @@ class KickBlueBall(Node):
         if not finite(*data):
             return self._reject('light', 'light reading %s is not finite' % (data[:4],))
         self.readings['light'].set(self._seconds(), data)
+
+    def _on_joints(self, msg):
+        joints = tuple(msg.position)
+        if len(joints) != len(JOINT_NAMES) or not finite(*joints):
+            return self._reject('joints', 'kinematic_joints %s is not four finite angles'
+                                % (joints[:5],))
+        self.readings['joints'].set(self._seconds(), joints)
+
+    def _on_mics(self, msg):
+        try:
+            window = mic_window(msg.data)
+        except ValueError as err:
+            return self._reject('mics', 'microphones: %s' % err)
+        joints = self.readings['joints'].value or KIN_CALIB_RAD
+        heard = locate(window, joints)
+        if heard is not None:
+            self.readings['sound'].set(self._seconds(), heard)
 
     def _on_touch(self, part, msg):
         self.readings[part].set(self._seconds(), int(msg.data))
@@ -375,7 +427,8 @@ class KickBlueBall(Node):
         reading = {key: latest.fresh(now, stale) for key, latest in self.readings.items()}
         return Percepts(now, tuple(eyes), cliff=self.cliff.fresh(now, stale),
                         sonar=reading['sonar'], touch_head=reading['head'],
-                        touch_body=reading['body'], light=reading['light'])
+                        touch_body=reading['body'], light=reading['light'],
+                        joints=reading['joints'], sound=reading['sound'])
 
     def publish(self, action):
         """Each part of the action that is set, on its control topic."""
@@ -389,6 +442,8 @@ class KickBlueBall(Node):
             self.pub_illum.publish(UInt32MultiArray(data=[int(v) for v in action.illum]))
         if action.tone is not None:
             self.pub_tone.publish(UInt16MultiArray(data=[int(v) for v in action.tone]))
+        if action.stream is not None:
+            self.pub_stream.publish(Int16MultiArray(data=[int(v) for v in action.stream]))
 
     def _check_silence(self, now):
         """Warn about inputs that stopped (or never started) arriving."""
@@ -467,13 +522,19 @@ def _fail(parser, err):
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
     parser = build_parser()
-    options = parser.parse_args(user_args(
-        argv, parser.prog, GROUPS, NODE_NAME))
+    options = parser.parse_args(user_args(argv, parser.prog, GROUPS, NODE_NAME))
     if options.save_debug:
         try:
             os.makedirs(options.save_debug, exist_ok=True)
         except OSError as err:
             parser.error('--save-debug: %s' % err)
+    return run(parser, options, partial(KickBlueBall, save_debug=options.save_debug), argv)
+
+
+def run(parser, options, make_node, argv=None):
+    """Build the node (make_node(robot=, args=)) and spin it until Ctrl+C or SIGTERM, then
+    stop the wheels; a bad parameter or name is said in one line (exit 2)."""
+    argv = list(sys.argv if argv is None else argv)
     # Detection takes about a millisecond; OpenCV's worker threads would only add
     # wake-up jitter on a small machine shared with the simulator.
     cv2.setNumThreads(1)
@@ -481,7 +542,7 @@ def main(argv=None):
     stop = StopRequest()
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-        node = KickBlueBall(save_debug=options.save_debug, robot=options.robot, args=argv)
+        node = make_node(robot=options.robot, args=argv)
     except (ValueError, ParameterException, NameValidationException) as err:
         # a bad parameter or name: say so in one line
         rclpy.try_shutdown()

@@ -163,6 +163,32 @@ ROBOT_INTERFACE = tuple(Topic(*row[:6], *(row[6:] or (None,))) for row in (
 ))
 TOPIC = {row.key: row for row in ROBOT_INTERFACE}
 
+# Demo mode's own topics (the MDK's "core" layer), in the robot's namespace beside the
+# robot's: what it shows of itself (out) and what clients tell it (in). The MDK's names;
+# core/selection/action is ours (the selected action by name).
+CORE_OUT, CORE_IN = 'core out', 'core in'
+CORE_INTERFACE = tuple(Topic(*row) for row in (
+    ('animal_state', 'core/animal/state', 'miro2_msg/msg/AnimalState', CORE_OUT, SENSOR_QOS,
+     'emotion, mood (valence, arousal -1..1), sleep (wakefulness, pressure 0..1), flags'),
+    ('selection_priority', 'core/selection/priority', 'std_msgs/msg/Float32MultiArray',
+     CORE_OUT, SENSOR_QOS, "each action's priority, in demo mode's action order"),
+    ('selection_inhibition', 'core/selection/inhibition', 'std_msgs/msg/Float32MultiArray',
+     CORE_OUT, SENSOR_QOS, 'each action\'s inhibition: 0 for the selected one, else 1'),
+    ('selection_action', 'core/selection/action', 'std_msgs/msg/String', CORE_OUT, SENSOR_QOS,
+     'the selected action, by name'),
+    ('priority_peak', 'core/priority_peak', 'miro2_msg/msg/PriorityPeak', CORE_OUT,
+     SENSOR_QOS, 'the attention map\'s peak: azimuth, elevation (body frame), height, range'),
+    ('detect_objects', 'core/detect_objects_{eye}', 'miro2_msg/msg/Objects', CORE_OUT,
+     SENSOR_QOS, 'what the detectors found in each eye (balls, faces, tags)'),
+    ('config_state', 'core/config/state', 'std_msgs/msg/String', CORE_OUT, SENSOR_QOS,
+     "the demo's switches as the MDK's letters (those on)"),
+    ('animal_adjust', 'core/animal/adjust', 'miro2_msg/msg/AnimalAdjust', CORE_IN,
+     CONTROL_QOS, 'nudge emotion, mood or sleep (the MDK\'s Adjust)'),
+    ('config_command', 'core/config/command', 'std_msgs/msg/String', CORE_IN, CONTROL_QOS,
+     "'f<letter>' toggles a switch, 'ping' asks for core/config/state"),
+))
+CORE_TOPIC = {row.key: row for row in CORE_INTERFACE}
+
 # The frames of one robot, each prefixed with the robot's name (frame_id):
 #   <robot>/odom -> <robot>/base_link -> <robot>/imu_body, <robot>/imu_head, <robot>/sonar,
 #                                        <robot>/caml_optical, <robot>/camr_optical
@@ -237,6 +263,10 @@ class RobotTopics:
 
     def _row(self, key, **fields):
         return self.topic(TOPIC[key].name.format(**fields))
+
+    def core(self, key, **fields):
+        """A demo-mode topic (CORE_INTERFACE) by key."""
+        return self.topic(CORE_TOPIC[key].name.format(**fields))
 
     # Sensors: what the robot (or the simulator standing in for it) publishes.
     def eye_compressed(self, eye):

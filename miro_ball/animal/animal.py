@@ -1,0 +1,232 @@
+"""Demo mode's controller: MiRo as a small animal, one Percepts in, one Action out.
+
+Each tick (time passed in, no ROS here) the parts run in turn:
+
+    senses -> attention -> (feel, affect, sleep) -> action selection -> reflexes
+           -> expression -> voice
+
+senses.py turns detections and the sound heard into stimuli around MiRo; attention.py
+paints them on the priority map, whose peak is the target; feel.py reads strokes, pets
+and hits from the touch pads; affect.py and sleep.py move emotion, mood, wakefulness and
+pressure; actions.py says what each action wants and does, selection.py picks one; the
+reflexes here (cliff, sonar, sleep, the flags) have the last word on the wheels;
+express.py and voice.py show the state. Every part is replaceable: the selector by the
+`selector` parameter, any other by a subclass (docs/demo_mode.md).
+"""
+import math
+
+import numpy as np
+
+from miro_ball.animal.actions import ACTIONS, make_actions, Situation
+from miro_ball.animal.affect import AffectModel, Events
+from miro_ball.animal.attention import PriorityMap
+from miro_ball.animal.express import Expression
+from miro_ball.animal.feel import Feel
+from miro_ball.animal.params import Config, FLAG_LETTERS
+from miro_ball.animal.selection import selector_class
+from miro_ball.animal.senses import Senses
+from miro_ball.animal.sleep import SleepModel
+from miro_ball.animal.voice import as_tone, length_s, vocalise
+from miro_ball.controller.contract import Action
+from miro_ball.miro.constants import (CLIFF_THRESHOLD, KIN_CALIB_RAD, LIFT_RAD_CALIB,
+                                      PLATFORM_TICK_S, TILT_RAD, WHEEL_TRACK_M, YAW)
+
+SONAR_BAND_M = (0.10, 0.25)  # the MDK's sonar modulation: stop at the near end, free beyond
+SHUN_SPEED, SHUN_TURN = 0.1, 1.5  # backing off a drop, m/s and rad/s
+LOUD = 0.5  # a sound this loud (0..1 of the loud range) wakes and startles
+MAX_DT = 0.2  # a longer gap (a paused simulator) counts as this much
+
+
+class Animal:
+    """Percepts in, Action out (controller/contract.py), with its state to show:
+    emotion, mood (affect.Affect), sleep (SleepState), priorities and selected (index into
+    ACTIONS), peak and target (attention.Peak), stimuli of the latest tick."""
+
+    hears = True
+
+    def __init__(self, config=Config(), selector='basal_ganglia', seed=0):
+        self.rng = np.random.default_rng(seed)
+        self.config = config
+        self.map = PriorityMap(config.spatial)
+        self.feel = Feel(config.affect)
+        self.affect = AffectModel(config.affect, config.flags)
+        self.sleep = SleepModel(config.sleep)
+        self.actions = make_actions(config.action, config.flags)
+        self.selector = selector_class(selector)(config.action, self.rng)
+        self.express = Expression(config.express, config.flags, self.rng)
+        self.senses = Senses(config.spatial, config.action)
+        self.selected, self.priorities = None, [0.0] * len(ACTIONS)
+        self.peak = self.target = None
+        self.stimuli = []
+        self.loudness = 0.0
+        self._last_t = None
+        self._moved_at = self._target_at = 0.0
+        self._forward = 0.0
+        self._head = (LIFT_RAD_CALIB, 0.0, 0.0)  # lift, yaw, pitch told last
+        self._voice_ready_at = 0.0
+        self._vocalising_until = -math.inf
+        self._had_motion = False
+        self._was_asleep = False
+
+    @property
+    def detectors(self):
+        f = self.config.flags
+        wanted = [('ball', f.salience_ball), ('face', f.salience_faces), ('tag', True),
+                  ('motion', f.salience_motion)]
+        return tuple(name for name, on in wanted if on)
+
+    def configure(self, config):
+        """New parameters, the state kept (a live parameter change)."""
+        self.config = config
+        self.map.params = self.senses.spatial = config.spatial
+        self.senses.action = config.action
+        self.feel.params = config.affect
+        self.affect.params, self.affect.flags = config.affect, config.flags
+        self.sleep.params = config.sleep
+        self.express.params, self.express.flags = config.express, config.flags
+        self.selector.params = config.action
+        for action in self.actions:
+            action.params, action.flags = config.action, config.flags
+
+    @property
+    def flag_bits(self):
+        """The switches on, a bit each in FLAG_LETTERS order (core/animal/state's flags)."""
+        return sum(1 << i for i, (_, name, _) in enumerate(FLAG_LETTERS)
+                   if getattr(self.config.flags, name))
+
+    @property
+    def selected_name(self):
+        return ACTIONS[self.selected] if self.selected is not None else ''
+
+    @property
+    def asleep(self):
+        return self.config.flags.sleep and self.sleep.asleep
+
+    # -- the tick ----------------------------------------------------------------------------
+    def act(self, percepts):
+        t = percepts.t
+        dt = PLATFORM_TICK_S if self._last_t is None else min(MAX_DT, max(0.0, t - self._last_t))
+        self._last_t = t
+        flags = self.config.flags
+        joints = percepts.joints or KIN_CALIB_RAD
+
+        still = t - self._moved_at >= self.config.spatial.motion_still_s
+        stimuli = [s for s in self.senses.sights(percepts, include_motion=still)
+                   if s.kind != 'face' or flags.salience_faces]
+        heard = self.senses.sound(percepts.sound, joints)
+        self.loudness = heard.strength if heard is not None else 0.0
+        if heard is not None and flags.salience_sound:
+            stimuli.append(heard)
+        self.stimuli = stimuli
+        self.peak = self.map.update(dt, stimuli, self_noisy=t < self._vocalising_until)
+        self.target = self.map.target(self.peak)
+        if self.target is not None:
+            self._target_at = t
+
+        motion = any(s.kind == 'motion' for s in stimuli)
+        startled = motion and not self._had_motion
+        self._had_motion = motion
+        touches = self.feel.feel(percepts.touch_head, percepts.touch_body)
+        light = float(np.mean(percepts.light)) if percepts.light else 0.5
+        loud = self.loudness >= LOUD and t >= self._vocalising_until
+        if flags.sleep:
+            stimulation = min(1.0, touches.touched + self.loudness + 0.5 * (self.target
+                                                                            is not None))
+            self.sleep.step(dt, stimulation, woken=touches.touched or loud)
+        wakefulness = self.sleep.state.wakefulness if flags.sleep else 1.0
+        self.affect.step(dt, Events(touches.strokes, touches.pet, touches.hits,
+                                    self.loudness, startled, light), wakefulness)
+        emotion = self.affect.emotion
+
+        situation = Situation(t, dt, self.target, emotion.valence, emotion.arousal,
+                              joints[YAW], percepts.sonar, t - self._target_at, self._forward)
+        self.priorities = [action.priority(situation) for action in self.actions]
+        chosen = self.selector.select(t, self.priorities)
+        if chosen != self.selected:
+            if self.selected is not None:
+                self.actions[self.selected].stop(situation)
+            self.actions[chosen].start(situation)
+            self.selected = chosen
+        action = self.actions[chosen]
+        motor = action.motor(situation)
+        if action.finished:
+            action.stop(situation)
+
+        wheels = self._reflexes(motor.forward, motor.turn, percepts, wakefulness)
+        head = self._head_pose(motor, t, wakefulness)
+        shown = self.express.step(t, dt, emotion.valence, emotion.arousal, wakefulness,
+                                  touches.touched)
+        said = self._voice(t, touches, loud, wakefulness)
+        return Action(wheels=wheels, head=head, cosmetic=shown.cosmetic, illum=shown.illum,
+                      state=self.selected_name, **said)
+
+    def _reflexes(self, forward, turn, percepts, wakefulness):
+        """The lower level: flags, sonar, cliff and sleep have the last word on the wheels."""
+        flags = self.config.flags
+        if not flags.translation:
+            forward = 0.0
+        if not flags.rotation:
+            turn = 0.0
+        if flags.sonar_modulation and percepts.sonar is not None and forward > 0:
+            near, far = SONAR_BAND_M
+            forward *= min(1.0, max(0.0, (percepts.sonar - near) / (far - near)))
+        cliff = percepts.cliff
+        if cliff is not None and min(cliff) < CLIFF_THRESHOLD:
+            if flags.shun_cliffs:
+                # back off and turn away from the side that sees the drop
+                forward = -SHUN_SPEED
+                turn = -SHUN_TURN if cliff[0] < cliff[1] else SHUN_TURN
+            elif flags.cliff_reflex:
+                forward = min(forward, 0.0)
+        if flags.sleep:
+            low = self.config.sleep.asleep_below
+            gate = min(1.0, max(0.0, (wakefulness - low) / max(1e-6, 0.5 - low)))
+            forward, turn = forward * gate, turn * gate
+        self._forward = forward
+        if abs(forward) > 0.01 or abs(turn) > 0.05:
+            self._moved_at = percepts.t
+        half = turn * WHEEL_TRACK_M / 2
+        return forward - half, forward + half
+
+    def _head_pose(self, motor, t, wakefulness):
+        if not self.config.flags.neck:
+            return None
+        lift, yaw, pitch = self._head
+        lift = motor.lift if motor.lift is not None else lift
+        yaw = motor.yaw if motor.yaw is not None else yaw
+        pitch = motor.pitch if motor.pitch is not None else pitch
+        if abs(yaw - self._head[1]) > 0.005:
+            self._moved_at = t
+        self._head = (lift, yaw, pitch)
+        if self.config.flags.sleep:
+            lift, pitch = self.express.posture(t, lift, pitch, wakefulness)
+            yaw *= wakefulness
+        return (TILT_RAD, lift, yaw, pitch)
+
+    def _voice(self, t, touches, loud, wakefulness):
+        """A vocalisation now and then: pleased when stroked, hurt, startled, waking."""
+        asleep = self.asleep
+        woke, self._was_asleep = self._was_asleep and not asleep, asleep
+        emotion = self.affect.emotion
+        pleased = touches.strokes and emotion.valence > 0.1
+        occasion = pleased or touches.hits or (loud and not asleep) or woke
+        express = self.config.express
+        if not (self.config.flags.voice and occasion and t >= self._voice_ready_at):
+            return {}
+        self._voice_ready_at = t + express.voice_refractory_s
+        self._vocalising_until = t + length_s(emotion.valence) + 0.2  # and its echo
+        if express.voice_via == 'tone':
+            return {'tone': as_tone(emotion.valence, emotion.arousal, express.voice_volume)}
+        samples = vocalise(emotion.valence, emotion.arousal, express.voice_volume, self.rng)
+        return {'stream': tuple(int(v) for v in samples)}
+
+    # -- from clients ------------------------------------------------------------------------
+    def adjust(self, emotion=None, mood=None, sleep=None):
+        """A client's nudge (core/animal/adjust): each a pair of (data, gamma) pairs, for
+        (valence, arousal) or (wakefulness, pressure)."""
+        if emotion is not None:
+            self.affect.adjust('emotion', *emotion)
+        if mood is not None:
+            self.affect.adjust('mood', *mood)
+        if sleep is not None:
+            self.sleep.adjust(*sleep)

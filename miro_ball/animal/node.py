@@ -1,0 +1,170 @@
+"""miro_animal: MiRo's demo mode for one robot, a ROS 2 node in the robot's namespace.
+
+The controller node's machinery (controller/node.py: eyes decoded and the detectors run
+per eye, the percepts, the tick on simulated time, the control topics) driving an Animal
+(animal.py), plus demo mode's own topics (miro.interface.CORE_INTERFACE): its state, the
+selection, the attention peak and the objects out; core/animal/adjust and
+core/config/command in. Every part's parameters are ROS parameters and change live.
+"""
+import argparse
+import sys
+
+from std_msgs.msg import Float32MultiArray, String
+
+from miro_ball.animal.actions import ACTIONS
+from miro_ball.animal.animal import Animal
+from miro_ball.animal import core_messages
+from miro_ball.animal.params import (AnimalNodeParams, Config, config_command, FlagParams,
+                                     letters_on, PART_GROUPS)
+from miro_ball.common import params
+from miro_ball.common.cli import user_args
+from miro_ball.common.qos import profile
+from miro_ball.controller.detection import DetectionParams
+from miro_ball.controller import node as controller_node
+from miro_ball.miro.interface import CORE_IN, CORE_INTERFACE, CORE_TOPIC, EYES, RobotTopics
+
+NODE_NAME = 'miro_animal'
+GROUPS = (AnimalNodeParams, DetectionParams) + PART_GROUPS
+
+
+class MiroAnimal(controller_node.KickBlueBall):
+    """Demo mode. Attributes beyond the controller node's: animal_config (params.Config),
+    controller (the Animal), rejected counts bad adjust and config messages too."""
+
+    NAME = NODE_NAME
+
+    def _declare(self):
+        self.config = params.declare(self, AnimalNodeParams)
+        self.detection_params = params.declare(self, DetectionParams)
+        parts = [params.declare(self, cls) for cls in PART_GROUPS]
+        self.animal_config = Config(*parts)
+        self._core_publishers()
+        return (self.config, self.detection_params, *parts)
+
+    def _core_publishers(self):
+        names = RobotTopics()
+        self.pub_core = {}
+        for row in CORE_INTERFACE:
+            if row.direction == CORE_IN:
+                continue
+            kind = {'animal_state': 'AnimalState', 'priority_peak': 'PriorityPeak',
+                    'detect_objects': 'Objects'}.get(row.key)
+            msg_type = _miro2(kind) if kind else (String if row.type.endswith('String')
+                                                  else Float32MultiArray)
+            for fields, _ in row.names():
+                key = row.key + ''.join('_' + v for v in fields.values())
+                self.pub_core[key] = (msg_type, self.create_publisher(
+                    msg_type, names.core(row.key, **fields), profile(row.qos)))
+        self.create_subscription(_miro2('AnimalAdjust'), names.core('animal_adjust'),
+                                 self._on_adjust, profile(CORE_TOPIC['animal_adjust'].qos))
+        self.create_subscription(String, names.core('config_command'), self._on_config,
+                                 profile(CORE_TOPIC['config_command'].qos))
+
+    def _describe(self):
+        return "demo mode (selector '%s', switches '%s')" % (
+            self.config.selector, letters_on(self.animal_config.flags))
+
+    def _new_controller(self):
+        self.controller = Animal(self.animal_config, self.config.selector, self.config.seed)
+        self._make_detectors()
+
+    def _apply(self, values):
+        if isinstance(values, DetectionParams):
+            self.detection_params = values
+            self._make_detectors()
+        elif isinstance(values, AnimalNodeParams):
+            restart = (values.selector, values.seed) != (self.config.selector, self.config.seed)
+            self.config = values
+            if restart:
+                self._new_controller()
+        else:
+            detectors = self.controller.detectors
+            self.animal_config = self.animal_config.with_part(values)
+            self.controller.configure(self.animal_config)
+            if self.controller.detectors != detectors:
+                self._make_detectors()
+            if isinstance(values, FlagParams):
+                self._publish_config()
+
+    # -- in ----------------------------------------------------------------------------------
+    def _on_adjust(self, msg):
+        try:
+            self.controller.adjust(**core_messages.adjust_pairs(msg))
+        except ValueError as err:
+            self._reject('adjust', str(err))
+
+    def _on_config(self, msg):
+        try:
+            name = config_command(msg.data)
+        except ValueError as err:
+            return self._reject('config', str(err))
+        if name is not None:
+            # Through the parameters, so that `ros2 param get` and the log agree.
+            from rclpy.parameter import Parameter
+
+            value = not getattr(self.animal_config.flags, name)
+            self.set_parameters([Parameter(name, value=value)])
+        self._publish_config()
+
+    # -- out ---------------------------------------------------------------------------------
+    def _on_tick(self):
+        super()._on_tick()
+        if self.last_action is not None and self._last_tick is not None:
+            self._publish_core()
+
+    def _publish(self, key, msg):
+        _, publisher = self.pub_core[key]
+        publisher.publish(msg)
+
+    def _publish_core(self):
+        animal = self.controller
+        self._publish('animal_state', core_messages.animal_state(animal, self._last_tick))
+        self._publish('selection_priority', Float32MultiArray(
+            data=[float(v) for v in animal.priorities]))
+        self._publish('selection_inhibition', Float32MultiArray(
+            data=core_messages.inhibition(animal)))
+        self._publish('selection_action', String(data=animal.selected_name))
+        self._publish('priority_peak', core_messages.priority_peak(animal.target))
+        percepts_eyes = self.percepts(self._last_tick).eyes
+        for index, (eye, name) in enumerate(zip(percepts_eyes, EYES)):
+            key = 'detect_objects_' + name
+            if self.pub_core[key][1].get_subscription_count():
+                self._publish(key, core_messages.objects(index, eye))
+
+    def _publish_config(self):
+        self._publish('config_state', String(data=letters_on(self.animal_config.flags)))
+
+
+def _miro2(name):
+    from importlib import import_module
+
+    return getattr(import_module('miro2_msg.msg'), name)
+
+
+def build_parser():
+    lines = params.help_lines(*GROUPS)
+    lines += ['', 'actions: ' + ', '.join(ACTIONS),
+              '', "demo mode's topics, relative to the robot's namespace:"]
+    lines += ['  %-4s %-28s %s, %s' % ('in' if row.direction == CORE_IN else 'out', row.name,
+                                         row.type, row.about) for row in CORE_INTERFACE]
+    lines += ['', 'and the controller\'s inputs and outputs (python -m miro_ball.controller '
+                  '--help), with sensors/mics and control/stream.',
+              'The robot: --ros-args -r __ns:=/NAME, --robot NAME or $MIRO_ROBOT_NAME. '
+              '-p fast_sleep:=true runs the sleep cycle 25 times faster.']
+    parser = controller_node._Parser(
+        prog='miro_animal',
+        description="MiRo's demo mode for ROS 2: an animal that notices balls, faces, tags, "
+                    "motion and sounds, chooses what to do, feels, sleeps and shows it "
+                    "(docs/demo_mode.md). Ctrl+C stops it with a zero twist.",
+        epilog='\n'.join(lines), formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('--robot', metavar='NAME',
+                        help='the robot (its namespace); default $MIRO_ROBOT_NAME, else miro')
+    return parser
+
+
+def main(argv=None):
+    argv = list(sys.argv if argv is None else argv)
+    parser = build_parser()
+    options = parser.parse_args(user_args(argv, parser.prog, GROUPS, NODE_NAME))
+    return controller_node.run(parser, options, MiroAnimal, argv)
+
