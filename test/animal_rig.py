@@ -35,13 +35,16 @@ class AnimalRig:
         return self.node.frames_processed + sum(self.node.rejected.values())
 
     def advance(self):
+        """One platform tick; then callbacks until demo mode has ticked at this instant with
+        every frame and microphone block of it taken in."""
         published, seen = self.sim_node.frames_published, self.frames_seen()
         self.sim_node.advance(self.sim.ticks_per_platform_tick)
         wanted = seen + self.sim_node.frames_published - published
+        mics = self.sim_node.robots[self.robot.name]
         now = self.sim.time
         deadline = time.monotonic() + TICK_TIMEOUT_S
-        while not (self.frames_seen() >= wanted and self.node.last_tick is not None
-                   and self.node.last_tick >= now - 1e-9):
+        while not (self.frames_seen() >= wanted and self.node.mic_blocks >= mics.mic_blocks
+                   and self.node.last_tick is not None and self.node.last_tick >= now - 1e-9):
             if time.monotonic() > deadline:
                 raise TimeoutError(f'demo mode did not tick at {now:.2f} s')
             self.executor.spin_once(timeout_sec=0.01)

@@ -114,6 +114,19 @@ def test_noise_from_the_left_reaches_the_left_ear_first_and_louder_less_so_facin
         world.close()
 
 
+def test_a_short_sound_is_heard_once_not_again_a_ring_later(three):
+    """A quarter-second chirp from a's speaker: b hears it, then nothing but its own noise
+    floor for the next two seconds (the ring's old samples came back 0.82 s later once)."""
+    three.robots['a'].speaker.append(
+        (8000 * np.sin(np.arange(2000) * 2 * np.pi * 600 / 8000)).astype(np.int16))
+    ears = hear(three, 2.5)['b']
+    levels = [max(level_db(channel) for channel in ears[:, i:i + MIC_BLOCK_SAMPLES])
+              for i in range(0, ears.shape[1], MIC_BLOCK_SAMPLES)]
+    loud = [i for i, level in enumerate(levels) if level > -50]
+    assert loud and max(loud) - min(loud) <= 12, levels  # 0.25 s and the way: ~11 blocks
+    assert all(level < -55 for level in levels[max(loud) + 2:]), levels
+
+
 TUNE = str(bundled_sound('radio_tune.ogg'))
 
 

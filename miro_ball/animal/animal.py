@@ -35,6 +35,7 @@ SONAR_BAND_M = (0.10, 0.25)  # the MDK's sonar modulation: stop at the near end,
 SHUN_SPEED, SHUN_TURN = 0.1, 1.5  # backing off a drop, m/s and rad/s
 LOUD = 0.5  # a sound this loud (0..1 of the loud range) wakes and startles
 MAX_DT = 0.2  # a longer gap (a paused simulator) counts as this much
+HEARD_FOR_S = 0.6  # a sound is in the percepts this long after it ends (stale_s, a block)
 
 
 class Animal:
@@ -114,11 +115,13 @@ class Animal:
         stimuli = [s for s in self.senses.sights(percepts, include_motion=still)
                    if s.kind != 'face' or flags.salience_faces]
         heard = self.senses.sound(percepts.sound, joints)
-        self.loudness = heard.strength if heard is not None else 0.0
+        vocalising = t < self._vocalising_until
+        # MiRo's own voice is the loudest thing it hears: it neither startles nor wakes it.
+        self.loudness = heard.strength if heard is not None and not vocalising else 0.0
         if heard is not None and flags.salience_sound:
             stimuli.append(heard)
         self.stimuli = stimuli
-        self.peak = self.map.update(dt, stimuli, self_noisy=t < self._vocalising_until)
+        self.peak = self.map.update(dt, stimuli, self_noisy=vocalising)
         self.target = self.map.target(self.peak)
         if self.target is not None:
             self._target_at = t
@@ -128,7 +131,7 @@ class Animal:
         self._had_motion = motion
         touches = self.feel.feel(percepts.touch_head, percepts.touch_body)
         light = float(np.mean(percepts.light)) if percepts.light else 0.5
-        loud = self.loudness >= LOUD and t >= self._vocalising_until
+        loud = self.loudness >= LOUD
         if flags.sleep:
             stimulation = min(1.0, touches.touched + self.loudness + 0.5 * (self.target
                                                                             is not None))
@@ -214,7 +217,8 @@ class Animal:
         if not (self.config.flags.voice and occasion and t >= self._voice_ready_at):
             return {}
         self._voice_ready_at = t + express.voice_refractory_s
-        self._vocalising_until = t + length_s(emotion.valence) + 0.2  # and its echo
+        # Heard until the last block of it is out of date (stale_s of the node: 0.5 s).
+        self._vocalising_until = t + length_s(emotion.valence) + HEARD_FOR_S
         if express.voice_via == 'tone':
             return {'tone': as_tone(emotion.valence, emotion.arousal, express.voice_volume)}
         samples = vocalise(emotion.valence, emotion.arousal, express.voice_volume, self.rng)

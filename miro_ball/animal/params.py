@@ -79,7 +79,8 @@ class SpatialParams:
     gain_tag: float = knob(0.5, 'salience of an AprilTag', 0.0, 10.0)
     gain_motion: float = knob(0.6, 'salience of motion (times its size, up to 1)', 0.0, 10.0)
     gain_sound: float = knob(5.0, 'salience of a sound at full loudness', 0.0, 20.0)
-    gain_sound_self: float = knob(1.0, 'salience of sounds while MiRo itself vocalises',
+    gain_sound_self: float = knob(0.0, 'salience of sounds while MiRo itself vocalises (the '
+                                       'MDK: 1; its own voice is the loudest sound it hears)',
                                   0.0, 20.0)
     sound_range_m: float = knob(2.0, 'a sound is taken to be this far', 0.1, 20.0)
     sound_height_m: float = knob(0.6, 'and this high', 0.0, 5.0)

@@ -121,6 +121,7 @@ class KickBlueBall(Node):
 
     state             the controller's state name ('startup' while holding the head)
     frames_processed  camera frames decoded and run through the detectors
+    mic_blocks        microphone blocks taken in (while the controller hears)
     rejected          Counter of ignored inputs by kind (empty, corrupt, size, cliff,
                       camera_info)
     cameras           each eye's camera model (camera_model.CameraModel) from its latest
@@ -157,6 +158,7 @@ class KickBlueBall(Node):
         self.readings = {key: Latest() for key in ('sonar', 'light', 'joints', 'sound')
                          + TOUCH_PARTS}
         self._mics = None  # the microphones' subscription, while the controller hears
+        self.mic_blocks = 0  # microphone blocks taken in
         self.cameras = list(DEFAULT_CAMERAS)
         # Each eye's pinhole at the size of the frame its latest detection came from.
         self._frame_cameras = list(DEFAULT_CAMERAS)
@@ -357,6 +359,7 @@ class KickBlueBall(Node):
         self.readings['joints'].set(self._seconds(), joints)
 
     def _on_mics(self, msg):
+        self.mic_blocks += 1
         try:
             window = mic_window(msg.data)
         except ValueError as err:

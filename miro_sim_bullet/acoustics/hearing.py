@@ -114,8 +114,11 @@ class Acoustics:
                            * rms_scale(WHEEL_NOISE_DB) * speed / WHEEL_MAX_SPEED_M_PER_S))
         for row, samples in chunks:
             if samples is None:
-                if self._loud_until[row] <= n0 - _QUIET_AFTER:
-                    continue  # silent for long: its ring holds zeros already
+                if self._loud_until[row] <= n0 - HISTORY:
+                    continue  # silent a whole ring's length: it holds nothing but zeros
+                # (Zeros until then: a block read up to _QUIET_AFTER after the last sound
+                # reaches past it, and a sound that starts again reads a little before its
+                # start; what the ring held from a ring's length ago would be heard again.)
                 samples = np.zeros(TICK)
             else:
                 self._loud_until[row] = n0 + TICK

@@ -63,6 +63,7 @@ class RobotInterface:
                  'control_flags': self._on_flags}
         self.pub_eyes = {eye: [None] * 3 for eye in EYES}
         self.streams = {}  # rate -> [(producer, fields, publisher)]
+        self.mic_blocks = 0  # published (in-process rigs wait until a listener has them all)
         self._publishers = {}  # (row key, its placeholder's value if any) -> publisher
         self.subs = []
         self.controls = []  # (topic, the type it takes)
@@ -182,6 +183,7 @@ class RobotInterface:
 
     def publish_mics(self, samples):
         """One block of the microphones, int16 (channels, samples), channel by channel."""
+        self.mic_blocks += 1
         self.pub_mics.publish(_mics_prefix(*samples.shape) + samples.astype('<i2').tobytes())
 
     def wanted_eyes(self):
