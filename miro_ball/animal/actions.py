@@ -5,8 +5,8 @@ pattern). The MDK's set: mull, orient, approach, avert, flee, retreat, halt, sea
 Priorities are 0..1 (the MDK's levels: idle 0.1, low 0.25, medium 0.5, high 0.75,
 uninterruptable 1). Angles are in MiRo's body frame (+ left); a Motor is forward speed
 (m/s), turn rate (rad/s, + left) and head targets (None: leave the head where it is).
-An action that ran its course rests (no priority) for as long as it ran, so the next
-one gets its turn.
+A running action keeps the priority it started with until its pattern is done; then it
+rests (no priority) for as long as it ran, so the next one gets its turn.
 """
 import math
 from typing import NamedTuple, Optional
@@ -52,20 +52,28 @@ class Action:
         self.params, self.flags = params, flags
         self.started = self.resting_until = -math.inf
         self.finished = False
+        self.running = None  # the priority it started with, while it runs
 
     def priority(self, s):
         if s.t < self.resting_until:
             return 0.0
-        return _clamp(self.want(s), 0.0, 1.0)
+        want = _clamp(self.want(s), 0.0, 1.0)
+        if self.running is not None:
+            # Committed: a running action keeps the priority it won with until its pattern
+            # is done, so it is not dropped half-way (and nothing dithers).
+            return max(want, self.running)
+        return want
 
     def want(self, s):
         raise NotImplementedError
 
     def start(self, s):
+        self.running = _clamp(self.want(s), 0.0, 1.0)
         self.started, self.finished = s.t, False
 
     def stop(self, s):
         """Deselected (or finished): rest for as long as it ran."""
+        self.running = None
         self.resting_until = s.t + (s.t - self.started) if self.finished else s.t
 
     def motor(self, s):

@@ -152,8 +152,8 @@ class Animal:
             self.selected = chosen
         action = self.actions[chosen]
         motor = action.motor(situation)
-        if action.finished:
-            action.stop(situation)
+        if action.finished and t - action.started >= self.config.action.min_duration_s:
+            action.stop(situation)  # (a pattern done sooner holds its end till then)
 
         wheels = self._reflexes(motor.forward, motor.turn, percepts, wakefulness)
         head = self._head_pose(motor, t, wakefulness)

@@ -193,6 +193,9 @@ class AffectParams:
                                   'touches itself with its head)', 0, 0x3FFF)
     head_pads: int = knob(0x3FFF, 'head pads that count (bits)', 0, 0x3FFF)
 
+    def __post_init__(self):
+        check_ranges(self)
+
 
 @dataclass(frozen=True)
 class SleepParams:

@@ -1,7 +1,7 @@
 """Action selection: which action runs, from their priorities.
 
 The basal ganglia (the MDK's model, ours in code): every action's priority, with a little
-noise, competes; the winner is disinhibited (its inhibition 0, every other's 1) and
+noise (up to +- selection_noise), competes; the winner is disinhibited (its inhibition 0, every other's 1) and
 drives the body. The running action gets a bonus (hysteresis), so two actions of nearly
 equal priority do not take turns every tick, and it keeps running for min_duration_s
 unless a challenger reaches the uninterruptable priority 1.
@@ -22,7 +22,7 @@ class BasalGanglia:
 
     def select(self, t, priorities):
         p = self.params
-        noisy = [value + p.selection_noise * self.rng.standard_normal() for value in priorities]
+        noisy = [value + p.selection_noise * self.rng.uniform(-1.0, 1.0) for value in priorities]
         current = self.selected
         if current is not None:
             noisy[current] += p.hysteresis

@@ -65,9 +65,12 @@ class DetectionParams:
     max_radius: int = field(default=50, metadata={'help': 'largest ball radius (px @640)',
                                                   'range': (2, 1000)})
     # The other detectors (sights.py), for controllers that ask for them.
-    face_every: int = field(default=4, metadata={
-        'help': 'faces: look in one frame of this many per eye (a look costs ~40 ms)',
+    face_every: int = field(default=6, metadata={
+        'help': 'faces: look in one frame of this many per eye (a look costs ~25 ms)',
         'range': (1, 100)})
+    face_scale_step: float = field(default=1.25, metadata={
+        'help': 'faces: each size looked for is this much larger than the last (smaller '
+                'finds more, costs more)', 'range': (1.05, 2.0)})
     face_width: int = field(default=320, metadata={
         'help': 'faces: frames scaled down to this width first, px', 'range': (64, 1280)})
     face_min_px: int = field(default=20, metadata={

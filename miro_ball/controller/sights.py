@@ -56,7 +56,7 @@ class FaceDetector:
         height, width = grey.shape
         smallest = self.params.face_min_px
         found = self.cascade.detect_multi_scale(
-            grey, scale_factor=1.15, step_ratio=1, min_size=(smallest, smallest),
+            grey, scale_factor=self.params.face_scale_step, step_ratio=1, min_size=(smallest, smallest),
             max_size=(height, height))
         self.last = tuple(_normalised(f['c'] + f['width'] / 2, f['r'] + f['height'] / 2,
                                       f['width'], width, height) for f in found)
