@@ -1,0 +1,151 @@
+"""Demo mode on the simulated MiRo, in simulated time: what a user sees it do.
+
+The simulator and miro_animal share one executor, stepped a platform tick at a time
+(animal_rig.py); touches, balls and sounds are put in the world as the GUI's hand and a
+world file would; what is judged is the world's ground truth and what demo mode sent.
+"""
+import math
+
+import pytest
+
+from animal_rig import AnimalRig
+from miro_ball.miro.constants import LIFT_RAD_CALIB, YAW
+from miro_sim_bullet.scene.sounds import Sound
+
+FAR = (60.0, 60.0)  # where the ball goes when a test wants it out of the way
+
+
+@pytest.fixture
+def rig(ros_context):
+    made = []
+
+    def make(world='empty', **params):
+        made.append(AnimalRig(ros_context, world, **params))
+        return made[-1]
+    yield make
+    for each in made:
+        each.close()
+
+
+def wag_crossings(actions):
+    """How often the tail passed its middle (back and forth) in these actions."""
+    wags = [a.cosmetic[1] for _, a in actions]
+    return sum((a - 0.5) * (b - 0.5) < 0 for a, b in zip(wags, wags[1:]))
+
+
+def bearing_error(robot, target):
+    """Degrees between where MiRo's head points (body yaw + the neck's yaw, as they are in
+    the world) and the target."""
+    x, y, yaw = robot.pose()
+    towards = math.atan2(target[1] - y, target[0] - x)
+    head_yaw = robot.sensors.kinematic_positions[YAW]
+    return abs(math.degrees(math.remainder(towards - yaw - head_yaw, 2 * math.pi)))
+
+
+def stroke(rig, seconds, pads_per_s=10):
+    """A hand along MiRo's back, front to back and round again (both rows)."""
+    for i in range(int(seconds * 50)):
+        column = int(i / 50 * pads_per_s) % 7
+        rig.robot.touch('body', (1 << column) | (1 << (column + 7)))
+        rig.advance()
+
+
+def test_stroking_pleases_it_and_the_tail_wags_faster_a_hit_hurts(rig):
+    rig = rig()
+    rig.sim.place_ball(*FAR)
+    rig.run(3.0)
+    before = rig.animal.affect.emotion.valence
+    start = len(rig.actions)
+    rig.run(5.0)
+    calm_wags = wag_crossings(rig.actions[start:])
+    start = len(rig.actions)
+    stroke(rig, 5.0)
+    stroked = rig.actions[start:]
+    assert rig.animal.affect.emotion.valence >= before + 0.1
+    assert wag_crossings(stroked[len(stroked) // 2:]) > calm_wags  # 2.5 s against 5 s
+    assert any(a.stream for _, a in stroked)  # and it said so
+    pleased = rig.animal.affect.emotion.valence
+    for _ in range(3):
+        rig.robot.touch('body', 0x3FFF)  # slaps: every pad at once
+        rig.run(0.5)
+    assert rig.animal.affect.emotion.valence < pleased - 0.3
+
+
+def test_a_ball_ahead_is_approached(rig):
+    rig = rig()
+    rig.sim.place_ball(0.8, 0.0)
+    rig.run(0.2)
+
+    def distance():
+        x, y, _ = rig.robot.pose()
+        bx, by = rig.sim.ball_position()[:2]
+        return math.hypot(bx - x, by - y)
+    start = distance()
+    rig.run(10.0, until=lambda: distance() < start - 0.3)
+    assert distance() < start - 0.3
+    assert 'approach' in {a.state for _, a in rig.actions}
+
+
+def test_a_face_on_the_wall_is_noticed_and_looked_at(rig):
+    rig = rig('den')  # a photographed face on a board 1 m ahead
+    face = (1.0, 0.0)
+    rig.robot.place(0.0, 0.0, math.radians(-40))  # the face 40 deg to the left, in view
+
+    def looking_at_face():
+        target = rig.animal.target
+        return (target is not None and target.kind == 'face'
+                and bearing_error(rig.robot, face) < 15)
+    rig.advance()
+    assert bearing_error(rig.robot, face) > 35
+    took = rig.run(15.0, until=looking_at_face)
+    assert looking_at_face(), (rig.animal.target, rig.robot.pose())
+    assert took > 0.1  # it turned to look
+    assert any(stimulus.kind == 'face' for stimulus in rig.animal.stimuli)
+
+
+def test_a_loud_sound_behind_turns_it_round_and_arouses_it(rig):
+    rig = rig()
+    rig.sim.place_ball(*FAR)
+    rig.run(1.0)
+    x, y, yaw = rig.robot.pose()
+    behind = (x - 1.5 * math.cos(yaw), y - 1.5 * math.sin(yaw))
+    calm = rig.animal.affect.emotion.arousal
+    rig.sim.acoustics.add_sound(Sound('bang', (*behind, 0.3), 'noise', -10.0, stop=1.5))
+
+    turned, aroused = [], []
+    for _ in range(5 * 50):
+        rig.advance()
+        turned.append(bearing_error(rig.robot, behind))
+        aroused.append(rig.animal.affect.emotion.arousal)
+    assert turned[0] > 150 and min(turned) <= 90  # from behind to at most 90 deg off
+    assert max(aroused) > calm + 0.2
+
+
+def test_a_tired_miro_left_alone_falls_asleep_and_a_touch_wakes_it(rig, ros_context):
+    """The sleep cycle's timing is test_animal_parts' (fast_sleep: asleep within 3 min);
+    here MiRo starts tired, told so on core/animal/adjust as client_demo_interact does, and
+    what sleep looks like on the body is judged."""
+    from miro2_msg.msg import AnimalAdjust
+
+    rig = rig(fast_sleep=True)
+    rig.sim.place_ball(*FAR)
+    tell = rig.node.create_publisher(AnimalAdjust, 'core/animal/adjust', 10)
+    tired = AnimalAdjust()
+    tired.sleep.pressure.data, tired.sleep.pressure.gamma = 0.75, 1.0
+    rig.run(0.5)
+    tell.publish(tired)
+    rig.run(0.5)
+    assert rig.animal.sleep.state.pressure >= 0.74
+    rig.run(30.0, until=lambda: rig.animal.asleep)
+    rig.run(2.0)  # settled into sleep
+    assert rig.animal.asleep
+    settled = rig.actions[-50:]
+    assert all(a.cosmetic[2] >= 0.8 and a.cosmetic[3] >= 0.8 for _, a in settled)
+    assert all(a.wheels == (0.0, 0.0) for _, a in settled)
+    assert all(a.head[1] > LIFT_RAD_CALIB + 0.2 for _, a in settled)  # the head hangs
+    x, y, _ = rig.robot.pose()
+    rig.run(2.0)
+    assert math.dist(rig.robot.pose()[:2], (x, y)) < 0.005  # and the body is still
+    rig.robot.touch('head', 0b11 << 5)  # a gentle touch, two pads
+    rig.run(3.0)
+    assert not rig.animal.asleep and rig.node.last_action.cosmetic[2] < 0.5
