@@ -38,6 +38,7 @@ setup(
         'pybullet',
         'rosbags',  # rosbag2 (MCAP) recording without a ROS install
         'ruamel.yaml',  # rosbag2 metadata (rosbags uses it too)
+        'scikit-image',  # faces: its LBP frontal-face cascade (demo mode's face detector)
         'scipy',  # rotations (scipy.spatial.transform), the microphones' filters
         'soundfile',  # sound files: a world's sounds, the recorder's WAV, the audio clients
     ],
@@ -98,6 +99,9 @@ setup(
             'client_stream = miro_ball.examples.client_stream:main',
             'client_drive_voice = miro_ball.examples.client_drive_voice:main',
             'miro_foxglove = miro_ball.foxglove.__main__:main',
+            'miro_animal = miro_ball.animal.node:main',
+            'client_demo_config = miro_ball.examples.client_demo_config:main',
+            'client_demo_interact = miro_ball.examples.client_demo_interact:main',
         ],
     },
 )

@@ -9,6 +9,7 @@ import math
 import pytest
 
 from animal_rig import AnimalRig
+from miro_ball.examples import client_demo_config, client_demo_interact
 from miro_ball.miro.constants import LIFT_RAD_CALIB, YAW
 from miro_sim_bullet.scene.sounds import Sound
 
@@ -149,3 +150,38 @@ def test_a_tired_miro_left_alone_falls_asleep_and_a_touch_wakes_it(rig, ros_cont
     rig.robot.touch('head', 0b11 << 5)  # a gentle touch, two pads
     rig.run(3.0)
     assert not rig.animal.asleep and rig.node.last_action.cosmetic[2] < 0.5
+
+
+def run_client(rig, module, args, limit_s):
+    """Step demo mode's world until the client is done; its exit code (None: not done)."""
+    cls = {client_demo_config: client_demo_config.DemoConfig,
+           client_demo_interact: client_demo_interact.DemoInteract}[module]
+    client = cls(module.build_parser().parse_args(args + ['--robot', rig.robot.name]),
+                 context=rig.node.context)
+    rig.executor.add_node(client)
+    try:
+        rig.run(limit_s)
+    except SystemExit as done:
+        return done.code or 0
+    finally:
+        rig.executor.remove_node(client)
+        client.destroy_node()
+    return None
+
+
+def test_the_mdk_clients_switch_parts_and_nudge_the_state(rig, capsys):
+    rig = rig()
+    code = run_client(rig, client_demo_config, ['v', 'T'], limit_s=3.0)
+    out = capsys.readouterr().out
+    assert code == 0 and 'switches on: trnscudMSFBhaHm' in out and 'off: vT' in out
+    assert not rig.node.get_parameter('voice').value and not rig.animal.config.flags.tail
+    assert rig.run(1.0) and all(a.cosmetic[1] == 0.5 for _, a in rig.actions[-50:])  # no wag
+    code = run_client(rig, client_demo_config, ['--set', 'vtrn'], limit_s=3.0)
+    assert code == 0 and 'switches on: vtrn\n' in capsys.readouterr().out
+    before = rig.animal.affect.emotion.valence
+    code = run_client(rig, client_demo_interact, ['emotion+', '--seconds', '2'], limit_s=4.0)
+    lines = capsys.readouterr().out.splitlines()
+    assert code == 0 and len(lines) >= 3 and lines[-1].split()[4] == 'emotion', lines
+    assert rig.animal.affect.emotion.valence > before + 0.3
+    code = run_client(rig, client_demo_interact, ['sleep+', '--seconds', '2'], limit_s=4.0)
+    assert code == 0 and rig.animal.sleep.state.pressure > 0.3  # 1 - 0.975 ** 20 = 0.4

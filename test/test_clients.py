@@ -23,7 +23,7 @@ from rostools import Probe, advance_ticks, advance_until, kill_if_running, spin_
 T = RobotTopics(default_robot_name())
 CLIENTS = ('client_minimal', 'client_video', 'client_show', 'client_follower', 'client_test',
            'client_read_battery', 'client_tf', 'client_hear', 'client_audio', 'client_stream',
-           'client_drive_voice')
+           'client_drive_voice', 'client_demo_config', 'client_demo_interact')
 
 
 CLASSES = {client_minimal: client_minimal.Minimal, client_show: client_show.Show,

@@ -167,6 +167,7 @@ TOPIC = {row.key: row for row in ROBOT_INTERFACE}
 # robot's: what it shows of itself (out) and what clients tell it (in). The MDK's names;
 # core/selection/action is ours (the selected action by name).
 CORE_OUT, CORE_IN = 'core out', 'core in'
+COMMAND_QOS = Qos(depth=50)  # a client may send a toggle for every switch at once
 CORE_INTERFACE = tuple(Topic(*row) for row in (
     ('animal_state', 'core/animal/state', 'miro2_msg/msg/AnimalState', CORE_OUT, SENSOR_QOS,
      'emotion, mood (valence, arousal -1..1), sleep (wakefulness, pressure 0..1), flags'),
@@ -184,7 +185,7 @@ CORE_INTERFACE = tuple(Topic(*row) for row in (
      "the demo's switches as the MDK's letters (those on)"),
     ('animal_adjust', 'core/animal/adjust', 'miro2_msg/msg/AnimalAdjust', CORE_IN,
      CONTROL_QOS, 'nudge emotion, mood or sleep (the MDK\'s Adjust)'),
-    ('config_command', 'core/config/command', 'std_msgs/msg/String', CORE_IN, CONTROL_QOS,
+    ('config_command', 'core/config/command', 'std_msgs/msg/String', CORE_IN, COMMAND_QOS,
      "'f<letter>' toggles a switch, 'ping' asks for core/config/state"),
 ))
 CORE_TOPIC = {row.key: row for row in CORE_INTERFACE}
