@@ -77,6 +77,31 @@ def test_the_controller_survives_every_topic(ros_context, executor):
         rig.close()
 
 
+def test_demo_mode_survives_every_topic(ros_context):
+    """miro_animal (with the simulator, stepped between messages): every topic, then it
+    still notices a stroke."""
+    from animal_rig import AnimalRig
+
+    rig = AnimalRig(ros_context, 'empty')
+    try:
+        rig.run(0.5)
+        delivered = fuzz(rig.node, Probe(ros_context, rig.executor, 'fuzzer'), rig.executor,
+                         between=rig.advance)
+        topics = RobotTopics(rig.robot.name)
+        assert {topics.mics, topics.core('animal_adjust'), topics.core('config_command')} \
+            <= set(delivered) and min(delivered.values()) > 2
+        state = rig.animal.affect
+        assert all(math.isfinite(v) for v in (state.emotion.valence, state.mood.arousal))
+        before = state.emotion.valence
+        for i in range(100):
+            column = i // 5 % 7
+            rig.robot.touch('body', (1 << column) | (1 << (column + 7)))
+            rig.advance()
+        assert rig.animal.affect.emotion.valence > before + 0.05
+    finally:
+        rig.close()
+
+
 def test_the_gui_survives_every_topic(ros_context, executor):
     from miro_ball.gui.bridge import GuiBridge
 

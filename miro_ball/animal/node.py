@@ -9,6 +9,7 @@ core/config/command in. Every part's parameters are ROS parameters and change li
 import argparse
 import sys
 
+from sensor_msgs.msg import Image
 from std_msgs.msg import Float32MultiArray, String
 
 from miro_ball.animal.actions import ACTIONS
@@ -16,12 +17,18 @@ from miro_ball.animal.animal import Animal
 from miro_ball.animal import core_messages
 from miro_ball.animal.params import (AnimalNodeParams, Config, config_command, FlagParams,
                                      letters_on, PART_GROUPS)
+from miro_ball.animal.map_view import map_in_eye
 from miro_ball.common import params
+from miro_ball.common.messages import message_class
 from miro_ball.common.cli import user_args
 from miro_ball.common.qos import profile
 from miro_ball.controller.detection import DetectionParams
 from miro_ball.controller import node as controller_node
-from miro_ball.miro.interface import CORE_IN, CORE_INTERFACE, CORE_TOPIC, EYES, RobotTopics
+from miro_ball.miro.body import optical_frame
+from miro_ball.miro.constants import KIN_CALIB_RAD
+from miro_ball.miro.interface import (CORE_IN, CORE_INTERFACE, CORE_TOPIC, EYES, frame_id,
+                                      RobotTopics)
+from miro_ball.miro.kc import EYE_FRAMES, KinematicChain
 
 NODE_NAME = 'miro_animal'
 GROUPS = (AnimalNodeParams, DetectionParams) + PART_GROUPS
@@ -43,19 +50,18 @@ class MiroAnimal(controller_node.KickBlueBall):
 
     def _core_publishers(self):
         names = RobotTopics()
+        self._kc = KinematicChain(KIN_CALIB_RAD)
         self.pub_core = {}
         for row in CORE_INTERFACE:
             if row.direction == CORE_IN:
                 continue
-            kind = {'animal_state': 'AnimalState', 'priority_peak': 'PriorityPeak',
-                    'detect_objects': 'Objects'}.get(row.key)
-            msg_type = _miro2(kind) if kind else (String if row.type.endswith('String')
-                                                  else Float32MultiArray)
+            msg_type = message_class(row.type)
             for fields, _ in row.names():
                 key = row.key + ''.join('_' + v for v in fields.values())
                 self.pub_core[key] = (msg_type, self.create_publisher(
                     msg_type, names.core(row.key, **fields), profile(row.qos)))
-        self.create_subscription(_miro2('AnimalAdjust'), names.core('animal_adjust'),
+        self.create_subscription(message_class(CORE_TOPIC['animal_adjust'].type),
+                                 names.core('animal_adjust'),
                                  self._on_adjust, profile(CORE_TOPIC['animal_adjust'].qos))
         self.create_subscription(String, names.core('config_command'), self._on_config,
                                  profile(CORE_TOPIC['config_command'].qos))
@@ -125,20 +131,33 @@ class MiroAnimal(controller_node.KickBlueBall):
             data=core_messages.inhibition(animal)))
         self._publish('selection_action', String(data=animal.selected_name))
         self._publish('priority_peak', core_messages.priority_peak(animal.target))
-        percepts_eyes = self.percepts(self._last_tick).eyes
-        for index, (eye, name) in enumerate(zip(percepts_eyes, EYES)):
-            key = 'detect_objects_' + name
-            if self.pub_core[key][1].get_subscription_count():
-                self._publish(key, core_messages.objects(index, eye))
+        percepts = None
+        for index, name in enumerate(EYES):
+            objects, view = 'detect_objects_' + name, 'attention_view_' + name
+            if self._listened(objects) or self._listened(view):
+                percepts = percepts or self.percepts(self._last_tick)
+                eye = percepts.eyes[index]
+            if self._listened(objects):
+                self._publish(objects, core_messages.objects(index, eye))
+            if self._listened(view):  # only for a viewer: it costs a millisecond
+                self._publish(view, self._attention_view(eye.camera, name, percepts.joints))
+
+    def _listened(self, key):
+        return self.pub_core[key][1].get_subscription_count() > 0
+
+    def _attention_view(self, camera, eye, joints):
+        self._kc.set_joints(*(joints or KIN_CALIB_RAD))
+        animal = self.controller
+        picture = map_in_eye(animal.map.values, camera, self._kc, EYE_FRAMES[eye],
+                             4 * animal.config.spatial.peak_threshold)
+        msg = Image(height=picture.shape[0], width=picture.shape[1], encoding='mono8',
+                    step=picture.shape[1], data=picture.tobytes())
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = frame_id(self.robot, optical_frame(eye))
+        return msg
 
     def _publish_config(self):
         self._publish('config_state', String(data=letters_on(self.animal_config.flags)))
-
-
-def _miro2(name):
-    from importlib import import_module
-
-    return getattr(import_module('miro2_msg.msg'), name)
 
 
 def build_parser():

@@ -194,8 +194,14 @@ def _eye(name, side):
                 matrix_rpy(rotation))
 
 
+def optical_frame(eye):
+    """The link of an eye's optical frame (z along the view, x right: ROS's camera frame),
+    where its images and camera_info are stamped."""
+    return f'{eye}_optical'
+
+
 def _optical(eye):
-    return Link(f'{eye}_optical', eye, f'{eye}_optical_joint', FIXED, (0.0, 0.0, 0.0),
+    return Link(optical_frame(eye), eye, f'{eye}_optical_joint', FIXED, (0.0, 0.0, 0.0),
                 matrix_rpy(OPTICAL_IN_CAMERA))
 
 

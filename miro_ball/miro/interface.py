@@ -181,6 +181,8 @@ CORE_INTERFACE = tuple(Topic(*row) for row in (
      SENSOR_QOS, 'the attention map\'s peak: azimuth, elevation (body frame), height, range'),
     ('detect_objects', 'core/detect_objects_{eye}', 'miro2_msg/msg/Objects', CORE_OUT,
      SENSOR_QOS, 'what the detectors found in each eye (balls, faces, tags)'),
+    ('attention_view', 'core/attention_{eye}', 'sensor_msgs/msg/Image', CORE_OUT, SENSOR_QOS,
+     'the attention map as each eye sees it, mono8 64x36 (the MDK\'s core/pril, prir)'),
     ('config_state', 'core/config/state', 'std_msgs/msg/String', CORE_OUT, SENSOR_QOS,
      "the demo's switches as the MDK's letters (those on)"),
     ('animal_adjust', 'core/animal/adjust', 'miro2_msg/msg/AnimalAdjust', CORE_IN,

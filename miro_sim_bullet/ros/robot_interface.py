@@ -17,6 +17,7 @@ from std_msgs.msg import Int16MultiArray, MultiArrayDimension, UInt16
 from miro_ball.common.checks import finite, finite_values
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
+from miro_ball.miro.body import optical_frame
 from miro_ball.miro.constants import JOINT_NAMES, JOINT_POSITIONS
 from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id, MICS,
                                       ONCE, ROBOT_INTERFACE, RobotTopics, SimTopics, TOPIC,
@@ -203,7 +204,7 @@ class RobotInterface:
         None) as render.eye_images encoded them, and its camera_info."""
         compressed, raw, info = self.pub_eyes[eye]
         jpeg, rgb = frame
-        optical = frame_id(self.name, f'{eye}_optical')
+        optical = frame_id(self.name, optical_frame(eye))
         if jpeg is not None:
             compressed.publish(convert.compressed_image(jpeg, when, optical))
         if rgb is not None:
