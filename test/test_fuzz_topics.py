@@ -105,26 +105,29 @@ def test_demo_mode_survives_every_topic(ros_context):
 def test_the_gui_survives_every_topic(ros_context, executor):
     from miro_ball.gui.bridge import GuiBridge
 
-    from miro_ball.gui.protocol import Hear, View
+    from miro_ball.gui.protocol import Demo, Hear, View
     from miro_ball.miro.interface import EYES
 
     name = default_robot_name()
     bridge = GuiBridge(name, context=ros_context)
     executor.add_node(bridge)
     try:
-        # A page showing everything: the eyes, the world and the microphones, so every
-        # subscription is made.
+        # A page showing everything: the eyes, the world, the microphones and demo mode, so
+        # every subscription is made.
         bridge.open(1)
         bridge.submit(View(frozenset(EYES), True), owner=1)
         bridge.submit(Hear(0, True, True), owner=1)
+        bridge.submit(Demo(True), owner=1)
         assert spin_until(executor, lambda: name in bridge.watches and bridge._scene_subs
-                          and bridge.watches[name]._mics_sub is not None)
+                          and bridge.watches[name]._mics_sub is not None
+                          and bridge.watches[name]._demo_subs)
         probe = Probe(ros_context, executor, 'fuzzer')
         # The bridge's own topics, then those of its robot part (in the robot's namespace).
         delivered = {**fuzz(bridge, probe, executor),
                      **fuzz(bridge.watches[name], probe, executor)}
         assert RobotTopics(default_robot_name()).package in delivered  # every readout
         assert RobotTopics(default_robot_name()).mics in delivered
+        assert RobotTopics(default_robot_name()).core('animal_state') in delivered
         assert min(delivered.values()) > 2
         json.loads(bridge.state(1))  # the page's readouts still make valid JSON
     finally:

@@ -515,3 +515,30 @@ def test_a_click_in_the_world_view_places_a_sound_and_a_click_on_it_stops_it(rig
     assert rig.until(lambda: not acoustics.sounds), f'{name} still plays'
     page.close()
     assert not rig.errors
+
+
+def test_demo_mode_is_started_watched_and_stopped_from_the_page(rig, tmp_path):
+    """The demo panel: its button runs miro_animal for the page's robot; the page shows the
+    selected action, every action's priority, the affect and sleep, and the attention map
+    over the eyes; the other button stops it."""
+    page = rig.open_page()
+    page.locator('#demo summary').click()
+    page.locator('#demo_start').click()
+    actions = page.evaluate('miroGui.config.actions')
+    assert 'approach' in actions and 'mull' in actions
+
+    def shown():
+        return page.evaluate("""() => {
+          const d = miroGui.demo;
+          return !!(d && d.state && Array.isArray(d.priorities) && d.action
+                    && (miroGui.demoOverlays || 0) > 2);
+        }""")
+    assert rig.until(shown, wall_guard_s=90.0), page.evaluate('miroGui.state.status')
+    assert page.locator('#demo_action').inner_text() in actions
+    assert ROBOT in page.evaluate('miroGui.state.demo_running')
+    assert 0.0 <= float(page.locator('#demo_wake').inner_text()) <= 1.0
+    page.screenshot(path=str(tmp_path / 'demo_panel.png'), full_page=True)
+    page.locator('#demo_stop').click()
+    assert rig.until(lambda: not page.evaluate('miroGui.state.demo_running'))
+    page.close()
+    assert not rig.errors

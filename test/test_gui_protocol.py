@@ -81,6 +81,8 @@ def test_the_world_views_messages():
         p.Hear(3, True, True)
     assert parse({'t': 'sound', 'x': 1, 'y': 2, 'kind': 'tone'})[0] == p.PlaceSound(1.0, 2.0, 'tone')
     assert parse({'t': 'unsound', 'name': 'gui_sound1'})[0] == p.StopSound('gui_sound1')
+    assert parse({'t': 'demo', 'shown': True})[0] == p.Demo(True)
+    assert parse({'t': 'demo_run', 'run': False})[0] == p.DemoRun(False)
 
 
 @pytest.mark.parametrize('text', [
@@ -124,6 +126,8 @@ def test_the_world_views_messages():
     '{"t": "hear", "mic": 0, "listen": false}',
     '{"t": "sound", "x": 0, "y": 0, "kind": "bang"}', '{"t": "sound", "x": 0, "y": NaN, "kind": "tone"}',
     '{"t": "unsound", "name": "\\n[[sound]]"}',
+    '{"t": "demo", "shown": 1}', '{"t": "demo_run", "run": "yes"}', '{"t": "demo_run"}',
+    '{"t": "demo", "shown": true, "robot": "miro"}',
 ])
 def test_malformed_messages_are_rejected_with_a_one_line_reason(text):
     with pytest.raises(p.Rejected) as err:
@@ -412,3 +416,45 @@ def test_the_pages_hearing_levels_spectrum_and_sound():
     assert np.array_equal(np.frombuffer(base64.b64decode(heard['data']), '<i2'), tone)
     text, cut = speaker_message(np.ones(MAX_AUDIO_SAMPLES + 5, np.int16))
     assert cut and len(base64.b64decode(json.loads(text)['data'])) == 2 * MAX_AUDIO_SAMPLES
+
+
+def test_demo_modes_topics_become_what_the_page_draws_and_garbage_is_refused():
+    import base64
+
+    from miro2_msg.msg import AnimalState, ObjectBall, ObjectFace, ObjectTag, Objects
+    from sensor_msgs.msg import Image
+    from std_msgs.msg import Float32MultiArray, String
+
+    from miro_ball.animal.actions import ACTIONS
+    from miro_ball.gui import demo
+
+    state = AnimalState()
+    state.emotion.valence, state.sleep.wakefulness = 0.5, 0.25
+    assert demo.animal_state(state) == {'emotion': [0.5, 0.0], 'mood': [0.0, 0.0],
+                                        'sleep': [0.25, 0.0]}
+    state.mood.arousal = math.nan
+    with pytest.raises(ValueError):
+        demo.animal_state(state)
+    assert demo.priorities(Float32MultiArray(data=[0.5] * len(ACTIONS))) == [0.5] * len(ACTIONS)
+    for bad in ([0.5] * (len(ACTIONS) + 1), [math.inf] * len(ACTIONS)):
+        with pytest.raises(ValueError):
+            demo.priorities(Float32MultiArray(data=bad))
+    assert demo.action(String(data='orient')) == 'orient'
+    with pytest.raises(ValueError):
+        demo.action(String(data='<script>'))
+    found = Objects(balls=[ObjectBall(centre=[0.5, 0.25], radius=0.125)],
+                    faces=[ObjectFace(corner=[0.25, 0.5], size=[0.125, 0.25])],
+                    tags=[ObjectTag(id=3, centre=[0.75, 0.5])])
+    assert demo.objects(found) == [
+        {'kind': 'ball', 'x': 0.5, 'y': 0.25, 'r': 0.125},
+        {'kind': 'face', 'x': 0.25, 'y': 0.5, 'w': 0.125, 'h': 0.25},
+        {'kind': 'tag 3', 'x': 0.75, 'y': 0.5}]
+    assert len(demo.objects(Objects(tags=[ObjectTag()] * 100))) == 20  # bounded
+    view = demo.attention_view(Image(width=4, height=2, step=4, encoding='mono8',
+                                     data=bytes(range(8))))
+    assert base64.b64decode(view['data']) == bytes(range(8))
+    for bad in (Image(width=4, height=2, step=4, encoding='rgb8', data=bytes(24)),
+                Image(width=4, height=2, step=4, encoding='mono8', data=bytes(3)),
+                Image(width=4000, height=2000, step=4000, encoding='mono8', data=bytes(10))):
+        with pytest.raises(ValueError):
+            demo.attention_view(bad)

@@ -34,6 +34,7 @@ from miro_ball.common.qos import profile
 from miro_ball.common.robots import robots_running
 from miro_ball.common.throttle import Throttled
 from miro_ball.gui import protocol as p
+from miro_ball.gui.demo import DemoRunner
 from miro_ball.gui import readouts as r
 from miro_ball.gui.frames import FrameStore
 from miro_ball.gui.robot_part import NODE_NAME, PUBLISHED, RobotPart
@@ -63,6 +64,7 @@ class _Page:
     channels: frozenset = DEFAULT_VIEW[0]
     world: bool = DEFAULT_VIEW[1]
     hearing: bool = False  # its Hearing panel is open
+    demo: bool = False  # its demo-mode panel is open
 
 
 @dataclass(frozen=True)
@@ -89,6 +91,7 @@ class GuiBridge(Node):
         self.on_frame = on_frame if on_frame is not None else (lambda channel: None)
         self.on_event = on_event if on_event is not None else (lambda owners, text: None)
         self.images = FrameStore(self.warn, self.on_frame)
+        self.demo = DemoRunner()  # demo mode processes the pages started
         self.sim = SimLink(self, self._report, self.warn)
         self._lock = threading.Lock()
         # Pages coming and going apart from their commands, so a flood of commands (whose
@@ -116,6 +119,7 @@ class GuiBridge(Node):
         self.create_timer(DISCOVERY_PERIOD_S, self._discover)
 
     def destroy_node(self):
+        self.demo.stop_all()
         for name in list(self.watches):
             self._drop_watch(name)
         super().destroy_node()
@@ -182,6 +186,7 @@ class GuiBridge(Node):
             'sim': sim,
             'rtf_set': self.sim.rtf_set,
             'status': contested or self.status,
+            'demo_running': self.demo.running(),
         }
         now = time.monotonic()
         states = {None: json.dumps(r.jsonable({
@@ -215,6 +220,8 @@ class GuiBridge(Node):
                 watch.stop('no page watches it')
             watch.watch_sensors(watching)
             watch.watch_mics(any(page.hearing for page in self.pages.values()
+                                 if page.robot == name))
+            watch.watch_demo(any(page.demo for page in self.pages.values()
                                  if page.robot == name))
             watch.show({ch for ch in shown.get(name, ()) if p.CHANNELS[ch] != 'overhead'})
             if not watching and name not in self.robots:
@@ -354,6 +361,19 @@ class GuiBridge(Node):
             watch.hear(command.mic, command.listen)
         return True
 
+    def _demo(self, page, command, owner):
+        page.demo = command.shown
+        return True
+
+    def _demo_run(self, page, command, owner):
+        if not command.run:
+            self.demo.stop(page.robot)
+            self.status = f'demo mode stopped for {page.robot}'
+            return False
+        failed = self.demo.start(page.robot)
+        self.status = failed or f'demo mode started for {page.robot}'
+        return False
+
     def _play_sound(self, page, command, owner):
         self.sim.play_sound(command.kind, command.x, command.y)
         return False
@@ -404,6 +424,8 @@ class GuiBridge(Node):
         if changed:
             self._update_subscriptions()
         self.sim.read_rtf()
+        for robot, said in self.demo.reap():
+            self.status = f'demo mode for {robot} ended: {said}'
 
 
 # The page's own commands, whatever robot it watches.
@@ -416,6 +438,8 @@ _PAGE_COMMANDS = {
     p.Place: GuiBridge._place,
     p.Hear: GuiBridge._hear,
     p.PlaceSound: GuiBridge._play_sound,
+    p.Demo: GuiBridge._demo,
+    p.DemoRun: GuiBridge._demo_run,
     p.StopSound: GuiBridge._stop_sound,
 }
 

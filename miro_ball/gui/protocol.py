@@ -14,6 +14,7 @@ import math
 import struct
 from dataclasses import dataclass
 
+from miro_ball.animal.actions import ACTIONS
 from miro_ball.miro.constants import (COSMETIC_CALIB, DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX,
                                       JOINT_LIMITS_RAD, LIFT, LIFT_RAD_CALIB, PITCH,
                                       PLATFORM_TICK_S, TILT_RAD, WHEEL_MAX_SPEED_M_PER_S, YAW)
@@ -137,6 +138,16 @@ class StopSound:
 
 
 @dataclass(frozen=True)
+class Demo:
+    shown: bool  # the page shows its demo-mode panel (demo mode's topics are read only then)
+
+
+@dataclass(frozen=True)
+class DemoRun:
+    run: bool  # start (true) or stop (false) demo mode for the page's robot
+
+
+@dataclass(frozen=True)
 class SetRtf:
     value: float  # the simulator's real_time_factor; 0 = as fast as possible
 
@@ -254,9 +265,7 @@ def _place(msg, clamped):
 
 
 def _hear(msg, clamped):
-    listen, shown = msg.get('listen'), msg.get('shown')
-    if not isinstance(listen, bool) or not isinstance(shown, bool):
-        raise Rejected('listen and shown must be true or false')
+    listen, shown = _flag(msg, 'listen'), _flag(msg, 'shown')
     out_of_range = []
     mic = _integer(msg, 'mic', 0, len(MICS) - 1, out_of_range)
     if out_of_range:
@@ -277,6 +286,13 @@ def _unsound(msg, clamped):
         return StopSound(check_name(msg.get('name'), 'sound name'))
     except ValueError as err:
         raise Rejected(str(err)) from None
+
+
+def _flag(msg, key):
+    value = msg.get(key)
+    if not isinstance(value, bool):
+        raise Rejected(f'{key} must be true or false')
+    return value
 
 
 def _touch(msg, clamped):
@@ -308,6 +324,8 @@ KINDS = {
     'hear': (('mic', 'listen', 'shown'), _hear),
     'sound': (('x', 'y', 'kind'), _sound),
     'unsound': (('name',), _unsound),
+    'demo': (('shown',), lambda msg, clamped: Demo(_flag(msg, 'shown'))),
+    'demo_run': (('run',), lambda msg, clamped: DemoRun(_flag(msg, 'run'))),
     'rtf': (('value',), lambda msg, clamped: SetRtf(
         float(_number(msg, 'value', 0.0, MAX_RTF, clamped)))),
 }
@@ -353,7 +371,7 @@ def page_config():
             'tick_s': PLATFORM_TICK_S,
             'touch': {'rows': TOUCH_ROWS, 'columns': TOUCH_COLUMNS},
             'battery_marks': list(BATTERY_MARKS_V), 'mics': MICS,
-            'sound_kinds': SOUND_KINDS}
+            'sound_kinds': SOUND_KINDS, 'actions': ACTIONS}
 
 
 def frame_message(channel, stamp, jpeg):

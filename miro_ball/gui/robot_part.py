@@ -19,13 +19,14 @@ from miro_ball.common.messages import drive_command, message_class
 from miro_ball.common.qos import profile
 from miro_ball.controller.names import debug_topic
 from miro_ball.gui import protocol as p
+from miro_ball.gui import demo
 from miro_ball.gui import readouts as r
 from miro_ball.gui.hearing import MicMeter, speaker_message
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_NAMES
 from miro_ball.miro.hearing import mic_window
-from miro_ball.miro.interface import CONTROL_QOS, EYE_QOS, EYES, MIC_QOS, RobotTopics, \
-    SENSOR_QOS, TOPIC
+from miro_ball.miro.interface import CONTROL_QOS, CORE_TOPIC, EYE_QOS, EYES, MIC_QOS, \
+    RobotTopics, SENSOR_QOS, TOPIC
 from miro_ball.miro.rotations import yaw_of
 
 NODE_NAME = 'miro_gui'
@@ -132,6 +133,7 @@ class RobotPart(Node):
         self._image_subs = {}  # channel number: its subscriptions
         self.meter = MicMeter()
         self._mics_sub = None
+        self._demo_subs = []
 
     # -- what it reads ------------------------------------------------------------------------
     def watch_sensors(self, on):
@@ -171,6 +173,38 @@ class RobotPart(Node):
         else:
             self.destroy_subscription(self._mics_sub)
             self._mics_sub = None
+
+    def watch_demo(self, on):
+        """Subscribe to demo mode's topics (while a page shows its demo panel), or not; what
+        they say goes to the pages in the readouts' 'demo'."""
+        if on == bool(self._demo_subs):
+            return
+        for sub in self._demo_subs:
+            self.destroy_subscription(sub)
+        self._demo_subs = []
+        self.values.pop('demo', None)
+        if not on:
+            return
+        try:
+            for key, convert, slot in demo.READ:
+                row = CORE_TOPIC[key]
+                fields = {'eye': slot.rsplit('_', 1)[1]} if '{eye}' in row.name else {}
+                self._demo_subs.append(self.create_subscription(
+                    message_class(row.type), self.topics.core(key, **fields),
+                    self._demo_handler(convert, slot), profile(row.qos)))
+        except ValueError as err:  # miro2_msg not built
+            self.warn('demo', f'demo mode cannot be shown: {err}')
+
+    def _demo_handler(self, convert, slot):
+        def on_message(msg):
+            try:
+                value = convert(msg)
+            except (TypeError, ValueError, IndexError) as err:
+                self.warn(f'demo:{self.robot}', f'{self.robot}: demo mode\'s {slot} ignored: '
+                          f'{err}')
+                return
+            self.values.setdefault('demo', {})[slot] = value
+        return on_message
 
     def show(self, channels):
         """Subscribe to exactly these image channels (numbers) of the robot."""

@@ -303,6 +303,104 @@ function playAudio(message) {
   audioAt += buffer.duration;
 }
 
+// ---- demo mode: what the animal does, feels and attends to ---------------------------------
+let demoActions = [];
+
+function setUpDemo(config) {
+  demoActions = config.actions || [];
+  $('demo').addEventListener('toggle', () => send({ t: 'demo', shown: $('demo').open }));
+  $('demo_start').addEventListener('click', () => send({ t: 'demo_run', run: true }));
+  $('demo_stop').addEventListener('click', () => send({ t: 'demo_run', run: false }));
+}
+
+function showDemo(demo, state) {
+  const running = (state.demo_running || []).includes(state.robot);
+  $('demo_running').textContent = running ? `(runs for ${state.robot})` : '';
+  gui.demo = demo || null;
+  if (!$('demo').open || !demo) return;
+  $('demo_action').textContent = demo.action || '-';
+  if (Array.isArray(demo.priorities)) drawPriorities(demo.priorities, demo.action);
+  if (demo.state) drawAffect(demo.state);
+}
+
+function drawPriorities(values, selected) {
+  const canvas = $('demo_priorities');
+  const ctx = canvas.getContext('2d');
+  const row = canvas.height / Math.max(1, demoActions.length);
+  const left = 70;
+  ctx.clearRect(0, 0, canvas.width, canvas.height);
+  ctx.font = '12px system-ui, sans-serif';
+  ctx.textBaseline = 'middle';
+  demoActions.forEach((name, i) => {
+    const value = Math.min(Math.max(Number(values[i]) || 0, 0), 1);
+    const y = i * row;
+    ctx.fillStyle = '#333';
+    ctx.fillText(name, 4, y + row / 2);
+    ctx.strokeStyle = '#4a8bbf';
+    ctx.strokeRect(left + 0.5, y + 3.5, canvas.width - left - 8, row - 7);
+    ctx.fillStyle = name === selected ? '#2e7d32' : '#9ec3e0';
+    ctx.fillRect(left + 1, y + 4, (canvas.width - left - 9) * value, row - 8);
+  });
+}
+
+function drawAffect({ emotion, mood, sleep }) {
+  const canvas = $('demo_affect');
+  const ctx = canvas.getContext('2d');
+  const w = canvas.width, h = canvas.height;
+  const at = ([valence, arousal]) => [(valence + 1) / 2 * w, (1 - arousal) / 2 * h];
+  ctx.clearRect(0, 0, w, h);
+  ctx.strokeStyle = '#bbb';
+  ctx.beginPath(); ctx.moveTo(w / 2, 0); ctx.lineTo(w / 2, h); ctx.moveTo(0, h / 2); ctx.lineTo(w, h / 2);
+  ctx.stroke();
+  ctx.fillStyle = '#777';
+  ctx.font = '10px system-ui, sans-serif';
+  ctx.fillText('happy', w - 32, h / 2 - 3); ctx.fillText('sad', 2, h / 2 - 3);
+  ctx.fillText('alert', w / 2 + 3, 10); ctx.fillText('calm', w / 2 + 3, h - 3);
+  const [mx, my] = at(mood);
+  ctx.strokeStyle = '#6a1b9a'; ctx.lineWidth = 2;
+  ctx.beginPath(); ctx.arc(mx, my, 8, 0, 2 * Math.PI); ctx.stroke();
+  const [ex, ey] = at(emotion);
+  ctx.fillStyle = '#c62828';
+  ctx.beginPath(); ctx.arc(ex, ey, 5, 0, 2 * Math.PI); ctx.fill();
+  ctx.lineWidth = 1;
+  const [wake, pressure] = sleep;
+  $('demo_wake').textContent = fixed(wake, 2);
+  $('demo_pressure').textContent = fixed(pressure, 2);
+  $('demo_wake_bar').firstChild.style.width = `${100 * wake}%`;
+  $('demo_pressure_bar').firstChild.style.width = `${100 * pressure}%`;
+}
+
+// The attention map as this eye sees it, in red, and what the detectors found, labelled.
+function demoOverlay(ctx, eye, w, h) {
+  const demo = gui.demo;
+  if (!demo || !$('demo').open || !$('demo_overlay').checked) return;
+  const view = demo[`attention_view_${eye}`];
+  if (view && view.w > 0 && view.h > 0 && typeof view.data === 'string') {
+    const bytes = Uint8Array.from(atob(view.data), (c) => c.charCodeAt(0));
+    if (bytes.length === view.w * view.h) {
+      const small = new OffscreenCanvas(view.w, view.h);
+      const picture = small.getContext('2d').createImageData(view.w, view.h);
+      bytes.forEach((v, i) => picture.data.set([255, 40, 0, Math.round(0.6 * v)], 4 * i));
+      small.getContext('2d').putImageData(picture, 0, 0);
+      ctx.imageSmoothingEnabled = true;
+      ctx.drawImage(small, 0, 0, w, h);
+      gui.demoOverlays = (gui.demoOverlays || 0) + 1;
+    }
+  }
+  ctx.lineWidth = Math.max(1, w / 320);
+  ctx.font = `${Math.round(w / 40)}px system-ui, sans-serif`;
+  for (const thing of demo[`detect_objects_${eye}`] || []) {
+    const x = thing.x * w, y = thing.y * h;
+    ctx.strokeStyle = ctx.fillStyle = thing.kind === 'ball' ? '#00e5ff' : thing.kind === 'face' ? '#ffeb3b' : '#76ff03';
+    ctx.beginPath();
+    if (thing.kind === 'ball') ctx.arc(x, y, thing.r * w, 0, 2 * Math.PI);
+    else if (thing.kind === 'face') ctx.rect(x, y, thing.w * w, thing.h * h);
+    else ctx.rect(x - 6, y - 6, 12, 12);
+    ctx.stroke();
+    ctx.fillText(thing.kind, x + 4, y - 4);
+  }
+}
+
 // ---- images --------------------------------------------------------------------------------
 function onFrame(buffer) {
   const view = new DataView(buffer);
@@ -335,6 +433,7 @@ function draw(name, stamp, bitmap) {
   const ctx = canvas.getContext('2d');
   ctx.drawImage(bitmap, 0, 0);
   if (target !== 'overhead') crossHairs(ctx, bitmap.width, bitmap.height, target === 'caml' ? 0.75 : 0.25);
+  if (target === 'caml' || target === 'camr') demoOverlay(ctx, target, bitmap.width, bitmap.height);
   gui.frames[name] = (gui.frames[name] || 0) + 1;
   gui.drawn.push({ ch: name, stamp, at: performance.timeOrigin + now });
   if (gui.drawn.length > LOG_LENGTH) gui.drawn.splice(0, gui.drawn.length - LOG_LENGTH);
@@ -444,6 +543,7 @@ function showState(state) {
   $('pause').textContent = sim.paused ? 'resume' : 'pause';
   showRtfSet(state.rtf_set !== undefined ? state.rtf_set : sim.rtf_set);
   $('status').textContent = state.status;
+  showDemo(r.demo, state);
   $('fps').textContent = `${fps('caml')} / ${fps('camr')}`;
 }
 
@@ -609,6 +709,7 @@ function setUp(config) {
   if ($('headsliders').childElementCount) return;  // a reconnection: the controls are there
   batteryMarks(config.battery_marks);
   setUpHearing(config);
+  setUpDemo(config);
   if (config.touch && config.touch.rows > 0 && config.touch.columns > 0) {
     touchGrid = { rows: config.touch.rows, columns: config.touch.columns };
     drawBodyMap();
