@@ -318,3 +318,28 @@ def test_asleep_the_wheels_stop_and_the_head_hangs():
     assert action.wheels == (0.0, 0.0)
     assert action.cosmetic[2] >= 0.8 and action.head[1] > math.radians(50)
     assert animal.priorities and len(animal.priorities) == len(ACTIONS)
+
+
+def test_every_parameter_is_in_the_docs_and_a_part_can_be_replaced():
+    from dataclasses import fields
+    from pathlib import Path
+
+    from miro_ball.animal.params import PART_GROUPS
+    from miro_ball.controller.behaviour import BehaviourParams
+    from miro_ball.controller.controllers import make_controller
+
+    text = (Path(__file__).resolve().parent.parent / 'docs' / 'demo_mode.md').read_text()
+    # (the detectors' own are the controller's: docs/controller.md)
+    missing = [f.name for cls in (AnimalNodeParams,) + PART_GROUPS for f in fields(cls)
+               if f'`{f.name}`' not in text]
+    assert not missing
+    # The docs' own example selector, as -p selector:= names it: it dithers where the basal
+    # ganglia hold one action.
+    greedy = Animal(selector='miro_ball.examples.selector_greedy:Greedy')
+    assert greedy.act(percepts(0.0, ball_at(0.8, 0.0))).state
+    close = [[0.5 + 0.01 * (-1) ** i, 0.5 - 0.01 * (-1) ** i] for i in range(100)]
+    picks = [greedy.selector.select(i * DT, each) for i, each in enumerate(close)]
+    assert sum(a != b for a, b in zip(picks, picks[1:])) == 99
+    # The whole animal as a mode of the controller node: the contract is all it needs.
+    mode = make_controller('miro_ball.animal.animal:Animal', BehaviourParams())
+    assert mode.config == Config() and mode.act(percepts(0.0, ball_at(0.8, 0.0))).wheels

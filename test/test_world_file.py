@@ -21,7 +21,7 @@ def write(tmp_path, text, name='mine.toml'):
 
 def test_bundled_worlds_are_installed_with_the_package():
     assert {'miro', 'empty', 'football', 'football_pitch', 'petshop', 'cube',
-            'tables'} <= set(bundled_worlds())
+            'tables', 'den'} <= set(bundled_worlds())
     assert 'table' not in bundled_worlds()
 
 

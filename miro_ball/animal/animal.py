@@ -46,6 +46,10 @@ class Animal:
     hears = True
 
     def __init__(self, config=Config(), selector='basal_ganglia', seed=0):
+        if not isinstance(config, Config):
+            # Built by the controller node as a `mode` (with its BehaviourParams): demo
+            # mode's own parameters at their defaults.
+            config = Config()
         self.rng = np.random.default_rng(seed)
         self.config = config
         self.map = PriorityMap(config.spatial)

@@ -118,7 +118,7 @@ class ActionParams:
     orient_max_s: float = knob(2.0, 'orient: longest, s', 0.02, 20.0)
     turn_rate: float = knob(2.0, 'fastest body turn, rad/s', 0.1, 5.0)
     approach_base: float = knob(0.2, 'approach: base priority', -1.0, 1.0)
-    approach_size_gain: float = knob(0.5, 'approach: priority per unit of target size',
+    approach_size_gain: float = knob(0.5, 'approach: priority per radian the target spans',
                                      0.0, 5.0)
     approach_arousal_gain: float = knob(1.0, 'approach: priority per unit of arousal',
                                         0.0, 5.0)
@@ -139,7 +139,7 @@ class ActionParams:
     flee_arousal_gain: float = knob(0.25, 'flee: priority per unit of arousal', 0.0, 5.0)
     flee_valence_gain: float = knob(0.5, 'flee: priority per unit of negative valence',
                                     0.0, 5.0)
-    flee_size_gain: float = knob(0.75, 'flee: priority per unit of target size', 0.0, 5.0)
+    flee_size_gain: float = knob(0.75, 'flee: priority per radian the target spans', 0.0, 5.0)
     flee_speed: float = knob(0.3, 'flee: speed, m/s', 0.0, 0.4)
     flee_s: float = knob(2.0, 'flee: how long, s', 0.02, 20.0)
     avert_base: float = knob(0.0, 'avert: base priority', -1.0, 1.0)

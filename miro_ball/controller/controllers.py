@@ -28,8 +28,11 @@ def controller_class(mode):
     if cls is None or not callable(getattr(cls, 'act', None)):
         raise ValueError("mode '%s': %s has no controller class %s (one with act(percepts))"
                          % (mode, module_name, class_name))
-    # Checked here, with the mode, so a set_parameters change to it is refused with the reason.
-    unknown = [name for name in getattr(cls, 'detectors', ()) if name not in DETECTORS]
+    # Checked here, with the mode, so a set_parameters change to it is refused with the reason
+    # (detectors that depend on the instance's settings, a property, are checked when made).
+    names = getattr(cls, 'detectors', ())
+    unknown = [name for name in names if name not in DETECTORS] \
+        if isinstance(names, (tuple, list)) else []
     if unknown:
         raise ValueError("mode '%s': no detector named %s (known: %s)"
                          % (mode, ', '.join(map(repr, unknown)), ', '.join(sorted(DETECTORS))))

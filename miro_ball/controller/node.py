@@ -17,7 +17,7 @@ import argparse
 import math
 import os
 import sys
-from collections import Counter
+from collections import Counter, deque
 from functools import partial
 
 import cv2
@@ -64,6 +64,7 @@ STARTUP = 'startup'
 WARN_EVERY_S = 5.0
 NO_CLOCK_NOTICE_S = 5.0  # wall seconds
 MAX_FRAME_SIDE = max(max(size) for size in FRAME_SIZES)
+FRAMES_KEPT = 500  # frame lags kept (a benchmark's window)
 
 
 def _uses(key, purpose, **fields):
@@ -122,6 +123,7 @@ class KickBlueBall(Node):
     state             the controller's state name ('startup' while holding the head)
     frames_processed  camera frames decoded and run through the detectors
     mic_blocks        microphone blocks taken in (while the controller hears)
+    frame_lags        how old each of the latest frames was when it arrived, s (node time)
     rejected          Counter of ignored inputs by kind (empty, corrupt, size, cliff,
                       camera_info)
     cameras           each eye's camera model (camera_model.CameraModel) from its latest
@@ -159,6 +161,7 @@ class KickBlueBall(Node):
                          + TOUCH_PARTS}
         self._mics = None  # the microphones' subscription, while the controller hears
         self.mic_blocks = 0  # microphone blocks taken in
+        self.frame_lags = deque(maxlen=FRAMES_KEPT)  # node time - stamp of the latest frames
         self.cameras = list(DEFAULT_CAMERAS)
         # Each eye's pinhole at the size of the frame its latest detection came from.
         self._frame_cameras = list(DEFAULT_CAMERAS)
@@ -307,6 +310,8 @@ class KickBlueBall(Node):
 
     def _on_image(self, eye, msg):
         now = self._seconds()
+        stamp = msg.header.stamp
+        self.frame_lags.append(now - (stamp.sec + stamp.nanosec * 1e-9))
         frame = self._decode(EYES[eye], msg)
         if frame is None:
             return
