@@ -175,7 +175,7 @@ def test_hysteresis_and_the_minimum_duration_keep_the_choice_steady():
 def test_a_selector_of_ones_own_is_found_and_bad_names_are_refused_in_one_line():
     assert selector_class('basal_ganglia') is BasalGanglia
     assert selector_class('test_animal_parts:FirstAlways') is FirstAlways
-    for name, said in [('bg', 'selector must be basal_ganglia or module:Class'),
+    for name, said in [('bg', 'selector must be one of basal_ganglia or module:Class'),
                        ('no_such_module:X', 'cannot import'),
                        ('test_animal_parts:Nope', 'no selector class')]:
         with pytest.raises(ValueError, match=said) as err:

@@ -10,7 +10,7 @@ A selector is any class built as ``Class(params, rng)`` (params: ActionParams, r
 numpy Generator) with ``select(t, priorities) -> index`` (priorities in ACTIONS order);
 ``-p selector:=module:Class`` puts your own in (docs/demo_mode.md).
 """
-import importlib
+from miro_ball.common.plugins import named_class
 
 UNINTERRUPTABLE = 1.0
 
@@ -35,23 +35,9 @@ class BasalGanglia:
         return winner
 
 
-BUILT_IN = {'basal_ganglia': BasalGanglia}
+BUILT_IN = {'basal_ganglia': f'{__name__}:BasalGanglia'}
 
 
 def selector_class(name):
-    """The selector class a name (built-in or module:Class) names; ValueError in one line."""
-    if name in BUILT_IN:
-        return BUILT_IN[name]
-    module_name, _, class_name = name.partition(':')
-    if not class_name:
-        raise ValueError("selector must be %s or module:Class of your own, not '%s'"
-                         % (' or '.join(BUILT_IN), name))
-    try:
-        module = importlib.import_module(module_name)
-    except ImportError as err:
-        raise ValueError(f"selector '{name}': cannot import {module_name}: {err}") from None
-    cls = getattr(module, class_name, None)
-    if cls is None or not callable(getattr(cls, 'select', None)):
-        raise ValueError(f"selector '{name}': {module_name} has no selector class "
-                         f"{class_name} (one with select(t, priorities))")
-    return cls
+    """The class a selector name (built-in or module:Class) names; ValueError in one line."""
+    return named_class('selector', name, BUILT_IN, 'select', 'selector')

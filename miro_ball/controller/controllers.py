@@ -3,8 +3,7 @@
 A built-in name (tutorial, improved, wag) or ``package.module:Class`` of your own: a
 class built as ``Class(BehaviourParams)`` that implements the contract (contract.py).
 """
-import importlib
-
+from miro_ball.common.plugins import named_class
 from miro_ball.controller.behaviour import BehaviourParams, MODES
 from miro_ball.controller.detectors import DETECTORS
 
@@ -15,19 +14,7 @@ BUILT_IN = dict({name: 'miro_ball.controller.behaviour:%s' % cls.__name__
 
 def controller_class(mode):
     """The class `mode` names; ValueError (one line) when it names none."""
-    path = BUILT_IN.get(mode, mode)
-    module_name, _, class_name = path.partition(':')
-    if not class_name:
-        raise ValueError("mode must be one of %s or module:Class of your own, not '%s'"
-                         % (', '.join(BUILT_IN), mode))
-    try:
-        module = importlib.import_module(module_name)
-    except ImportError as err:
-        raise ValueError("mode '%s': cannot import %s: %s" % (mode, module_name, err)) from None
-    cls = getattr(module, class_name, None)
-    if cls is None or not callable(getattr(cls, 'act', None)):
-        raise ValueError("mode '%s': %s has no controller class %s (one with act(percepts))"
-                         % (mode, module_name, class_name))
+    cls = named_class('mode', mode, BUILT_IN, 'act', 'controller')
     # Checked here, with the mode, so a set_parameters change to it is refused with the reason
     # (detectors that depend on the instance's settings, a property, are checked when made).
     names = getattr(cls, 'detectors', ())
