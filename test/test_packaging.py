@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-BUNDLED = ['cube', 'empty', 'football', 'football_pitch', 'miro', 'petshop', 'tables']
+BUNDLED = ['cube', 'den', 'empty', 'football', 'football_pitch', 'miro', 'petshop', 'tables']
 
 
 @pytest.fixture(scope='module')

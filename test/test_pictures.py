@@ -174,8 +174,9 @@ def big_png(tmp_path, name, side):
 
 @pytest.mark.parametrize('text, expected', [
     ('[[box]]\nsize = [1, 1, 1]\npicture = "nowhere.png"\n',
-     "box[0].picture: no picture 'nowhere.png': bundled pictures are face_poster.png, "
-     'miro_lab_logo.png, apriltag36h11_N.png (N = 0, 1, 2, 3), or give a path to a PNG'),
+     "box[0].picture: no picture 'nowhere.png': bundled pictures are face_photo.png, "
+     'face_poster.png, miro_lab_logo.png, apriltag36h11_N.png (N = 0, 1, 2, 3), or give a '
+     'path to a PNG'),
     ('[[box]]\nsize = [1, 1, 1]\npicture = 3\n',
      'box[0].picture: must be the file name of a PNG, got 3'),
     ('[[box]]\nsize = [1, 1, 1]\npicture = ""\n', 'box[0].picture: must be the file name'),
