@@ -9,6 +9,7 @@ core/config/command in. Every part's parameters are ROS parameters and change li
 import argparse
 import sys
 
+from rclpy.parameter import Parameter
 from sensor_msgs.msg import Image
 from std_msgs.msg import Float32MultiArray, String
 
@@ -31,6 +32,7 @@ from miro_ball.miro.interface import (CORE_IN, CORE_INTERFACE, CORE_TOPIC, EYES,
 from miro_ball.miro.kc import EYE_FRAMES, KinematicChain
 
 NODE_NAME = 'miro_animal'
+VIEW_FULL_SCALE = 4  # an attention view is white at four times the target threshold
 GROUPS = (AnimalNodeParams, DetectionParams) + PART_GROUPS
 
 
@@ -40,31 +42,37 @@ class MiroAnimal(controller_node.KickBlueBall):
 
     NAME = NODE_NAME
 
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self._kc = KinematicChain(KIN_CALIB_RAD)  # for the attention views
+        names = RobotTopics()
+        self.pub_core = {}  # row key (and _<eye>): publisher
+        try:
+            for row in CORE_INTERFACE:
+                if row.direction == CORE_IN:
+                    continue
+                for fields, _ in row.names():
+                    key = row.key + ''.join('_' + v for v in fields.values())
+                    self.pub_core[key] = self.create_publisher(
+                        message_class(row.type), names.core(row.key, **fields),
+                        profile(row.qos))
+            adjust = CORE_TOPIC['animal_adjust']
+            self.create_subscription(message_class(adjust.type), names.core('animal_adjust'),
+                                     self._on_adjust, profile(adjust.qos))
+        except ValueError as err:  # miro2_msg not built
+            self.destroy_node()
+            raise ValueError(f'{err}: build it with python -m miro_ball.build_interfaces') \
+                from None
+        self.create_subscription(String, names.core('config_command'), self._on_config,
+                                 profile(CORE_TOPIC['config_command'].qos))
+        self._publish_config()
+
     def _declare(self):
         self.config = params.declare(self, AnimalNodeParams)
         self.detection_params = params.declare(self, DetectionParams)
         parts = [params.declare(self, cls) for cls in PART_GROUPS]
         self.animal_config = Config(*parts)
-        self._core_publishers()
         return (self.config, self.detection_params, *parts)
-
-    def _core_publishers(self):
-        names = RobotTopics()
-        self._kc = KinematicChain(KIN_CALIB_RAD)
-        self.pub_core = {}
-        for row in CORE_INTERFACE:
-            if row.direction == CORE_IN:
-                continue
-            msg_type = message_class(row.type)
-            for fields, _ in row.names():
-                key = row.key + ''.join('_' + v for v in fields.values())
-                self.pub_core[key] = (msg_type, self.create_publisher(
-                    msg_type, names.core(row.key, **fields), profile(row.qos)))
-        self.create_subscription(message_class(CORE_TOPIC['animal_adjust'].type),
-                                 names.core('animal_adjust'),
-                                 self._on_adjust, profile(CORE_TOPIC['animal_adjust'].qos))
-        self.create_subscription(String, names.core('config_command'), self._on_config,
-                                 profile(CORE_TOPIC['config_command'].qos))
 
     def _describe(self):
         return "demo mode (selector '%s', switches '%s')" % (
@@ -104,13 +112,12 @@ class MiroAnimal(controller_node.KickBlueBall):
             name = config_command(msg.data)
         except ValueError as err:
             return self._reject('config', str(err))
-        if name is not None:
-            # Through the parameters, so that `ros2 param get` and the log agree.
-            from rclpy.parameter import Parameter
-
-            value = not getattr(self.animal_config.flags, name)
-            self.set_parameters([Parameter(name, value=value)])
-        self._publish_config()
+        if name is None:  # a ping
+            return self._publish_config()
+        # Through the parameters, so that `ros2 param get` and the log agree (the change
+        # publishes the new state).
+        toggled = not getattr(self.animal_config.flags, name)
+        self.set_parameters([Parameter(name, value=toggled)])
 
     # -- out ---------------------------------------------------------------------------------
     def _on_tick(self):
@@ -119,8 +126,7 @@ class MiroAnimal(controller_node.KickBlueBall):
             self._publish_core()
 
     def _publish(self, key, msg):
-        _, publisher = self.pub_core[key]
-        publisher.publish(msg)
+        self.pub_core[key].publish(msg)
 
     def _publish_core(self):
         animal = self.controller
@@ -143,13 +149,13 @@ class MiroAnimal(controller_node.KickBlueBall):
                 self._publish(view, self._attention_view(eye.camera, name, percepts.joints))
 
     def _listened(self, key):
-        return self.pub_core[key][1].get_subscription_count() > 0
+        return self.pub_core[key].get_subscription_count() > 0
 
     def _attention_view(self, camera, eye, joints):
         self._kc.set_joints(*(joints or KIN_CALIB_RAD))
         animal = self.controller
         picture = map_in_eye(animal.map.values, camera, self._kc, EYE_FRAMES[eye],
-                             4 * animal.config.spatial.peak_threshold)
+                             VIEW_FULL_SCALE * animal.config.spatial.peak_threshold)
         msg = Image(height=picture.shape[0], width=picture.shape[1], encoding='mono8',
                     step=picture.shape[1], data=picture.tobytes())
         msg.header.stamp = self.get_clock().now().to_msg()
@@ -166,8 +172,8 @@ def build_parser():
               '', "demo mode's topics, relative to the robot's namespace:"]
     lines += ['  %-4s %-28s %s, %s' % ('in' if row.direction == CORE_IN else 'out', row.name,
                                          row.type, row.about) for row in CORE_INTERFACE]
-    lines += ['', 'and the controller\'s inputs and outputs (python -m miro_ball.controller '
-                  '--help), with sensors/mics and control/stream.',
+    lines += ['', 'and the controller\'s inputs and outputs (python -m miro_ball --help), with '
+                  'sensors/mics and control/stream.',
               'The robot: --ros-args -r __ns:=/NAME, --robot NAME or $MIRO_ROBOT_NAME. '
               '-p fast_sleep:=true runs the sleep cycle 25 times faster.']
     parser = controller_node._Parser(

@@ -1,8 +1,8 @@
 """Action selection: which action runs, from their priorities.
 
 The basal ganglia (the MDK's model, ours in code): every action's priority, with a little
-noise (up to +- selection_noise), competes; the winner is disinhibited (its inhibition 0, every other's 1) and
-drives the body. The running action gets a bonus (hysteresis), so two actions of nearly
+noise (up to +- selection_noise), competes; the winner is disinhibited (its inhibition 0,
+every other's 1) and drives the body. The running action gets a bonus (hysteresis), so two actions of nearly
 equal priority do not take turns every tick, and it keeps running for min_duration_s
 unless a challenger reaches the uninterruptable priority 1.
 

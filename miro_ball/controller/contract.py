@@ -6,8 +6,9 @@ A controller is any object with
     act(percepts) -> Action
 
 and optionally ``waits_for_head = True`` (wheels still while the node holds the start
-head pose) and ``hears = True`` (the node listens to the microphones for it). The node (node.py) builds the Percepts from MiRo's sensor topics and
-publishes each field of the Action that is not None on its control topic. Both values
+head pose) and ``hears = True`` (the node listens to the microphones for it). The node
+(node.py) builds the Percepts from MiRo's sensor topics and publishes each field of the
+Action that is not None on its control topic. Both values
 are plain frozen data: a controller is tested without ROS by calling act() on Percepts
 made by hand.
 """

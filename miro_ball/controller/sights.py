@@ -56,8 +56,8 @@ class FaceDetector:
         height, width = grey.shape
         smallest = self.params.face_min_px
         found = self.cascade.detect_multi_scale(
-            grey, scale_factor=self.params.face_scale_step, step_ratio=1, min_size=(smallest, smallest),
-            max_size=(height, height))
+            grey, scale_factor=self.params.face_scale_step, step_ratio=1,
+            min_size=(smallest, smallest), max_size=(height, height))
         self.last = tuple(_normalised(f['c'] + f['width'] / 2, f['r'] + f['height'] / 2,
                                       f['width'], width, height) for f in found)
         return self.last
