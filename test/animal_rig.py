@@ -17,9 +17,12 @@ TICK_TIMEOUT_S = 10.0
 
 
 class AnimalRig:
-    def __init__(self, context, world='den', **params):
+    def __init__(self, context, world='den', camera_rate=15.0, **params):
+        """params: demo mode's ROS parameters; camera_rate: the eyes' frames a second (a
+        test about touch, sound or sleep needs fewer)."""
         self.sim_node = SimNode(context=context, parameter_overrides=[
-            Parameter('paused', value=True), Parameter('world', value=world)])
+            Parameter('paused', value=True), Parameter('world', value=world),
+            Parameter('camera_rate', value=camera_rate)])
         self.sim = self.sim_node.sim
         self.robot = self.sim.robot
         self.node = MiroAnimal(context=context, robot=self.robot.name, parameter_overrides=[

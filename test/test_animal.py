@@ -52,7 +52,7 @@ def stroke(rig, seconds, pads_per_s=10):
 
 
 def test_stroking_pleases_it_and_the_tail_wags_faster_a_hit_hurts(rig):
-    rig = rig()
+    rig = rig(camera_rate=5.0)  # what it sees does not matter here
     rig.sim.place_ball(*FAR)
     rig.run(3.0)
     before = rig.animal.affect.emotion.valence
@@ -105,7 +105,7 @@ def test_a_face_on_the_wall_is_noticed_and_looked_at(rig):
 
 
 def test_a_loud_sound_behind_turns_it_round_and_arouses_it(rig):
-    rig = rig()
+    rig = rig(camera_rate=5.0)
     rig.sim.place_ball(*FAR)
     rig.run(1.0)
     x, y, yaw = rig.robot.pose()
@@ -128,7 +128,7 @@ def test_a_tired_miro_left_alone_falls_asleep_and_a_touch_wakes_it(rig, ros_cont
     what sleep looks like on the body is judged."""
     from miro2_msg.msg import AnimalAdjust
 
-    rig = rig(fast_sleep=True)
+    rig = rig(camera_rate=5.0, fast_sleep=True)
     rig.sim.place_ball(*FAR)
     tell = rig.node.create_publisher(AnimalAdjust, 'core/animal/adjust', 10)
     tired = AnimalAdjust()
@@ -170,7 +170,7 @@ def run_client(rig, module, args, limit_s):
 
 
 def test_the_mdk_clients_switch_parts_and_nudge_the_state(rig, capsys):
-    rig = rig()
+    rig = rig(camera_rate=5.0)
     code = run_client(rig, client_demo_config, ['v', 'T'], limit_s=3.0)
     out = capsys.readouterr().out
     assert code == 0 and 'switches on: trnscudMSFBhaHm' in out and 'off: vT' in out

@@ -14,7 +14,8 @@ from geometry_msgs.msg import TwistStamped
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, CompressedImage, JointState, Range
-from std_msgs.msg import Float32MultiArray, UInt16, UInt16MultiArray, UInt32MultiArray
+from std_msgs.msg import (Float32MultiArray, Int16MultiArray, UInt16, UInt16MultiArray,
+                          UInt32MultiArray)
 
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
 from miro_ball.controller.contract import Action
@@ -397,9 +398,11 @@ class Expressive:
     part of the action and keeps the percepts it was given."""
 
     detectors = ()
+    hears = True  # the node listens to the microphones for it
     ACTION = Action(wheels=(0.1, 0.1), head=(0.0, 0.5, 0.2, -0.1),
                     cosmetic=(0.0, 1.0, 0.5, 0.5, 0.2, 0.8),
-                    illum=(0xFF0000FF,) * 6, tone=(440, 100, 5), state='showing off')
+                    illum=(0xFF0000FF,) * 6, tone=(440, 100, 5), stream=(0, 1000, -1000, 0),
+                    state='showing off')
 
     def __init__(self, params):
         self.percepts = []
@@ -413,16 +416,23 @@ def test_a_controller_of_your_own_reads_every_percept_and_sets_every_action(make
     rig = make_rig(Parameter('mode', value='test_controller_node:Expressive'),
                    Parameter('head_hold_s', value=0.0))
     p, names = rig.probe, rig.names
-    got = {key: [] for key in ('cosmetic', 'illum', 'tone')}
+    got = {key: [] for key in ('cosmetic', 'illum', 'tone', 'stream')}
     for key, kind, topic in (('cosmetic', Float32MultiArray, names.cosmetic_joints),
                              ('illum', UInt32MultiArray, names.illum),
-                             ('tone', UInt16MultiArray, names.tone)):
+                             ('tone', UInt16MultiArray, names.tone),
+                             ('stream', Int16MultiArray, names.stream)):
         p.create_subscription(kind, topic, got[key].append, 100)
+    # A loud hiss, as loud at every microphone: heard, somewhere, at about -10 dBFS.
+    hiss = np.random.default_rng(0).normal(0, 10000, 4 * 500).astype(np.int16)
     readings = [(p.create_publisher(Range, names.sonar, 2), Range(range=0.25)),
                 (p.create_publisher(Float32MultiArray, names.light, 2),
                  Float32MultiArray(data=[0.1, 0.2, 0.3, 0.4]))]
     readings += [(p.create_publisher(UInt16, names.touch(part), 2), UInt16(data=bits))
                  for part, bits in (('head', 3), ('body', 8))]
+    readings += [(p.create_publisher(JointState, names.kinematic_joints, 2),
+                  JointState(position=[-0.1, 0.6, 0.3, -0.2])),
+                 (p.create_publisher(Int16MultiArray, names.mics, 2),
+                  Int16MultiArray(data=hiss.tolist()))]
     rig.wait_until(lambda: all(pub.get_subscription_count() > 0 for pub, _ in readings)
                    and rig.node.pub_tone.get_subscription_count() > 0, 'discovery')
     rig.set_clock(10.0)
@@ -438,12 +448,15 @@ def test_a_controller_of_your_own_reads_every_percept_and_sets_every_action(make
     assert seen.t == pytest.approx(rig.now) and seen.sonar == pytest.approx(0.25)
     assert seen.light == pytest.approx((0.1, 0.2, 0.3, 0.4))
     assert (seen.touch_head, seen.touch_body) == (3, 8)
+    assert seen.joints == pytest.approx((-0.1, 0.6, 0.3, -0.2))
+    assert -12 < seen.sound.level_db < -8
     assert seen.eyes[0].image is None and seen.eyes[1].image.shape == (360, 640, 3)
     assert seen.found('ball') == (None, None)  # no detector asked for: none run
     action = Expressive.ACTION
     assert tuple(got['cosmetic'][-1].data) == pytest.approx(action.cosmetic)
     assert tuple(got['illum'][-1].data) == action.illum
     assert tuple(got['tone'][-1].data) == action.tone
+    assert tuple(got['stream'][-1].data) == action.stream
     assert tuple(rig.joints[-1].position) == pytest.approx(action.head)
     assert rig.last_twist()[0] == pytest.approx(0.1) and rig.node.state == 'showing off'
 

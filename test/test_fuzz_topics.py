@@ -82,7 +82,7 @@ def test_demo_mode_survives_every_topic(ros_context):
     still notices a stroke."""
     from animal_rig import AnimalRig
 
-    rig = AnimalRig(ros_context, 'empty')
+    rig = AnimalRig(ros_context, 'empty', camera_rate=5.0)
     try:
         rig.run(0.5)
         delivered = fuzz(rig.node, Probe(ros_context, rig.executor, 'fuzzer'), rig.executor,
