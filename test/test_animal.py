@@ -185,3 +185,35 @@ def test_the_mdk_clients_switch_parts_and_nudge_the_state(rig, capsys):
     assert rig.animal.affect.emotion.valence > before + 0.3
     code = run_client(rig, client_demo_interact, ['sleep+', '--seconds', '2'], limit_s=4.0)
     assert code == 0 and rig.animal.sleep.state.pressure > 0.3  # 1 - 0.975 ** 20 = 0.4
+
+
+def test_each_robot_has_its_own_demo_mode_in_its_namespace(ros_context):
+    """Two robots, two demo modes: every topic of each under its own robot's name."""
+    from miro_ball.animal.node import MiroAnimal
+
+    nodes = [MiroAnimal(context=ros_context, robot=name) for name in ('miro01', 'miro02')]
+    try:
+        for node, name in zip(nodes, ('miro01', 'miro02')):
+            assert node.get_fully_qualified_name() == f'/{name}/miro_animal'
+            topics = [pub.topic_name for pub in node.publishers] + \
+                [sub.topic_name for sub in node.subscriptions]
+            assert f'/{name}/core/animal/state' in topics and f'/{name}/control/cmd_vel' in topics
+            assert all(t.startswith(f'/{name}/') for t in topics
+                       if t not in ('/clock', '/rosout', '/parameter_events'))
+    finally:
+        for node in nodes:
+            node.destroy_node()
+
+
+def test_help_and_a_typo_in_a_parameter_is_refused_in_one_line():
+    import subprocess
+    import sys
+
+    shown = subprocess.run([sys.executable, '-m', 'miro_ball.animal', '--help'],
+                           capture_output=True, text=True, timeout=60)
+    assert shown.returncode == 0
+    assert 'fast_sleep' in shown.stdout and 'core/animal/state' in shown.stdout
+    typo = subprocess.run([sys.executable, '-m', 'miro_ball.animal', '--ros-args', '-p',
+                           'fast_sleeep:=true'], capture_output=True, text=True, timeout=60)
+    assert typo.returncode == 2 and typo.stderr.count('\n') == 1
+    assert "did you mean fast_sleep" in typo.stderr

@@ -343,3 +343,18 @@ def test_every_parameter_is_in_the_docs_and_a_part_can_be_replaced():
     # The whole animal as a mode of the controller node: the contract is all it needs.
     mode = make_controller('miro_ball.animal.animal:Animal', BehaviourParams())
     assert mode.config == Config() and mode.act(percepts(0.0, ball_at(0.8, 0.0))).wheels
+
+
+def test_reflexes_have_the_last_word_a_drop_backs_it_off_a_wall_slows_it():
+    animal = Animal()
+    ahead = ball_at(0.8, 0.0)
+    for i in range(30):  # approaching the ball
+        wheels = animal.act(percepts(i * DT, ahead)).wheels
+    assert min(wheels) > 0.1
+    left, right = animal.act(percepts(0.62, ahead, cliff=(0.2, 1.0))).wheels
+    assert left + right < 0 and left > right  # backs off, turning right: away from the drop
+    near = Percepts(0.64, percepts(0.64, ahead).eyes, sonar=0.12, light=(0.5,) * 4)
+    slowed = animal.act(near).wheels
+    assert 0 <= sum(slowed) / 2 < 0.25 * sum(wheels) / 2 + 1e-6
+    stopped = Animal(Config().with_part(FlagParams(translation=False, rotation=False)))
+    assert stopped.act(percepts(0.0, ahead)).wheels == (0.0, 0.0)
