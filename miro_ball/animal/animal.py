@@ -35,6 +35,9 @@ SONAR_BAND_M = (0.10, 0.25)  # the MDK's sonar modulation: stop at the near end,
 SHUN_SPEED, SHUN_TURN = 0.1, 1.5  # backing off a drop, m/s and rad/s
 LOUD = 0.5  # a sound this loud (0..1 of the loud range) wakes and startles
 MAX_DT = 0.2  # a longer gap (a paused simulator) counts as this much
+SEEN = ('ball', 'face', 'tag', 'motion')  # the detectors demo mode runs on each eye
+SWITCHED_BY = {'ball': 'salience_ball', 'face': 'salience_faces', 'motion': 'salience_motion',
+               'sound': 'salience_sound'}
 HEARD_FOR_S = 0.6  # a sound is in the percepts this long after it ends (stale_s, a block)
 
 
@@ -71,14 +74,17 @@ class Animal:
         self._voice_ready_at = 0.0
         self._vocalising_until = -math.inf
         self._had_motion = False
+        self._was_roused = False
         self._was_asleep = False
 
     @property
     def detectors(self):
-        f = self.config.flags
-        wanted = [('ball', f.salience_ball), ('face', f.salience_faces), ('tag', True),
-                  ('motion', f.salience_motion)]
-        return tuple(name for name, on in wanted if on)
+        return tuple(kind for kind in SEEN if self._noticed(kind))
+
+    def _noticed(self, kind):
+        """Whether a kind of thing draws attention (its switch, if it has one, is on)."""
+        switch = SWITCHED_BY.get(kind)
+        return switch is None or getattr(self.config.flags, switch)
 
     def configure(self, config):
         """New parameters, the state kept (a live parameter change)."""
@@ -117,12 +123,12 @@ class Animal:
 
         still = t - self._moved_at >= self.config.spatial.motion_still_s
         stimuli = [s for s in self.senses.sights(percepts, include_motion=still)
-                   if s.kind != 'face' or flags.salience_faces]
+                   if self._noticed(s.kind)]
         heard = self.senses.sound(percepts.sound, joints)
         vocalising = t < self._vocalising_until
         # MiRo's own voice is the loudest thing it hears: it neither startles nor wakes it.
         self.loudness = heard.strength if heard is not None and not vocalising else 0.0
-        if heard is not None and flags.salience_sound:
+        if heard is not None and self._noticed('sound'):
             stimuli.append(heard)
         self.stimuli = stimuli
         self.peak = self.map.update(dt, stimuli, self_noisy=vocalising)
@@ -136,10 +142,14 @@ class Animal:
         touches = self.feel.feel(percepts.touch_head, percepts.touch_body)
         light = float(np.mean(percepts.light)) if percepts.light else 0.5
         loud = self.loudness >= LOUD
+        # A touch or a loud sound wakes MiRo when it begins (not again every tick it lasts).
+        roused = touches.touched or loud
+        woken = roused and not self._was_roused
+        self._was_roused = roused
         if flags.sleep:
             stimulation = min(1.0, touches.touched + self.loudness + 0.5 * (self.target
                                                                             is not None))
-            self.sleep.step(dt, stimulation, woken=touches.touched or loud)
+            self.sleep.step(dt, stimulation, woken=woken)
         wakefulness = self.sleep.state.wakefulness if flags.sleep else 1.0
         self.affect.step(dt, Events(touches.strokes, touches.pet, touches.hits,
                                     self.loudness, startled, light), wakefulness)
