@@ -84,13 +84,16 @@ def topics():
                        'arrives: %g deg pinhole)' % (side, CAM_HFOV_DEG_SIM), eye=eye)]
     used += [_uses('cliff', '[L, R], 1 floor, <0.7 drop'),
              _uses('sonar', 'percepts: range ahead'),
-             _uses('light', 'percepts: light')]
+             _uses('light', 'percepts: light'),
+             _uses('kinematic_joints', 'percepts: the neck\'s joints'),
+             _uses('mics', 'percepts: the sound heard (for a controller that hears)')]
     used += [_uses('touch', 'percepts: touch, ' + part, part=part) for part in TOUCH_PARTS]
     used += [_uses('cmd_vel', "the action's wheels"),
              _uses('kinematic_targets', "head pose at start, then the action's head"),
              _uses('cosmetic_joints', "the action's cosmetic joints"),
              _uses('illum', "the action's LEDs"),
-             _uses('tone', "the action's tone")]
+             _uses('tone', "the action's tone"),
+             _uses('stream', "the action's samples for the speaker")]
     used += [(DEBUG_TOPIC.format(eye=eye), TOPIC['eye_compressed'].type, 'out',
               'annotated, only while subscribed') for eye in EYES]
     return used
@@ -116,8 +119,6 @@ class Latest:
 
 
 class KickBlueBall(Node):
-    NAME = NODE_NAME
-
     """The controller. Attributes for tests and embedding:
 
     state             the controller's state name ('startup' while holding the head)
@@ -132,11 +133,15 @@ class KickBlueBall(Node):
     last_action       the controller's latest Action (contract.Action)
     last_tick         node time (s) of the latest control tick, None before the first
     robot             the robot it drives: the last part of its namespace
-    controller, detectors ([{name: detect}] per eye), detection_params, config (ControllerParams),
-    pub_twist
+    controller, detectors ([{name: detect}] per eye), detection_params,
+    config (ControllerParams), pub_twist
 
-    robot (a name) picks the namespace, as --robot does; a remapped __ns wins.
+    robot (a name) picks the namespace, as --robot does; a remapped __ns wins. A subclass
+    (demo mode's node) names itself (NAME) and may replace _declare, _describe, _apply and
+    _new_controller.
     """
+
+    NAME = NODE_NAME
 
     def __init__(self, *, context=None, parameter_overrides=None, save_debug=None, robot=None,
                  args=None):
