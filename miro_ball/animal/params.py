@@ -182,8 +182,9 @@ class AffectParams:
     stroke_valence: float = knob(0.05, 'valence per stroke (a hand moving two pads along)',
                                  0.0, 1.0)
     stroke_pads: int = knob(2, 'a stroke: the hand moves this many pads along the line', 1, 6)
-    pet_valence: float = knob(0.025, 'valence per second of a still hand', 0.0, 1.0)
-    hit_pads: int = knob(6, 'a hit: this many pads touched at once from none', 2, 14)
+    pet_valence: float = knob(0.05, 'valence per second of a still hand (a pet)', 0.0, 1.0)
+    hit_pads: int = knob(5, 'a hit: this many pads touched at once from none (a fingertip '
+                            'covers one or two)', 2, 14)
     hit_valence: float = knob(-0.2, 'valence per hit', -1.0, 0.0)
     hit_arousal: float = knob(0.2, 'arousal per hit', 0.0, 1.0)
     loud_valence: float = knob(-0.1, 'valence per second of full loudness', -2.0, 0.0)
