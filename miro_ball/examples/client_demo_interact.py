@@ -58,11 +58,11 @@ class DemoInteract(Client):
         now = self.now()
         if self.started is None:
             self.started = now
-        if self.shown_at is None or now - self.shown_at >= 1.0:
+        done = now - self.started >= self.seconds
+        if self.shown_at is None or now - self.shown_at >= 1.0 or done:
             self.shown_at = now
             self.say(f't = {now:7.2f} s  {describe(msg)}')
-        if now - self.started >= self.seconds:
-            self.say(f't = {now:7.2f} s  {describe(msg)}')
+        if done:
             raise SystemExit(0)
 
 
