@@ -12,6 +12,7 @@ import math
 from typing import NamedTuple, Optional
 
 from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT_RAD_CALIB, YAW
+from miro_ball.miro.kinematics import wrap
 
 YAW_LIMIT = JOINT_LIMITS_RAD[YAW][1]
 
@@ -23,7 +24,6 @@ class Situation(NamedTuple):
     target: Optional[object]  # attention.Peak or None
     valence: float
     arousal: float
-    head_yaw: float  # rad
     sonar: Optional[float]  # m
     since_target: float  # s since anything was attended to
     forward: float  # the forward speed MiRo was last told, m/s
@@ -39,10 +39,6 @@ class Motor(NamedTuple):
 
 def _clamp(value, low, high):
     return min(high, max(low, value))
-
-
-def _wrap(angle):
-    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 class Action:
@@ -109,9 +105,9 @@ class Steered(Action):
         self.range = s.target.range if s.target else None
 
     def track(self, s, turned):
-        self.goal = _wrap(self.goal - turned * s.dt)
+        self.goal = wrap(self.goal - turned * s.dt)
         t = s.target
-        if t is not None and t.kind == self.kind and abs(_wrap(t.azimuth - self.goal)) < \
+        if t is not None and t.kind == self.kind and abs(wrap(t.azimuth - self.goal)) < \
                 self.resync_rad:
             self.goal, self.range = t.azimuth, t.range if t.range is not None else self.range
 
@@ -212,7 +208,7 @@ class Flee(Steered):
 
     def motor(self, s):
         p = self.params
-        away = _wrap(self.goal + math.pi)
+        away = wrap(self.goal + math.pi)
         turn = self.turn_towards(away) if self.flags.rotation else 0.0
         self.track(s, turn)
         self.finished = self.elapsed(s) > p.flee_s

@@ -29,7 +29,8 @@ from miro_ball.animal.sleep import SleepModel
 from miro_ball.animal.voice import as_tone, length_s, vocalise
 from miro_ball.controller.contract import Action
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, KIN_CALIB_RAD, LIFT_RAD_CALIB,
-                                      PLATFORM_TICK_S, TILT_RAD, WHEEL_TRACK_M, YAW)
+                                      PLATFORM_TICK_S, TILT_RAD)
+from miro_ball.miro.kinematics import cmd_vel2wheel_speed
 
 SONAR_BAND_M = (0.10, 0.25)  # the MDK's sonar modulation: stop at the near end, free beyond
 SHUN_SPEED, SHUN_TURN = 0.1, 1.5  # backing off a drop, m/s and rad/s
@@ -156,7 +157,7 @@ class Animal:
         emotion = self.affect.emotion
 
         situation = Situation(t, dt, self.target, emotion.valence, emotion.arousal,
-                              joints[YAW], percepts.sonar, t - self._target_at, self._forward)
+                              percepts.sonar, t - self._target_at, self._forward)
         self.priorities = [action.priority(situation) for action in self.actions]
         chosen = self.selector.select(t, self.priorities)
         if chosen != self.selected:
@@ -173,7 +174,7 @@ class Animal:
         head = self._head_pose(motor, t, wakefulness)
         shown = self.express.step(t, dt, emotion.valence, emotion.arousal, wakefulness,
                                   touches.touched)
-        said = self._voice(t, touches, loud, wakefulness)
+        said = self._voice(t, touches, loud)
         return Action(wheels=wheels, head=head, cosmetic=shown.cosmetic, illum=shown.illum,
                       state=self.selected_name, **said)
 
@@ -202,8 +203,7 @@ class Animal:
         self._forward = forward
         if abs(forward) > 0.01 or abs(turn) > 0.05:
             self._moved_at = percepts.t
-        half = turn * WHEEL_TRACK_M / 2
-        return forward - half, forward + half
+        return cmd_vel2wheel_speed(forward, turn)
 
     def _head_pose(self, motor, t, wakefulness):
         if not self.config.flags.neck:
@@ -220,7 +220,7 @@ class Animal:
             yaw *= wakefulness
         return (TILT_RAD, lift, yaw, pitch)
 
-    def _voice(self, t, touches, loud, wakefulness):
+    def _voice(self, t, touches, loud):
         """A vocalisation now and then: pleased when stroked, hurt, startled, waking."""
         asleep = self.asleep
         woke, self._was_asleep = self._was_asleep and not asleep, asleep

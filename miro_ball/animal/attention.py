@@ -33,11 +33,20 @@ class Peak(NamedTuple):
     height: float  # the map's value there (salience)
     range: Optional[float]  # m, of the stimulus that painted it, if known
     span: float  # rad
-    stimulus_count: int  # how many stimuli painted the map this tick
 
 
-def _wrap(angle):
-    return (angle + math.pi) % (2 * math.pi) - math.pi
+def _wrap(angles):
+    """Angles (an array) into [-pi, pi)."""
+    return (angles + math.pi) % (2 * math.pi) - math.pi
+
+
+def cell_of(azimuth, elevation):
+    """(row, column) of the map's cell holding a direction, rad (scalars or arrays)."""
+    step = math.radians(BIN_DEG)
+    column = np.round((np.asarray(azimuth) - AZIMUTHS[0]) / step).astype(int) % len(AZIMUTHS)
+    row = np.clip(np.round((np.asarray(elevation) - ELEVATIONS[0]) / step).astype(int), 0,
+                  len(ELEVATIONS) - 1)
+    return row, column
 
 
 class PriorityMap:
@@ -74,7 +83,9 @@ class PriorityMap:
             target = 1.0 if kind in seen else 0.0
             self.habituation[kind] += (target - self.habituation[kind]) * min(
                 1.0, dt / p.habituation_s)
-        painted = {}
+        # The painted cells the map has faded from are forgotten (bounded bookkeeping).
+        self._painted = {cell: s for cell, s in self._painted.items()
+                         if self.values[cell] > 1e-3}
         for stimulus in stimuli:
             height = self.salience(stimulus, self_noisy)
             if height <= 0:
@@ -86,13 +97,11 @@ class PriorityMap:
             higher = blob > self.values
             self.values = np.where(higher, blob, self.values)
             self.kinds = np.where(higher, KINDS.index(stimulus.kind), self.kinds)
-            row = int(np.argmin(np.abs(ELEVATIONS - stimulus.elevation)))
-            column = int(np.argmin(np.abs(_wrap(AZIMUTHS - stimulus.azimuth))))
-            painted[(row, column)] = stimulus
-        self._painted.update(painted)
-        return self.peak(len(stimuli))
+            row, column = cell_of(stimulus.azimuth, stimulus.elevation)
+            self._painted[(int(row), int(column))] = stimulus
+        return self.peak()
 
-    def peak(self, count=0):
+    def peak(self):
         row, column = np.unravel_index(int(np.argmax(self.values)), self.values.shape)
         kind = int(self.kinds[row, column])
         if kind == NO_KIND or self.values[row, column] <= 0:
@@ -100,20 +109,17 @@ class PriorityMap:
         source = self._nearest_painted(row, column, KINDS[kind])
         return Peak(KINDS[kind], float(AZIMUTHS[column]), float(ELEVATIONS[row]),
                     float(self.values[row, column]), source.range if source else None,
-                    source.span if source else 0.0, count)
+                    source.span if source else 0.0)
 
     def _nearest_painted(self, row, column, kind):
         """The latest stimulus of that kind painted nearest the cell (for range and span)."""
         best, best_distance = None, math.inf
-        for (r, c), stimulus in list(self._painted.items()):
+        for (r, c), stimulus in self._painted.items():
             if stimulus.kind != kind:
                 continue
             distance = abs(r - row) + min(abs(c - column), len(AZIMUTHS) - abs(c - column))
             if distance < best_distance:
                 best, best_distance = stimulus, distance
-        # Forget the painted cells the map has faded from (bounded bookkeeping).
-        self._painted = {cell: s for cell, s in self._painted.items()
-                         if self.values[cell] > 1e-3}
         return best
 
     def target(self, peak):

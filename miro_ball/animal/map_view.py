@@ -4,7 +4,7 @@ show it. For a viewer (the GUI lays it over the eye); nothing in demo mode reads
 """
 import numpy as np
 
-from miro_ball.animal.attention import AZIMUTHS, BIN_DEG, ELEVATIONS
+from miro_ball.animal.attention import cell_of
 from miro_ball.miro.kc import BODY
 
 VIEW_SIZE = (64, 36)  # width, height of the picture (16:9, as the eyes)
@@ -21,10 +21,5 @@ def map_in_eye(values, camera, kc, frame, full_scale, size=VIEW_SIZE):
     rays = camera.pixel_to_direction(kc, frame, uu, vv, BODY)
     azimuth = np.arctan2(rays[..., 1], rays[..., 0])
     elevation = np.arctan2(rays[..., 2], np.hypot(rays[..., 0], rays[..., 1]))
-    step = np.radians(BIN_DEG)
-    column = np.clip(np.round((azimuth - AZIMUTHS[0]) / step).astype(int) % len(AZIMUTHS),
-                     0, len(AZIMUTHS) - 1)
-    row = np.clip(np.round((elevation - ELEVATIONS[0]) / step).astype(int), 0,
-                  len(ELEVATIONS) - 1)
-    seen = values[row, column] / max(full_scale, 1e-9)
+    seen = values[cell_of(azimuth, elevation)] / max(full_scale, 1e-9)
     return np.clip(np.nan_to_num(seen) * 255, 0, 255).astype(np.uint8)

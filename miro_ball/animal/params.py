@@ -6,7 +6,7 @@ change of tick keeps the behaviour. Where the MDK has no number (or its model is
 ours) the value is our own and its help says what it does.
 """
 import math
-from dataclasses import dataclass, field, make_dataclass, replace
+from dataclasses import dataclass, field, fields, make_dataclass, replace
 
 from miro_ball.common.params import check_ranges
 from miro_ball.miro.constants import LIFT_RAD_CALIB, PLATFORM_TICK_S
@@ -276,8 +276,7 @@ class Config:
         return replace(self, **{SLOTS[type(values)]: values})
 
 
-SLOTS = {FlagParams: 'flags', SpatialParams: 'spatial', ActionParams: 'action',
-         AffectParams: 'affect', SleepParams: 'sleep', ExpressParams: 'express'}
+SLOTS = {f.type: f.name for f in fields(Config)}  # each part's class: its name in Config
 
 
 def letters_on(flags):

@@ -13,6 +13,7 @@ from typing import NamedTuple, Optional
 from miro_ball.miro.constants import KIN_CALIB_RAD, YAW
 from miro_ball.miro.interface import EYES
 from miro_ball.miro.kc import BODY, EYE_FRAMES, HEAD, KinematicChain
+from miro_ball.miro.kinematics import wrap
 
 KINDS = ('ball', 'face', 'tag', 'motion', 'sound')
 
@@ -87,8 +88,7 @@ class Senses:
             return None
         loud = (heard.level_db - self.spatial.quiet_db) / (self.spatial.loud_db
                                                            - self.spatial.quiet_db)
-        azimuth = heard.azimuth + (joints or KIN_CALIB_RAD)[YAW]
-        azimuth = math.atan2(math.sin(azimuth), math.cos(azimuth))
+        azimuth = wrap(heard.azimuth + (joints or KIN_CALIB_RAD)[YAW])
         self.kc.set_joints(*(joints or KIN_CALIB_RAD))
         head_height = self.kc.origin(HEAD, BODY)[2]
         elevation = math.atan2(self.spatial.sound_height_m - head_height,
