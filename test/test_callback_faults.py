@@ -67,3 +67,39 @@ def test_what_the_node_can_not_go_on_from_ends_the_spin(ros_context, fatal, faul
     finally:
         executor.shutdown()
         node.destroy_node()
+
+
+@pytest.mark.parametrize('warning_first', [True, False])
+def test_a_warning_and_a_failing_callback_in_either_order_leave_the_node_serving(
+        ros_context, warning_first, capfd):
+    """Every node warns through Throttled and logs faults through the spin's fault log, one
+    logger at two severities: rclpy refused the second severity from their shared call site
+    (the node exited, or every later warning came out as an ERROR traceback)."""
+    import rclpy
+
+    from miro_ball.common.throttle import Throttled
+
+    node = rclpy.create_node('warns_and_fails', context=ros_context)
+    warn = Throttled(node.get_logger().warning, period_s=0.0)
+    ticks = []
+
+    def tick():
+        ticks.append(len(ticks))
+        if (len(ticks) % 2 == 1) == warning_first:
+            warn('bad', f'a bad message number {len(ticks)}: ignored')
+        else:
+            raise ValueError('a callback that fails')
+    node.create_timer(0.005, tick)
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    try:
+        spin_until_stopped(executor, StopWhen(lambda: len(ticks) >= 8))
+        assert len(ticks) >= 8, 'the node stopped serving after a warning and a fault'
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+    err = capfd.readouterr().err
+    warnings = [line for line in err.splitlines() if 'a bad message number' in line]
+    assert len(warnings) >= 3 and all(line.startswith('[WARN]') for line in warnings), err
+    assert 'Logger severity cannot be changed' not in err
+    assert err.count('a callback failed') == 1, err

@@ -17,6 +17,7 @@ from miro_ball.common.throttle import Throttled
 
 WAKE_PERIOD_S = 0.1
 FAULT_PERIOD_S = 10.0
+FAULT_CHARS = 4000  # a traceback is worth its lines, but not a megabyte of repr
 # What no node can go on from: its memory, or its handles into ROS, are gone.
 FATAL = (MemoryError, InvalidHandle)
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -69,11 +70,11 @@ def spin_until_stopped(executor, stop, context=None, fatal=()):
 def _fault_log(executor):
     nodes = executor.get_nodes()
     log = nodes[0].get_logger().error if nodes else print
-    throttled = Throttled(log, period_s=FAULT_PERIOD_S)
+    throttled = Throttled(log, period_s=FAULT_PERIOD_S, max_chars=FAULT_CHARS)
 
     def fault(err):
         where = traceback.extract_tb(err.__traceback__)[-1:]
         key = (type(err), *((where[0].filename, where[0].lineno) if where else ()))
         throttled(key, 'a callback failed; its message is dropped and the node goes on:\n'
-                  + ''.join(traceback.format_exception(err)).rstrip())
+                  + ''.join(traceback.format_exception(err)).rstrip(), cause=key)
     return fault
