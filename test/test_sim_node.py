@@ -417,3 +417,55 @@ def test_a_twist_on_cmd_vel_is_said_once_with_the_type_it_wants(sim_node, execut
         user.destroy_node()
         rclpy.try_shutdown(context=context)
     assert ''.join(seen + [capfd.readouterr().err]).count(wanted) == 1
+
+
+def test_hostile_sound_requests_are_refused_in_one_line_each_and_a_tone_still_plays(
+        make_sim, probe, executor, capfd, tmp_path):
+    """The red team's requests: a file outside the allowed folders, a FIFO, /dev/stdin, a
+    header of 2147483647 Hz, NaN samples, 40 failed reads; the simulator steps on and a valid
+    tone (and a file of the allowed folder) still plays."""
+    import struct
+
+    import soundfile
+    from std_msgs.msg import String
+
+    folder = tmp_path / 'sounds'
+    folder.mkdir()
+    secret = tmp_path / 'secret.wav'
+    soundfile.write(str(secret), np.full(800, 0.5), 8000)
+    soundfile.write(str(folder / 'ok.wav'), np.sin(np.arange(8000) * 0.3), 8000)
+    soundfile.write(str(folder / 'nan.wav'), np.full(800, np.nan), 8000, subtype='FLOAT')
+    huge = bytearray((folder / 'ok.wav').read_bytes())
+    huge[24:32] = struct.pack('<II', 2147483647, 2**32 - 1)
+    (folder / 'huge.wav').write_bytes(bytes(huge))
+    (folder / 'broken.flac').write_bytes(b'fLaC' + bytes(38))
+    os.mkfifo(folder / 'pipe.wav')
+    node = make_sim(sound_folders=str(folder))
+    play = probe.publisher(String, SIM.sound)
+    assert spin_until(executor, lambda: play.get_subscription_count())
+
+    def sound(name, file):
+        play.publish(String(data=f'[[sound]]\nname = "{name}"\nfile = "{file}"\n'))
+        drain(executor)  # the topic keeps 10: each is taken before the next
+    hostile = {'secret': str(secret), 'up': '../secret.wav', 'pipe': 'pipe.wav',
+               'stdin': '/dev/stdin', 'huge': 'huge.wav', 'nan': 'nan.wav'}
+    for name, file in hostile.items():
+        sound(name, file)
+    for index in range(40):
+        sound(f'broken{index}', 'broken.flac')
+    run(node, executor, 0.2)
+    play.publish(String(data='[[sound]]\nname = "tone"\ntone = 440\n'))
+    sound('ok', 'ok.wav')
+    acoustics = node.sim.acoustics
+    assert spin_until(executor, lambda: {'tone', 'ok'} <= set(node.sim.acoustics.sounds),
+                      what='the tone and the allowed file playing')
+    time_before = node.sim.time
+    run(node, executor, 0.2)
+    assert node.sim.time > time_before and set(acoustics.sounds) == {'tone', 'ok'}
+    err = capfd.readouterr().err
+    for said in ("no sound file '" + str(secret), "no sound file '../secret.wav'",
+                 "'pipe.wav' is not a regular file", "no sound file '/dev/stdin'",
+                 "'huge.wav' says 2147483647 samples a second", "'nan.wav' holds samples that "
+                 'are not numbers', "cannot read 'broken.flac' as sound"):
+        assert said in err, said + "\n" + err.replace(str(tmp_path), "T")
+    assert 'Traceback' not in err

@@ -216,7 +216,7 @@ def robots(count, name=lambda i: f'miro{i:02d}'):
     ('a = ' + '[' * 5000 + ']' * 5000 + '\n', 'nested too deeply'),
     ('[[sound]]\nposition = [0, 0, 0]\n', "sound[0]: needs exactly one of 'file'"),
     ('[[sound]]\ntone = 440\nnoise = true\n', "sound[0]: needs exactly one of 'file'"),
-    ('[[sound]]\nfile = "nowhere.wav"\n', "sound[0].file: cannot read 'nowhere.wav' as sound"),
+    ('[[sound]]\nfile = "nowhere.wav"\n', "sound[0].file: no sound file 'nowhere.wav' in the allowed folders"),
     ('[[sound]]\nfile = "broken.toml"\n', "sound[0].file: cannot read 'broken.toml' as sound"),
     ('[[sound]]\ntone = 20000\n', 'sound[0].tone: must be 20..9000 Hz'),
     ('[[sound]]\nnoise = true\nlevel = 10\n', 'sound[0].level: must be -120..0 dB'),

@@ -9,7 +9,7 @@ stays a few lines); the rest are counted, and the count rides on the kind's next
 import re
 import time
 
-CAUSES_PER_PERIOD = 3
+CAUSES_PER_PERIOD = 10
 MAX_CHARS = 300  # a line a person reads: a message longer than this is cut
 _NUMBER = re.compile(r'[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?')
 

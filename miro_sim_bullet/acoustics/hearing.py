@@ -81,12 +81,15 @@ class Acoustics:
     def add_sound(self, sound):
         """A world sound (scene.sounds.Sound) starts to play, its start and stop counted
         from now; its name replaces one of the same name. ValueError when MAX_SOUNDS
-        already play."""
-        self.remove_sound(sound.name)
-        if len(self.sounds) >= MAX_SOUNDS:
+        already play, or its file can not be played (sound_files.SoundFileError): then
+        nothing changes."""
+        others = len(self.sounds) - (sound.name in self.sounds)
+        if others >= MAX_SOUNDS:
             raise ValueError(f'at most {MAX_SOUNDS} sounds play at once')
-        self.sounds[sound.name] = (self._take_row(),
-                                   WorldSource(sound, (self.seed, 0, len(self.sounds)), self.sent))
+        # The source first: a file that fails to play must not keep a row.
+        source = WorldSource(sound, (self.seed, 0, others), self.sent)
+        self.remove_sound(sound.name)
+        self.sounds[sound.name] = (self._take_row(), source)
 
     def remove_sound(self, name):
         """Silence a world sound at once (what it sent is still on its way: not heard)."""

@@ -13,12 +13,19 @@ import numpy as np
 from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ
 from miro_sim_bullet.acoustics.fir import lowpass, Stream
 from miro_sim_bullet.acoustics.propagation import RATE
+from miro_sim_bullet.acoustics.sound_files import BANK
 
 FS = RATE
 # A world's noise is hiss below 5 kHz (a fan, a radio between stations), scaled back to RMS
 # 1 after the filter.
 _HISS = lowpass(5000.0, FS, 63)
 _HISS /= math.sqrt(np.sum(_HISS ** 2))  # white noise of RMS 1 stays of RMS 1
+# A file's samples (at the microphones' rate) are doubled to FS as they play, with the
+# filter scipy's resample_poly designs for it; a block reads MARGIN samples either side so
+# that its filtered samples are those of the whole file filtered at once.
+UP = FS // MIC_SAMPLE_RATE_HZ
+_UP_HALF = 10 * UP
+MARGIN = _UP_HALF // UP + 1
 
 
 def rms_scale(level_db):
@@ -37,9 +44,9 @@ class WorldSource:
         self._first = since + round(sound.start * FS)
         self._last = since + round(min(sound.stop, 1e9) * FS)  # one past it
         self._scale = rms_scale(sound.level_db)
-        self._samples = _read(sound.file) if sound.kind == 'file' else None
+        self._samples = BANK.samples(sound.file) if sound.kind == 'file' else None
         if self._samples is not None and not sound.loop:
-            self._last = min(self._last, self._first + len(self._samples))
+            self._last = min(self._last, self._first + UP * len(self._samples))
 
     def emit(self, n0, count):
         lo, hi = max(n0, self._first), min(n0 + count, self._last)
@@ -54,25 +61,30 @@ class WorldSource:
         elif kind == 'noise':
             out[lo - n0:hi - n0] = self._hiss(lo, hi - lo)
         else:
-            out[lo - n0:hi - n0] = self._samples.take(played, mode='wrap')
+            out[lo - n0:hi - n0] = self._played(played)
         return out * self._scale
 
+    def _played(self, played):
+        """The file's samples at FS for ``played`` (consecutive indices since its start):
+        looped, it wraps around; else nothing is before its start or after its end."""
+        from scipy.signal import resample_poly  # here: only a world with a file pays for it
 
-def _read(path):
-    """A sound file as one channel at FS with RMS 1 (its level is the world file's):
-    resampled to the microphones' rate (which takes away what they cannot hear), then
-    to FS."""
-    import soundfile  # here, as scipy.signal: only a world with a sound file pays their import
-    from scipy.signal import resample_poly
+        first = played[0] // UP - MARGIN
+        wanted = np.arange(first, played[-1] // UP + MARGIN + 1)
+        samples = self._samples
+        if self.sound.loop:
+            chunk = samples.take(wanted, mode='wrap')
+        else:
+            inside = (wanted >= 0) & (wanted < len(samples))
+            chunk = np.where(inside, samples.take(wanted, mode='clip'), np.float32(0))
+        return resample_poly(chunk, UP, 1, window=_up_filter())[played - UP * first]
 
-    data, rate = soundfile.read(path, dtype='float64', always_2d=True)
-    mono = data.mean(axis=1)
-    if rate != MIC_SAMPLE_RATE_HZ:
-        divisor = math.gcd(int(rate), MIC_SAMPLE_RATE_HZ)
-        mono = resample_poly(mono, MIC_SAMPLE_RATE_HZ // divisor, int(rate) // divisor)
-    mono = resample_poly(mono, FS // MIC_SAMPLE_RATE_HZ, 1)
-    rms = math.sqrt(float(np.mean(mono ** 2)))
-    return mono / rms if rms > 0 else mono
+
+@functools.cache
+def _up_filter():
+    from scipy.signal import firwin
+
+    return firwin(2 * _UP_HALF + 1, 1 / UP, window=('kaiser', 5.0))
 
 
 NOISE_TABLE = 1 << 20  # samples of white noise made once: 26 s at 40 kHz before it repeats

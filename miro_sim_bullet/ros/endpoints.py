@@ -11,10 +11,12 @@ class Endpoints:
     publisher: Callable
     subscription: Callable
     service: Callable
+    timer: Callable
 
     @classmethod
     def of(cls, node):
-        return cls(node.create_publisher, node.create_subscription, node.create_service)
+        return cls(node.create_publisher, node.create_subscription, node.create_service,
+                   node.create_timer)
 
 
 def send_if_listened(publisher, build):

@@ -51,11 +51,12 @@ from miro_sim_bullet.ros.scene import SCENE_RATE_HZ
 from miro_sim_bullet.ros.scene_interface import SceneInterface
 from miro_sim_bullet.ros.sim_interface import SimInterface
 from miro_sim_bullet.ros.tf import TfInterface
+from miro_sim_bullet.scene.sounds import sound_folders
 from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, WorldError
 
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 TYPE_CHECK_PERIOD_S = 1.0  # wall seconds between looks for control publishers of a wrong type
-FIXED_PARAMS = ('world', 'physics_dt', 'frame_width', 'frame_height',
+FIXED_PARAMS = ('world', 'sound_folders', 'physics_dt', 'frame_width', 'frame_height',
                 'camera_rate', 'hfov_deg', 'lens', 'renderer', 'eye_workers', 'peer_check_s')
 
 
@@ -86,7 +87,8 @@ class SimNode(Node):
         self.warn = Throttled(self.get_logger().warning)
         # The world file is read first: a typo in its name is said at once, not after the
         # look for another simulator (peer_check_s).
-        world = load_world(p.world)
+        folders = sound_folders(p.sound_folders)
+        world = load_world(p.world, folders)
         # Before the look for another simulator: two started together see each other.
         self.pub_clock = self.create_publisher(ClockMsg, CLOCK, profile(CLOCK_QOS))
         if guard_domain:  # before the world is built: a refusal costs no time
@@ -111,7 +113,8 @@ class SimNode(Node):
         self.sim_interface = self.scene = None
         if privileged:
             self.sim_interface = SimInterface(ros, self.sim, self.cameras, reset=self.reset,
-                                              pause=self.pause, step=self.step, warn=self.warn)
+                                              pause=self.pause, step=self.step, warn=self.warn,
+                                              sound_folders=folders)
             self.scene = SceneInterface(ros, self.sim)
         # Called after every physics step with the world: an in-process judge sees each
         # contact, however brief.

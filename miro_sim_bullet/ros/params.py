@@ -13,6 +13,10 @@ RENDERERS = ('auto', 'tiny', 'egl')
 class SimParams:
     world: str = field(default='miro',
                        metadata={'help': 'bundled world name or path to a .toml world file'})
+    sound_folders: str = field(
+        default='', metadata={'help': "folders (separated by ':') whose sound files "
+                                      '/miro_sim/sound and the world file may play, besides the '
+                                      "bundled sounds and the world file's own folder"})
     real_time_factor: float = field(
         default=1.0, metadata={'help': 'simulated seconds per wall second; 0 = as fast as possible',
                                'range': (0.0, 1000.0)})

@@ -6,12 +6,14 @@ reset starts the schedule over, a step advances it) belongs to the node that pac
 the world, so the services call the functions it hands in.
 """
 from geometry_msgs.msg import PointStamped, PoseStamped
+from rclpy.clock import Clock, ClockType
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CompressedImage
 from std_msgs.msg import String
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.interface import SimTopics
+from miro_sim_bullet.acoustics.loading import SoundLoads
 from miro_sim_bullet.render.overhead import overhead_camera
 from miro_sim_bullet.render.eye_images import jpeg_bytes
 from miro_sim_bullet.ros import convert
@@ -21,6 +23,7 @@ from miro_sim_bullet.scene.world_file import load_sounds, WorldError
 # ROS's default keeps 10 requests: a burst of 200 clients lost 190 answers.
 SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 OVERHEAD_FRAME = 'overhead'
+LOADED_PERIOD_S = 0.02  # wall seconds between looks for sound files read
 
 
 class SimInterface:
@@ -28,12 +31,15 @@ class SimInterface:
 
     ros: Endpoints; world: the SimWorld; cameras: its Cameras (the overhead view);
     reset(): back to the start; pause(bool) -> whether now paused; step() ->
-    (done, message); warn(kind, message): a rate-limited warning.
+    (done, message); warn(kind, message): a rate-limited warning; sound_folders: where
+    /miro_sim/sound may take files from, besides the bundled sounds (scene.sounds).
     """
 
-    def __init__(self, ros, world, cameras, *, reset, pause, step, warn):
+    def __init__(self, ros, world, cameras, *, reset, pause, step, warn, sound_folders=()):
         self.world, self.cameras = world, cameras
         self._reset, self._pause, self._step, self._warn = reset, pause, step, warn
+        self.sound_folders = sound_folders
+        self.loads = SoundLoads()
         self.overhead = overhead_camera(world.description)
         t = SimTopics()
         self.pub_ball = ros.publisher(PointStamped, t.ball, 10)
@@ -46,6 +52,8 @@ class SimInterface:
         self.sub_set_pose = ros.subscription(PoseStamped, t.set_pose, self._on_set_pose, 10)
         self.sub_sound = ros.subscription(String, t.sound, self._on_sound, 10)
         self.sub_sound_off = ros.subscription(String, t.sound_off, self._on_sound_off, 10)
+        self.loaded_timer = ros.timer(LOADED_PERIOD_S, self._play_loaded,
+                                      clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.srvs = [
             ros.service(Trigger, t.reset, self._on_reset, qos_profile=SERVICE_QOS),
             ros.service(SetBool, t.pause, self._on_pause, qos_profile=SERVICE_QOS),
@@ -65,11 +73,26 @@ class SimInterface:
                        f'{", ".join(self.pub_objects)}')
 
     def _on_sound(self, msg):
+        """Tones and noise play at once; a file plays once read, off this thread."""
         try:
-            for sound in load_sounds(msg.data, SimTopics().sound):
-                self.world.acoustics.add_sound(sound)
+            for sound in load_sounds(msg.data, SimTopics().sound, self.sound_folders):
+                if sound.kind == 'file':
+                    self.loads.ask(sound)
+                else:
+                    self.world.acoustics.add_sound(sound)
         except (WorldError, ValueError) as err:
             self._warn('sound', f'sound ignored: {err}')
+
+    def _play_loaded(self):
+        # ``samples`` stays alive while the sound's source is made: the source takes it from
+        # the bank instead of reading the file again here.
+        for sound, samples, error in self.loads.ready():
+            try:
+                if error is not None:
+                    raise error
+                self.world.acoustics.add_sound(sound)
+            except ValueError as err:
+                self._warn('sound', f'sound {sound.name!r} ignored: {err}')
 
     def _on_sound_off(self, msg):
         if msg.data not in self.world.acoustics.sounds:

@@ -1,20 +1,31 @@
-"""A world file's sounds: ``[[sound]]`` sources and the ``[hearing]`` options (docs/worlds.md).
+"""A world's sounds: ``[[sound]]`` sources and the ``[hearing]`` options (docs/worlds.md).
 
-A sound plays from a point: a sound file (WAV, FLAC, OGG: what libsndfile reads; a bare
-name is one of the bundled sounds in worlds/sounds/, else a file next to the world file), a tone
+A sound plays from a point: a sound file (WAV, FLAC, OGG: what libsndfile reads), a tone
 or white noise, at a level (its RMS 1 m away, in dB of the microphones' full scale), from
 ``start`` seconds of simulated time until ``stop`` (or for ever), a file once or looped.
-A file that is missing, not audio, or too long is refused when the world loads, in one
-line, as every other mistake in a world file.
+
+Which files may be read (docs/limits.md): a sound request comes from anyone on the ROS
+graph (or a web page, through a bridge), so a file is one of the bundled sounds
+(worlds/sounds/), or lies in a folder the simulator was started with (its sound_folders
+parameter) or, for a world file, beside that file (its folder and below), once every
+symbolic link and '..' is resolved; and it is a regular file (a FIFO, a device or a folder
+would block or never end). Its header is checked before a sample is read: 8 to 192 kHz, at
+most MAX_CHANNELS channels and MAX_SOUND_S seconds. Any mistake is refused in one line, as
+every other mistake in a world file.
 """
 import importlib.resources
 import math
+import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
 KINDS = ('file', 'tone', 'noise')
 MAX_SOUNDS = 32
-MAX_SOUND_S = 600.0  # a file's length; 10 minutes at 20 kHz is 48 MB of samples
+MAX_SOUND_S = 600.0  # a file's length: held as float32 at 20 kHz, 10 minutes are 48 MB
+SAMPLE_RATE_RANGE_HZ = (8000, 192000)  # a header outside asked for a 320 GiB filter
+MAX_CHANNELS = 8
+MAX_SOUND_FILE_BYTES = 300_000_000  # 10 minutes of 8 channels at 48 kHz, 16 bits, and more
 LEVEL_RANGE_DB = (-120.0, 0.0)
 TONE_RANGE_HZ = (20.0, 9000.0)  # below the microphones' Nyquist frequency
 
@@ -25,7 +36,7 @@ class Sound:
     position: tuple  # x, y, z (m)
     kind: str  # file | tone | noise
     level_db: float  # RMS 1 m away, dB of full scale
-    file: str = ''  # absolute path, for a file
+    file: str = ''  # absolute path, for a file (checked: sound_file)
     frequency: float = 0.0  # Hz, for a tone
     loop: bool = False  # a file starts again when it ends
     start: float = 0.0  # s of simulated time
@@ -98,26 +109,73 @@ def bundled_sound(name):
     return Path(str(bundled)) if bundled.is_file() else None
 
 
+def sound_folders(text):
+    """The sound_folders parameter (folders separated by ':', as PATH) as resolved Paths;
+    ValueError in one line for one that is no folder."""
+    folders = []
+    for entry in filter(None, text.split(os.pathsep)):
+        path = Path(entry).expanduser()
+        if not path.is_dir():
+            raise ValueError(f'parameter sound_folders: {entry!r} is not a folder'[:200])
+        folders.append(path.resolve())
+    return tuple(folders)
+
+
 def _sound_file(parser, where, value):
-    """The absolute path of a sound file that libsndfile reads, not too long."""
+    """The resolved path of a sound file that may be read (see the module's docstring)."""
     import soundfile  # here: a world without sound files loads with the standard library only
-    if not isinstance(value, str) or not value or '\0' in value:
+    if not isinstance(value, str) or not value or '\0' in value or len(value) > 4096:
         parser.fail(where, f'must be the name of a sound file, got {value!r}'[:120])
-    path = Path(value)
-    bundled = bundled_sound(value) if path.name == value else None
-    if bundled is not None:
-        path = bundled
-    elif parser.folder is not None and not path.is_absolute():
-        path = parser.folder / path
+    path = _allowed_sound(parser, where, value)
     try:
         info = soundfile.info(str(path))
     except (OSError, RuntimeError, soundfile.LibsndfileError) as err:
         parser.fail(where, f'cannot read {value!r} as sound: {str(err)[:100]}')
-    if info.frames <= 0 or info.samplerate <= 0:
+    lo, hi = SAMPLE_RATE_RANGE_HZ
+    if not lo <= info.samplerate <= hi:
+        parser.fail(where, f'{value!r} says {info.samplerate} samples a second; a sound file '
+                           f'must be {lo}..{hi} Hz')
+    if not 1 <= info.channels <= MAX_CHANNELS:
+        parser.fail(where, f'{value!r} has {info.channels} channels; at most {MAX_CHANNELS}')
+    if info.frames <= 0:
         parser.fail(where, f'{value!r} holds no sound')
     if info.frames / info.samplerate > MAX_SOUND_S:
         parser.fail(where, f'{value!r} is longer than {MAX_SOUND_S:g} s')
-    return str(path.resolve())
+    return str(path)
+
+
+def _allowed_sound(parser, where, value):
+    """value as a regular file in one of the allowed folders (bundled sounds first, then
+    the world file's folder, then sound_folders; a relative path is looked for in each)."""
+    folders = [_bundled_folder(), *parser.sound_roots()]
+    candidates = [Path(value)] if Path(value).is_absolute() else \
+        [folder / value for folder in folders]
+    for candidate in candidates:
+        try:
+            path = candidate.resolve()
+            if not any(path.is_relative_to(folder) for folder in folders):
+                continue
+            found = path.stat()
+        except (OSError, RuntimeError, ValueError):  # missing, a link loop, too long a name
+            continue
+        if not stat.S_ISREG(found.st_mode):
+            parser.fail(where, f'{value!r} is not a regular file (a FIFO, device or folder is '
+                               'never opened)'[:200])
+        if found.st_size > MAX_SOUND_FILE_BYTES:
+            parser.fail(where, f'{value!r} is larger than {MAX_SOUND_FILE_BYTES} bytes')
+        return path
+    parser.fail(where, f'no sound file {value!r} in the allowed folders: a bundled sound '
+                       f'({", ".join(bundled_sounds())}), a file beside the world file, or in '
+                       "the simulator's sound_folders"[:300])
+
+
+def _bundled_folder():
+    return Path(str(importlib.resources.files('miro_sim_bullet.worlds') / 'sounds')).resolve()
+
+
+def bundled_sounds():
+    """File names of the sounds installed with the package (worlds/sounds/)."""
+    return sorted(p.name for p in _bundled_folder().iterdir() if p.suffix == '.ogg')
 
 
 def parse_hearing(parser, table):

@@ -162,8 +162,9 @@ def bundled_worlds():
     return sorted(p.name[:-5] for p in _bundled().iterdir() if p.name.endswith('.toml'))
 
 
-def load_world(name_or_path):
-    """A bundled world by name ('miro', 'empty', ...) or a user's .toml file."""
+def load_world(name_or_path, sound_folders=()):
+    """A bundled world by name ('miro', 'empty', ...) or a user's .toml file; its sound
+    files may also come from ``sound_folders`` (resolved Paths: scene.sounds)."""
     raw, source, folder = _read(str(name_or_path))
     if len(raw) > MAX_FILE_BYTES:
         raise WorldError(f'{source}: larger than {MAX_FILE_BYTES} bytes')
@@ -177,12 +178,13 @@ def load_world(name_or_path):
         raise WorldError(f'{source}: not valid TOML: {err}') from None
     except RecursionError:
         raise WorldError(f'{source}: nested too deeply') from None
-    return _Parser(source, folder).world(data, Path(source).stem)
+    return _Parser(source, folder, sound_folders).world(data, Path(source).stem)
 
 
-def load_sounds(text, source):
-    """The [[sound]] tables of a TOML text (what /miro_sim/sound carries) as Sounds; a
-    WorldError in one line as for a world file (``source`` names it)."""
+def load_sounds(text, source, sound_folders=()):
+    """The [[sound]] tables of a TOML text (what /miro_sim/sound carries) as Sounds, their
+    files from the bundled sounds or ``sound_folders`` only; a WorldError in one line as
+    for a world file (``source`` names it)."""
     if len(text) > MAX_FILE_BYTES:
         raise WorldError(f'{source}: larger than {MAX_FILE_BYTES} bytes')
     try:
@@ -191,7 +193,7 @@ def load_sounds(text, source):
         raise WorldError(f'{source}: not valid TOML: {err}') from None
     except RecursionError:
         raise WorldError(f'{source}: nested too deeply') from None
-    parser = _Parser(source)
+    parser = _Parser(source, sound_folders=sound_folders)
     parser.keys('top level', data, {'sound'})
     return parse_sounds(parser, data.get('sound', []))
 
@@ -239,9 +241,10 @@ def _read(name):
 class _Parser:
     """Checks one file's tables and turns them into dataclasses."""
 
-    def __init__(self, source, folder=None):
+    def __init__(self, source, folder=None, sound_folders=()):
         self.source = source
         self.folder = folder  # of a user's world file: where its pictures' paths start
+        self.sound_folders = tuple(sound_folders)  # besides it, where sound files may be
         self.names = {BALL_NAME}  # taken so far; the ball's name is always taken
         self.shapes = []
         self.pictures = []
@@ -249,6 +252,11 @@ class _Parser:
 
     def fail(self, where, problem):
         raise WorldError(f'{self.source}: {where}: {problem}')
+
+    def sound_roots(self):
+        """The folders a sound file may come from besides the bundled sounds."""
+        own = [Path(self.folder).resolve()] if self.folder is not None else []
+        return own + list(self.sound_folders)
 
     def keys(self, where, table, allowed):
         if not isinstance(table, dict):
