@@ -136,3 +136,65 @@ def test_the_layout_in_docs_shows_topics_that_exist():
             robot.wheel_speed_cmd, SimTopics().scene} <= named
     panels = json.dumps(layout['layout'])
     assert all(panel in panels for panel in layout['configById'])
+
+
+@pytest.mark.parametrize('origin, let_in', [
+    (None, True),  # a program, not a page
+    ('https://app.foxglove.dev', True),
+    ('http://localhost:8080', True), ('http://127.0.0.1:3000', True), ('http://[::1]:5173', True),
+    ('https://evil.example.com', False), ('null', False),  # a sandboxed frame of any page
+    ('http://localhost.evil.example.com', False), ('https://app.foxglove.dev.evil.com', False),
+    ('https://foxglove.example.org', True),  # --allow-origin's pattern below
+])
+def test_only_the_foxglove_app_pages_of_this_machine_and_origins_allowed_connect(
+        ros_context, executor, origin, let_in):
+    from websockets.exceptions import InvalidStatus
+
+    node = FoxgloveBridge('127.0.0.1', 0, context=ros_context,
+                          origins=['https://*.example.org'])
+    executor.add_node(node)
+    try:
+        def connect_as_page():
+            return connect(f'ws://127.0.0.1:{node.port}', subprotocols=['foxglove.sdk.v1'],
+                           origin=origin, close_timeout=0.5, open_timeout=5)
+        if let_in:
+            with connect_as_page() as ws:
+                assert json.loads(ws.recv(timeout=5))['op'] == 'serverInfo'
+        else:
+            with pytest.raises(InvalidStatus, match='403'):
+                connect_as_page()
+        assert node.gate.refused == (0 if let_in else 1)
+    finally:
+        executor.remove_node(node)
+        node.close()
+        node.destroy_node()
+
+
+@pytest.mark.parametrize('bridge', [True], indirect=True)
+def test_a_client_may_publish_on_a_robots_control_topics_only(paused_sim, executor, bridge,
+                                                               capfd):
+    from std_msgs.msg import String
+
+    with client(bridge) as ws:
+        receive(ws, paused_sim, executor, lambda texts, _: T.odom in channels_of(texts))
+        ws.send(json.dumps({'op': 'advertise', 'channels': [
+            {'id': 7, 'topic': '/miro_sim/sound', 'encoding': 'cdr',
+             'schemaName': 'std_msgs/msg/String'},
+            {'id': 8, 'topic': T.cmd_vel, 'encoding': 'cdr',
+             'schemaName': 'geometry_msgs/msg/TwistStamped'}]}))
+        ws.send(struct.pack('<BI', MESSAGE_DATA, 7)
+                + serialize_message(String(data='[[sound]]\ntone = 440\n')))
+        advance_ticks(paused_sim, executor, 10)
+    assert [topic for _, topic, _ in bridge.client_publishers.values()] == [T.cmd_vel]
+    assert not paused_sim.sim.acoustics.sounds
+    assert "may not publish on '/miro_sim/sound'" in capfd.readouterr().err
+
+
+def test_the_control_topics_are_each_robots_and_nothing_else():
+    from miro_ball.miro.interface import is_control_topic
+
+    assert is_control_topic(T.cmd_vel) and is_control_topic('/miro02/control/illum')
+    for topic in ('/miro_sim/sound', '/miro_sim/set_pose', f'/{T.name}/sensors/odom',
+                  f'/{T.name}/control/cmd_vel/x', '/a/b/control/cmd_vel', 'control/cmd_vel',
+                  '/1x/control/cmd_vel', None):
+        assert not is_control_topic(topic), topic

@@ -115,7 +115,7 @@ def test_the_sound_folders_parameter_must_name_folders():
 
 
 def test_a_file_of_nan_samples_is_refused_not_played_as_silence(allowed):
-    path = wav(allowed[0] / 'nan.wav', samples=np.full(800, np.nan), subtype='FLOAT')
+    wav(allowed[0] / 'nan.wav', samples=np.full(800, np.nan), subtype='FLOAT')
     sound, = request('nan.wav', allowed)
     with pytest.raises(SoundFileError, match='not numbers'):
         SoundBank().samples(sound.file)

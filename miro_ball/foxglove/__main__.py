@@ -24,8 +24,13 @@ def build_parser():
     parser.add_argument('--port', type=int, default=DEFAULT_PORT,
                         help=f'port ({DEFAULT_PORT}, Foxglove\'s default); 0: any free port')
     parser.add_argument('--allow-publish', action='store_true',
-                        help="let Foxglove publish (its Teleop panel on control/cmd_vel); off "
-                             'by default: a viewer drives nothing')
+                        help="let Foxglove publish on each robot's control topics (its Teleop "
+                             'panel on control/cmd_vel), and on nothing else; off by default: '
+                             'a viewer drives nothing')
+    parser.add_argument('--allow-origin', action='append', default=[], metavar='PATTERN',
+                        help='also let in web pages of this origin (fnmatch pattern, e.g. '
+                             "'https://foxglove.example.org'); the Foxglove app and pages of "
+                             'this machine always may, any other page is refused')
     parser.add_argument('--topics', nargs='+', default=['*'], metavar='PATTERN',
                         help=f"offer only these topics (fnmatch patterns: '/{DEFAULT_ROBOT_NAME}/*')")
     return parser
@@ -46,8 +51,9 @@ def main(argv=None):
     from miro_ball.foxglove.bridge import FoxgloveBridge
 
     try:
-        bridge = FoxgloveBridge(args.host, args.port, args.allow_publish, args.topics)
-    except RuntimeError as err:  # the SDK's error when the port is taken
+        bridge = FoxgloveBridge(args.host, args.port, args.allow_publish, args.topics,
+                                origins=args.allow_origin)
+    except (RuntimeError, OSError) as err:  # the port is taken, or no such address
         print(f'{PROG}: cannot serve on {args.host}:{args.port}: {err}', file=sys.stderr)
         rclpy.try_shutdown()
         return 1

@@ -8,6 +8,10 @@ node's timer does in the ROS thread (rclpy's entities are made and destroyed the
 
 Messages are stamped with simulated time (the latest /clock) when a simulator runs, and the
 server tells clients that time, so Foxglove's timeline is the world's.
+
+Who may connect is the gate's rule (gate.py: the Foxglove app and pages of this machine);
+with allow_publish a client may publish on each robot's control topics only (a teleop's),
+never on the simulator's own (/miro_sim/sound, set_pose) nor anything else.
 """
 import fnmatch
 import queue
@@ -20,9 +24,10 @@ from rosgraph_msgs.msg import Clock
 
 from miro_ball.common.definitions import ros2msg
 from miro_ball.common.messages import message_class
-from miro_ball.miro.interface import CLOCK, CLOCK_QOS
 from miro_ball.common.qos import matching, profile
 from miro_ball.common.throttle import Throttled
+from miro_ball.foxglove.gate import hidden_address, OriginGate
+from miro_ball.miro.interface import CLOCK, CLOCK_QOS, is_control_topic
 
 NODE_NAME = 'miro_foxglove'
 DISCOVERY_PERIOD_S = 1.0  # wall seconds between looks for new topics
@@ -61,10 +66,13 @@ class Listener(ServerListener):
 
 
 class FoxgloveBridge(Node):
-    """See the module docstring. allow_publish: clients may publish (their advertised
-    channels become ROS publishers); topics: fnmatch patterns of what to offer (all)."""
+    """See the module docstring. allow_publish: clients may publish on the robots' control
+    topics (their advertised channels become ROS publishers); topics: fnmatch patterns of
+    what to offer (all); origins: fnmatch patterns of the web pages let in besides the
+    Foxglove app and this machine's (gate.py). OSError when the port is taken."""
 
-    def __init__(self, host, port, allow_publish=False, topics=('*',), context=None):
+    def __init__(self, host, port, allow_publish=False, topics=('*',), context=None,
+                 origins=()):
         super().__init__(NODE_NAME, context=context)
         self.patterns = tuple(topics)
         self.allow_publish = allow_publish
@@ -75,17 +83,24 @@ class FoxgloveBridge(Node):
         self.work = queue.Queue(MAX_QUEUED)
         self._warn = Throttled(self.get_logger().warning)
         capabilities = [Capability.Time] + ([Capability.ClientPublish] if allow_publish else [])
+        hidden = hidden_address()
         self.server = foxglove.start_server(
-            name='miro_ball', host=host, port=port, capabilities=capabilities,
+            name='miro_ball', host=hidden, port=0, capabilities=capabilities,
             server_listener=Listener(self.work, self._warn),
             supported_encodings=['cdr'] if allow_publish else None)
-        self.port = self.server.port
+        try:
+            self.gate = OriginGate(host, port, (hidden, self.server.port), origins, self._warn)
+        except OSError:
+            self.server.stop()
+            raise
+        self.port = self.gate.port
         self.create_subscription(Clock, CLOCK, self._on_clock, profile(CLOCK_QOS))
         self.create_timer(DISCOVERY_PERIOD_S, self.discover)
         self.create_timer(WORK_PERIOD_S, self.do_work)
         self.discover()
 
     def close(self):
+        self.gate.close()
         self.server.stop()
         for channel in self.channels.values():
             channel.close()
@@ -150,6 +165,10 @@ class FoxgloveBridge(Node):
     def _advertise(self, argument):
         client, channel_id, topic, type_name, encoding = argument
         if not self.allow_publish:
+            return
+        if not is_control_topic(topic):
+            self._warn('advertise_topic', f'a Foxglove client may not publish on {topic[:100]!r}: '
+                       "only a robot's control topics (/<robot>/control/...) are open to it")
             return
         try:
             msg_class = message_class(type_name)

@@ -162,6 +162,7 @@ ROBOT_INTERFACE = tuple(Topic(*row[:6], *(row[6:] or (None,))) for row in (
      'platform flags'),
 ))
 TOPIC = {row.key: row for row in ROBOT_INTERFACE}
+_CONTROL_NAMES = frozenset(row.name for row in ROBOT_INTERFACE if row.direction == CONTROL)
 
 # Demo mode's own topics (the MDK's "core" layer), in the robot's namespace beside the
 # robot's: what it shows of itself (out) and what clients tell it (in). The MDK's names;
@@ -236,6 +237,14 @@ def robot_of_namespace(namespace):
 def frame_id(robot, frame):
     """A robot's frame: '<robot>/<frame>' (the frame prefix convention)."""
     return f'{robot}/{frame}'
+
+
+def is_control_topic(topic):
+    """Whether topic is one of the control topics of some robot ('/<robot>/control/...' of
+    the interface table): what a teleop may publish on, and nothing else."""
+    parts = topic.split('/', 2) if isinstance(topic, str) else ()
+    return len(parts) == 3 and parts[0] == '' and bool(_TOKEN.match(parts[1])) \
+        and len(parts[1]) <= MAX_NAME_LENGTH and parts[2] in _CONTROL_NAMES
 
 
 def robots_in(topic_names):
