@@ -112,6 +112,11 @@ def test_params_and_services_of_the_simulator(paused_sim, executor):
      'no interface geometry_msgs/msg/Twistt'),
     (['interface', 'show', 'nonsense'], 'is not a type name'),
     (['param', 'get', '/no_such_node', 'x'], 'no node /no_such_node'),
+    (['topic', 'pub', '--once', '/bad topic', 'std_msgs/msg/String', '{data: hi}'],
+     "'/bad topic' is not a ROS name"),
+    (['service', 'call', '/a//b', 'std_srvs/srv/Trigger'], "'/a//b' is not a ROS name"),
+    (['topic', 'pub', '--once', T.cmd_vel, 'geometry_msgs/msg/TwistStamped',
+      '{twist: ' + '[' * 5000 + ']' * 5000 + '}'], 'the values are nested too deeply'),
 ])
 def test_bad_input_is_one_line_and_exit_1(args, says, paused_sim, executor):
     code, out, err = ros2(args, paused_sim, executor)

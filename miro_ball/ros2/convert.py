@@ -59,11 +59,13 @@ def parse_yaml(text):
     except yaml.YAMLError as err:
         mark = getattr(err, 'problem_mark', None)
         where = f' (line {mark.line + 1}, column {mark.column + 1})' if mark else ''
-        raise ValueError(f'the values are not valid YAML{where}: {text!r}') from None
+        raise ValueError(f'the values are not valid YAML{where}: {text[:200]!r}') from None
+    except RecursionError:
+        raise ValueError('the values are nested too deeply') from None
     if data is None:
         data = {}
     if not isinstance(data, dict):
-        raise ValueError(f'the values must be a YAML mapping of field: value, got {text!r}')
+        raise ValueError(f'the values must be a YAML mapping of field: value, got {text[:200]!r}')
     return data
 
 

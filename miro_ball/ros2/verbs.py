@@ -38,7 +38,18 @@ def interface_class(type_name):
 
 
 def absolute(name):
-    return name if name.startswith('/') else '/' + name
+    """A topic or service name made absolute, checked by ROS's rules: CliError in one
+    line for a name ROS refuses (rclpy's own error is a traceback with a caret under it)."""
+    from rclpy.exceptions import NameValidationException
+    from rclpy.validate_full_topic_name import validate_full_topic_name
+
+    full = name if name.startswith('/') else '/' + name
+    try:
+        validate_full_topic_name(full)
+    except NameValidationException as err:
+        reason = str(err).splitlines()[0].split(':', 1)[-1].strip().rstrip(':')
+        raise CliError(f'{name[:100]!r} is not a ROS name: {reason}') from None
+    return full
 
 
 def print_listing(listing, show_types):
@@ -199,7 +210,7 @@ def parameter_value(text):
 
     try:
         value = yaml.safe_load(text)
-    except yaml.YAMLError:
+    except (yaml.YAMLError, RecursionError):
         value = text
     kinds = ((bool, ParameterType.PARAMETER_BOOL), (int, ParameterType.PARAMETER_INTEGER),
              (float, ParameterType.PARAMETER_DOUBLE), (str, ParameterType.PARAMETER_STRING))
@@ -228,12 +239,13 @@ def service_list(args, graph):
 
 
 def service_call(args, graph):
+    service = absolute(args.service)
     srv_class = interface_class(args.type)
     if not hasattr(srv_class, 'Request'):
         raise CliError(f'{args.type} is not a service type (package/srv/Name)')
     request = convert.fill(srv_class.Request(), convert.parse_yaml(args.values))
     print(f'requester: making request: {request!r}\n')
-    response = graph.call(absolute(args.service), srv_class, request)
+    response = graph.call(service, srv_class, request)
     print(f'response:\n{response!r}\n')
     return 0
 
