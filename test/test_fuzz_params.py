@@ -65,3 +65,16 @@ def test_controller_parameters_at_run_time(ros_context, executor):
         assert drives_at_a_ball_ahead(rig)
     finally:
         rig.close()
+
+
+def test_a_flood_of_changes_is_a_few_log_lines_and_each_is_applied(paused_sim, capfd):
+    """A client toggling a switch a thousand times a second logged a line a change (demo
+    mode's core/config/command: 1,900 lines in 6 s)."""
+    node = paused_sim
+    capfd.readouterr()
+    for index in range(200):
+        quality = 50 + index % 2
+        assert node.set_parameters([Parameter('jpeg_quality', value=quality)])[0].successful
+        assert node.params.jpeg_quality == quality
+    said = [line for line in capfd.readouterr().err.splitlines() if 'set at run time' in line]
+    assert 1 <= len(said) <= 2, said

@@ -303,14 +303,32 @@ def test_bad_messages_are_ignored_and_the_page_stays_connected():
                 session.ws_connect(address + 'ws') as ws:
             assert (await next_of_kind(ws, 'config'))['t'] == 'config'
             for text in ('{"t": []}', '{"t": "drive", "linear": ' + '9' * 400 + ', "angular": 0}',
-                         '{"t": "robot", "name": "' + '\U0001F600' * 3000 + '"}'):
+                         '{"t": "robot", "name": "' + '\U0001F600' * 3000 + '"}') * 50:
                 await ws.send_str(text)
             await ws.send_str('{"t": "stop"}')
             await until(lambda: bridge.got(p.Stop))
             assert not ws.closed and bridge.commands[0] == ('open', 1)
             assert len(bridge.commands) == 2  # nothing of the bad ones reached the bridge
-            assert len(warnings) == 1 and 'ignored' in warnings[0]  # throttled: one line
+            # Throttled: a line for each of the three causes, not 150.
+            assert len(warnings) == 3 and all('ignored' in line for line in warnings)
     asyncio.run(run())
+
+
+def test_a_binary_or_oversized_message_is_said_for_what_it_is():
+    async def run():
+        async with web_gui(FakeBridge()) as (server, address, warnings), \
+                aiohttp.ClientSession() as session:
+            async with session.ws_connect(address + 'ws') as ws:
+                await ws.send_bytes(b'\x00\x01')
+                await until(lambda: warnings)
+            async with session.ws_connect(address + 'ws') as ws:
+                await ws.send_str('{"t": "stop", "x": "' + 'a' * web_server.MAX_MESSAGE_BYTES + '"}')
+                await until(lambda: len(warnings) == 2)
+            return warnings
+    binary, oversized = asyncio.run(run())
+    assert 'a binary message ignored' in binary
+    assert 'its socket is closed' in oversized and f'at most {web_server.MAX_MESSAGE_BYTES} ' \
+        'bytes' in oversized and 'non-text' not in oversized
 
 
 def test_bad_http_requests_cost_one_warning_and_no_traceback(capfd, caplog):
@@ -335,7 +353,9 @@ def test_bad_http_requests_cost_one_warning_and_no_traceback(capfd, caplog):
     with caplog.at_level('DEBUG'):
         answers, warnings = asyncio.run(run())
     assert all(answer.split(b' ')[1] == b'400' for answer in answers)
-    assert len(warnings) == 1 and 'Traceback' not in warnings[0] and '\n' not in warnings[0]
+    # A line for each of the four causes, not for each of the 100 requests.
+    assert len(warnings) == len(bad)
+    assert not any('Traceback' in line or '\n' in line for line in warnings)
     out, err = capfd.readouterr()
     assert 'Traceback' not in out + err and 'Error handling request' not in out + err
     assert not [rec for rec in caplog.records if rec.levelname in ('WARNING', 'ERROR')]

@@ -10,6 +10,8 @@ Every number is bounded: a value that is legal but absurd (a 1e9 s tick, a
 import math
 from dataclasses import fields, MISSING, replace
 
+from miro_ball.common.throttle import Throttled
+
 # Parameters every rclpy node has; a user may set them on any of ours.
 ROS_OWN_PARAMS = {'use_sim_time': False, 'start_type_description_service': True}
 ROS_OWN_PREFIXES = ('qos_overrides.',)
@@ -194,7 +196,8 @@ class LiveParams:
     def __init__(self, node, values, apply, fixed=()):
         self.values = {type(v): v for v in values}
         self.apply = apply
-        self.log = node.get_logger().info
+        # A client may toggle a switch a thousand times a second: a few lines, not a flood.
+        self.log = Throttled(node.get_logger().info)
         self.fixed = set(fixed)
         self._owner = {f.name: (cls, f) for cls in self.values for f in fields(cls)}
         node.add_on_set_parameters_callback(self._on_set)
@@ -221,5 +224,5 @@ class LiveParams:
         for values in changed:
             self.apply(values)
         if said:
-            self.log('set at run time: ' + ', '.join(said))
+            self.log('set', 'set at run time: ' + ', '.join(said))
         return SetParametersResult(successful=True)

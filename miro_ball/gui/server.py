@@ -216,8 +216,14 @@ class GuiServer:
 
     async def _receive(self, page):
         async for msg in page.ws:
+            if msg.type == WSMsgType.ERROR:  # aiohttp's word for a message past the limit too
+                error = str(page.ws.exception() or 'a broken message')[:150]
+                self.warn('ws_error', f'page {page.number}: its socket is closed: {error} '
+                          f'(a message may be at most {MAX_MESSAGE_BYTES} bytes)')
+                continue
             if msg.type != WSMsgType.TEXT:
-                self.warn('binary', f'page {page.number}: a non-text message ignored')
+                self.warn('binary', f'page {page.number}: a {msg.type.name.lower()} message '
+                          'ignored: pages send text (JSON)')
                 continue
             try:
                 command, clamped = protocol.parse(msg.data)

@@ -17,6 +17,7 @@ from std_srvs.srv import SetBool, Trigger
 from miro_ball.common.clock_watch import clock_publishers, ClockWatch, shared_domain_line
 from miro_ball.common.qos import profile
 from miro_ball.common.stamps import seconds
+from miro_ball.common.throttle import Throttled
 from miro_ball.miro.interface import CLOCK, CONTROL_QOS, SimTopics
 
 RTF_PARAMETER = 'real_time_factor'
@@ -31,6 +32,8 @@ class SimLink:
     def __init__(self, node, report, warn):
         self.node = node
         self.report = report
+        # What pages ask of the simulator, for the log: 200 pages' resets are a few lines.
+        self.said = Throttled(node.get_logger().info)
         self.warn = warn
         self.topics = SimTopics()
         self.time = None
@@ -119,7 +122,7 @@ class SimLink:
             if name == 'pause' and result.success:
                 self.paused = request.data
             self.report(f'{action}: {result.message}')
-            self.node.get_logger().info(f'simulator {action}: {result.message}')
+            self.said(action, f'simulator {action}: {result.message}')
         client.call_async(request).add_done_callback(done)
 
     def set_rtf(self, value):
@@ -137,7 +140,7 @@ class SimLink:
             if results and results[0].successful:
                 self.rtf_set = float(value)
                 self.report(f'real-time factor set to {value:g}')
-                self.node.get_logger().info(f'real-time factor set to {value:g}')
+                self.said('rtf', f'real-time factor set to {value:g}')
             else:
                 reason = results[0].reason if results else 'no answer'
                 self.report(f'real-time factor {value:g} refused: {reason}')

@@ -85,6 +85,7 @@ class SimNode(Node):
         self.params = p = declare(self, SimParams)
         self._live = LiveParams(self, (p,), self._apply, fixed=FIXED_PARAMS)
         self.warn = Throttled(self.get_logger().warning)
+        self.said = Throttled(self.get_logger().info)  # what clients ask often (a reset)
         # The world file is read first: a typo in its name is said at once, not after the
         # look for another simulator (peer_check_s).
         folders = sound_folders(p.sound_folders)
@@ -195,7 +196,7 @@ class SimNode(Node):
         if self.sim_interface is not None:
             self.sim_interface.forget_touches()
         self._restart_schedule()
-        self.get_logger().info('world reset')
+        self.said('reset', 'world reset')
 
     def pause(self, paused):
         """Pause or run; whether paused now. Through the parameter, so that it always says
