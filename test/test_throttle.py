@@ -43,3 +43,10 @@ def test_a_long_message_is_cut_to_a_line_a_person_reads():
     warn, lines, _ = throttled()
     warn('camera_info', 'distortion model ' + 'x' * 5000)
     assert len(lines[0]) <= MAX_CHARS and lines[0].endswith('(cut short)')
+
+
+def test_nan_and_infinity_are_numbers_of_one_cause():
+    warn, lines, _ = throttled()
+    for value in ('nan', 'inf', '-inf', '1e9', 'NaN'):
+        warn('pose', f'set_pose ignored: position must be finite, got ({value}, 0.0, 0.1)')
+    assert len(lines) == 1

@@ -11,11 +11,13 @@ import time
 
 CAUSES_PER_PERIOD = 10
 MAX_CHARS = 300  # a line a person reads: a message longer than this is cut
-_NUMBER = re.compile(r'[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?')
+_NUMBER = re.compile(r'[-+]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|\b(?:nan|inf)\b)',
+                     re.IGNORECASE)
 
 
 def cause_of(message):
-    """What makes two messages the same complaint: their words, not their numbers."""
+    """What makes two messages the same complaint: their words, not their numbers (NaN and
+    infinity are numbers too)."""
     return _NUMBER.sub('#', message)
 
 

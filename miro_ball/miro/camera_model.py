@@ -135,11 +135,11 @@ class CameraModel:
 
     def _set(self, intrinsics, distortion_model, d):
         if distortion_model not in DISTORTION_MODELS:
-            raise ValueError(f'distortion model {distortion_model!r} is not one of '
+            raise ValueError(f'distortion model {str(distortion_model)[:40]!r} is not one of '
                              + ', '.join(DISTORTION_MODELS))
         d = tuple(float(v) for v in d)
         if not all(math.isfinite(v) for v in d):
-            raise ValueError(f'distortion coefficients must be finite, got {d}')
+            raise ValueError(f'distortion coefficients must be finite, got {d[:8]}')
         if distortion_model == EQUIDISTANT:
             if len(d) != 4:
                 raise ValueError(f'equidistant needs 4 coefficients, got {len(d)}')
