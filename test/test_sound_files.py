@@ -197,3 +197,22 @@ def test_files_are_read_off_the_callers_thread_and_a_slow_read_is_given_up(allow
         (name, "'ok.wav' was not read within 10 s: given up") for name in ('a', 'b')]
     assert loads.pending == 0
 
+
+
+@pytest.mark.parametrize('loop', [False, True])
+def test_a_file_plays_at_40_khz_as_the_whole_file_resampled_at_once(allowed, loop):
+    """Held at 20 kHz, doubled tick by tick as it plays: the same samples as scipy's
+    resample_poly of the whole file (what was held before, at four times the memory)."""
+    from scipy.signal import resample_poly
+
+    from miro_sim_bullet.acoustics.sources import WorldSource
+
+    path = wav(allowed[0] / 'tune.wav', seconds=0.5, rate=20000)
+    source = WorldSource(Sound('s', (0, 0, 0), 'file', 0.0, file=str(path), loop=loop), (0,))
+    ticks = [source.emit(n0, 800) for n0 in range(0, 800 * 30, 800)]
+    played = np.concatenate([np.zeros(800) if tick is None else tick for tick in ticks])
+    whole = resample_poly(SoundBank().samples(str(path)).astype(np.float64), 2, 1)
+    assert np.abs(played[:len(whole)] - whole).max() < 1e-9 if not loop else \
+        np.abs(played[100:len(whole) - 100] - whole[100:-100]).max() < 1e-9
+    if loop:  # and on again from its start
+        assert np.abs(played[len(whole) + 100:len(whole) + 900] - whole[100:900]).max() < 1e-6

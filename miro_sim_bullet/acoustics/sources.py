@@ -67,8 +67,6 @@ class WorldSource:
     def _played(self, played):
         """The file's samples at FS for ``played`` (consecutive indices since its start):
         looped, it wraps around; else nothing is before its start or after its end."""
-        from scipy.signal import resample_poly  # here: only a world with a file pays for it
-
         first = played[0] // UP - MARGIN
         wanted = np.arange(first, played[-1] // UP + MARGIN + 1)
         samples = self._samples
@@ -77,14 +75,28 @@ class WorldSource:
         else:
             inside = (wanted >= 0) & (wanted < len(samples))
             chunk = np.where(inside, samples.take(wanted, mode='clip'), np.float32(0))
-        return resample_poly(chunk, UP, 1, window=_up_filter())[played - UP * first]
+        return _upsampled(chunk)[played - UP * first]
+
+
+def _upsampled(chunk):
+    """chunk at UP times its rate, as scipy's resample_poly(chunk, UP, 1) makes it (its
+    filter, its delay), one polyphase branch for each of the UP phases: a tenth of its cost
+    on a tick's few hundred samples."""
+    taps = _up_filter()
+    delay = _UP_HALF // UP
+    out = np.empty(UP * len(chunk))
+    for phase in range(UP):
+        out[phase::UP] = np.convolve(chunk, taps[phase::UP])[delay:delay + len(chunk)]
+    return out
 
 
 @functools.cache
 def _up_filter():
+    """resample_poly's own low-pass for UP (a Kaiser window, 10 zero crossings a side),
+    with the gain UP that the zeros put between the samples take away."""
     from scipy.signal import firwin
 
-    return firwin(2 * _UP_HALF + 1, 1 / UP, window=('kaiser', 5.0))
+    return UP * firwin(2 * _UP_HALF + 1, 1 / UP, window=('kaiser', 5.0))
 
 
 NOISE_TABLE = 1 << 20  # samples of white noise made once: 26 s at 40 kHz before it repeats
