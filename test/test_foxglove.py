@@ -198,3 +198,36 @@ def test_the_control_topics_are_each_robots_and_nothing_else():
                   f'/{T.name}/control/cmd_vel/x', '/a/b/control/cmd_vel', 'control/cmd_vel',
                   '/1x/control/cmd_vel', None):
         assert not is_control_topic(topic), topic
+
+
+@pytest.mark.parametrize('bridge', [True], indirect=True)
+def test_a_type_name_runs_no_code_and_a_flood_of_channels_is_bounded(paused_sim, executor,
+                                                                     bridge, capfd):
+    """'venv/__main__/X' as a type imported venv's main, whose SystemExit ended the bridge;
+    2000 advertised channels kept 2000 ROS publishers."""
+    from miro_ball.foxglove.bridge import MAX_CLIENT_CHANNELS
+
+    with client(bridge) as ws:
+        receive(ws, paused_sim, executor, lambda texts, _: T.odom in channels_of(texts))
+        ws.send(json.dumps({'op': 'advertise', 'channels': [
+            {'id': 1, 'topic': T.cmd_vel, 'encoding': 'cdr', 'schemaName': name}
+            for name in ('venv/__main__/X', 'venv/msg/X', 'os/msg/X')]}))
+        ws.send(json.dumps({'op': 'advertise', 'channels': [
+            {'id': 10 + k, 'topic': T.cmd_vel, 'encoding': 'cdr',
+             'schemaName': 'geometry_msgs/msg/TwistStamped'} for k in range(200)]}))
+        advance_ticks(paused_sim, executor, 10)
+    assert len(bridge.client_publishers) == MAX_CLIENT_CHANNELS
+    err = capfd.readouterr().err
+    assert "as 'venv/__main__/X', not a ROS 2 type here" in err and 'channels already' in err
+
+
+def test_a_request_that_is_no_websocket_is_answered_by_the_gate(bridge):
+    import socket
+
+    for request in (b'GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n',
+                    b'GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nOrigin: https://evil.example.com\r\n'
+                    b'\r\n'):
+        with socket.create_connection(('127.0.0.1', bridge.port), timeout=5) as sock:
+            sock.sendall(request)
+            assert sock.recv(100).startswith(b'HTTP/1.1 400 ')
+    assert bridge.gate.refused == 0  # not a page's WebSocket: nothing to warn of

@@ -1,16 +1,38 @@
 """ROS message classes from the type names of the interface table ('sensor_msgs/msg/Range')."""
 import importlib
+import importlib.util
+import re
+from pathlib import Path
 
 from miro_ball.miro.interface import frame_id
 
+# A type name as rosidl makes them: a package, msg, a CamelCase name.
+_TYPE_NAME = re.compile(r'([a-z][a-z0-9_]*)/msg/([A-Z][A-Za-z0-9]*)\Z')
+
 
 def message_class(type_name):
-    """The Python class of a message type 'package/msg/Name'; ValueError if there is none."""
+    """The Python class of a message type 'package/msg/Name'; ValueError if there is none.
+
+    A type name may come from outside (a Foxglove client's advertisement): only a package
+    with rosidl's generated msg/ folder is imported, so 'venv/msg/X' runs nothing of venv's
+    (importing venv.__main__ ran its main() and ended the bridge)."""
+    match = _TYPE_NAME.match(type_name) if isinstance(type_name, str) else None
+    if match is None or not _interface_package(match[1]):
+        raise ValueError(f'no ROS message type {str(type_name)[:100]!r}')
     try:
-        package, kind, name = type_name.split('/')
-        return getattr(importlib.import_module(f'{package}.{kind}'), name)
-    except (ValueError, ImportError, AttributeError):
+        return getattr(importlib.import_module(f'{match[1]}.msg'), match[2])
+    except Exception:  # noqa: BLE001 -- whatever a broken package raises, it is no type here
         raise ValueError(f'no ROS message type {type_name!r}') from None
+
+
+def _interface_package(package):
+    """Whether ``package`` is found and has a generated msg/ folder (found, not imported)."""
+    try:
+        spec = importlib.util.find_spec(package)
+    except (ImportError, ValueError):
+        return False
+    return spec is not None and any((Path(place) / 'msg' / '__init__.py').is_file()
+                                    for place in spec.submodule_search_locations or ())
 
 
 def drive_command(node, robot, linear, angular):

@@ -33,6 +33,10 @@ NODE_NAME = 'miro_foxglove'
 DISCOVERY_PERIOD_S = 1.0  # wall seconds between looks for new topics
 WORK_PERIOD_S = 0.02  # how soon a client's subscribe reaches ROS
 MAX_QUEUED = 1000  # client requests waiting for the ROS thread (a flood is dropped)
+# ROS publishers made for clients' channels, all clients together: a teleop needs a few, and
+# a client that advertised thousands and left (its unadvertisements lost in a flood) kept
+# every one of them.
+MAX_CLIENT_CHANNELS = 32
 
 
 class Listener(ServerListener):
@@ -179,6 +183,11 @@ class FoxgloveBridge(Node):
         if encoding != 'cdr':
             self._warn('advertise', f'a Foxglove client offers {topic} in {encoding!r}, '
                        'not cdr: ignored')
+            return
+        self._unadvertise((client, channel_id))  # advertised again: the old one goes
+        if len(self.client_publishers) >= MAX_CLIENT_CHANNELS:
+            self._warn('advertise_many', f'Foxglove clients publish on {MAX_CLIENT_CHANNELS} '
+                       f'channels already: {topic} refused')
             return
         self.client_publishers[client, channel_id] = (
             self.create_publisher(msg_class, topic, 10), topic, msg_class)

@@ -22,6 +22,9 @@ HEAD_TIMEOUT_S = 5.0  # a connection that sends no request in this long is close
 MAX_CONNECTIONS = 64
 PIPE_CHUNK = 1 << 16
 FORBIDDEN = b'HTTP/1.1 403 Forbidden\r\nContent-Length: 0\r\nConnection: close\r\n\r\n'
+# Not a WebSocket request (a page's <img> or no-cors fetch sends no Origin): answered here,
+# never passed on (the SDK's server logged a line for each, unthrottled).
+BAD_REQUEST = b'HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\nConnection: close\r\n\r\n'
 
 
 def origin_allowed(origin, patterns=()):
@@ -76,8 +79,14 @@ class OriginGate:
         self._thread.start()
 
     def close(self):
+        """Stop listening and end every connection (their tasks first: a task left in a
+        stopped loop printed 'Event loop is closed' tracebacks at exit)."""
         async def stop():
             self._server.close()
+            tasks = [t for t in asyncio.all_tasks() if t is not asyncio.current_task()]
+            for task in tasks:
+                task.cancel()
+            await asyncio.gather(*tasks, return_exceptions=True)
             self._loop.stop()
         if self._thread.is_alive():
             asyncio.run_coroutine_threadsafe(stop(), self._loop)
@@ -91,6 +100,10 @@ class OriginGate:
         self._open += 1
         try:
             head = await asyncio.wait_for(reader.readuntil(b'\r\n\r\n'), HEAD_TIMEOUT_S)
+            if (header(head, 'upgrade') or '').lower() != 'websocket':
+                writer.write(BAD_REQUEST)
+                await writer.drain()
+                return
             origin = header(head, 'origin')
             if not origin_allowed(origin, self.patterns):
                 self.refused += 1
