@@ -3,6 +3,7 @@ samples finite, held compactly and bounded in all; a refused file leaves nothing
 import os
 import struct
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -216,3 +217,52 @@ def test_a_file_plays_at_40_khz_as_the_whole_file_resampled_at_once(allowed, loo
         np.abs(played[100:len(whole) - 100] - whole[100:-100]).max() < 1e-9
     if loop:  # and on again from its start
         assert np.abs(played[len(whole) + 100:len(whole) + 900] - whole[100:900]).max() < 1e-6
+
+
+@pytest.mark.parametrize('swapped_in', ['fifo', 'link'])
+def test_a_file_swapped_after_the_checks_is_refused_not_waited_on(allowed, outside,
+                                                                   swapped_in):
+    """A FIFO renamed over a checked file blocked the simulator's open for ever."""
+    from miro_sim_bullet.scene.sounds import open_regular
+
+    path = allowed[0] / 'race.wav'
+    if swapped_in == 'fifo':
+        os.mkfifo(path)
+    else:
+        path.symlink_to(outside)
+    started = time.monotonic()
+    with pytest.raises(OSError):
+        open_regular(path)
+    with pytest.raises(SoundFileError):
+        SoundBank().samples(str(path))
+    assert time.monotonic() - started < 5
+
+
+def test_a_file_of_too_many_frames_is_refused_by_its_header(allowed, monkeypatch):
+    from miro_sim_bullet.scene import sounds
+
+    monkeypatch.setattr(sounds, 'MAX_FRAMES', 100)
+    wav(allowed[0] / 'long.wav')  # 800 frames
+    with pytest.raises(WorldError, match="'long.wav' holds 800 frames; at most 100"):
+        request('long.wav', allowed)
+
+
+def test_files_given_up_are_not_read_later_and_do_not_fill_the_queue(allowed):
+    clock = Clock()
+    paths = {name: wav(allowed[0] / f'{name}.wav') for name in 'abc'}
+    read = []
+
+    class Slow(SoundBank):
+        def samples(self, path):
+            read.append(Path(path).stem)
+            time.sleep(0.3)
+            return super().samples(path)
+    loads = SoundLoads(bank=Slow(), clock=clock, timeout_s=1.0, max_pending=3)
+    for name in 'ab':
+        loads.ask(Sound(name, (0, 0, 0), 'file', -20.0, file=str(paths[name])))
+    clock.now = 2.0
+    assert len(loads.ready()) == 2  # both given up, 'b' still queued behind 'a'
+    loads.ask(Sound('c', (0, 0, 0), 'file', -20.0, file=str(paths['c'])))
+    (sound, samples, error), = wait_ready(loads)
+    assert sound.name == 'c' and error is None
+    assert 'b' not in read and read[-1] == 'c'  # 'a' perhaps: it may have been reading

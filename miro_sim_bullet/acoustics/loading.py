@@ -28,6 +28,7 @@ class SoundLoads:
         self.timeout_s, self.max_pending = timeout_s, max_pending
         self._asked, self._done = queue.Queue(), queue.Queue()
         self._pending = {}  # ticket -> (sound, when asked)
+        self._given_up = set()  # tickets the reading thread skips (one set.add: thread-safe)
         self._tickets = itertools.count()
         self._thread = None
 
@@ -37,7 +38,8 @@ class SoundLoads:
 
     def ask(self, sound):
         """Read sound.file; SoundFileError (one line) when MAX_PENDING files wait already."""
-        if len(self._pending) >= self.max_pending:
+        # The queue too: a file given up may still be waiting there.
+        if max(len(self._pending), self._asked.qsize()) >= self.max_pending:
             raise SoundFileError(f'{self.max_pending} sound files are being read already: '
                                  f'{Path(sound.file).name!r} not read')
         if self._thread is None:
@@ -64,6 +66,7 @@ class SoundLoads:
         for ticket, (sound, asked) in list(self._pending.items()):
             if now - asked > self.timeout_s:
                 del self._pending[ticket]
+                self._given_up.add(ticket)
                 out.append((sound, None, SoundFileError(
                     f'{Path(sound.file).name!r} was not read within {self.timeout_s:g} s: '
                     'given up')))
@@ -72,6 +75,9 @@ class SoundLoads:
     def _work(self):
         while True:
             ticket, path = self._asked.get()
+            if ticket in self._given_up:
+                self._given_up.discard(ticket)
+                continue
             samples = error = None
             try:
                 samples = self.bank.samples(path)

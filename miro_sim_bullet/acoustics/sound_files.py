@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ
+from miro_sim_bullet.scene.sounds import open_regular
 
 MAX_BYTES = 200_000_000  # every sound file's samples alive at once: 35 minutes of sound
 BLOCK_FRAMES = 1 << 16  # read and mixed down this many frames at a time
@@ -38,7 +39,7 @@ def decode(path):
 
     name = Path(path).name
     try:
-        with soundfile.SoundFile(path) as file:
+        with open_regular(path) as raw, soundfile.SoundFile(raw) as file:
             rate = file.samplerate
             mono = np.concatenate([block.mean(axis=1) for block in file.blocks(
                 BLOCK_FRAMES, dtype='float32', always_2d=True)] or [np.zeros(0, np.float32)])
@@ -79,7 +80,8 @@ class SoundBank:
                 found, held = self._live().get(key), self._held()
             if found is not None:
                 return found
-            info = soundfile.info(path)
+            with open_regular(path) as raw:
+                info = soundfile.info(raw)
         except (OSError, RuntimeError, soundfile.LibsndfileError) as err:
             raise SoundFileError(f'cannot read {Path(path).name!r} as sound: '
                                  f'{str(err)[:100]}') from None
