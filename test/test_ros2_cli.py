@@ -117,6 +117,9 @@ def test_params_and_services_of_the_simulator(paused_sim, executor):
     (['service', 'call', '/a//b', 'std_srvs/srv/Trigger'], "'/a//b' is not a ROS name"),
     (['topic', 'pub', '--once', T.cmd_vel, 'geometry_msgs/msg/TwistStamped',
       '{twist: ' + '[' * 5000 + ']' * 5000 + '}'], 'the values are nested too deeply'),
+    (['topic', 'pub', '--once', '/x', 'std_msgs/msg/String', '{data: [&a0 [1, 2], '
+      + ', '.join(f'&a{k} [{", ".join([f"*a{k - 1}"] * 10)}]' for k in range(1, 10)) + ']}'],
+     'the values use YAML aliases'),
 ])
 def test_bad_input_is_one_line_and_exit_1(args, says, paused_sim, executor):
     code, out, err = ros2(args, paused_sim, executor)

@@ -209,7 +209,7 @@ def parameter_value(text):
     import yaml
 
     try:
-        value = yaml.safe_load(text)
+        value = text if convert.has_alias(text) else yaml.safe_load(text)
     except (yaml.YAMLError, RecursionError):
         value = text
     kinds = ((bool, ParameterType.PARAMETER_BOOL), (int, ParameterType.PARAMETER_INTEGER),
