@@ -38,18 +38,22 @@ def faulty_node(context, fault):
     return node, ticks
 
 
+def serve(executor, node, ticks, count):
+    """Spin node until its timer ticked ``count`` times, which it must (faults or not)."""
+    executor.add_node(node)
+    try:
+        spin_until_stopped(executor, StopWhen(lambda: len(ticks) >= count))
+        assert len(ticks) >= count, 'the node stopped serving after a fault'
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+
+
 @pytest.mark.parametrize('make_executor', [SingleThreadedExecutor, EventsExecutor])
 def test_a_callback_that_raises_is_logged_once_and_the_node_serves_on(
         ros_context, make_executor, capfd):
     node, ticks = faulty_node(ros_context, ValueError('a bad message'))
-    executor = make_executor(context=ros_context)
-    executor.add_node(node)
-    try:
-        spin_until_stopped(executor, StopWhen(lambda: len(ticks) >= 10))
-        assert len(ticks) >= 10, 'the node stopped serving after a fault'
-    finally:
-        executor.shutdown()
-        node.destroy_node()
+    serve(make_executor(context=ros_context), node, ticks, 10)
     err = capfd.readouterr().err
     assert err.count('a callback failed') == 1, err  # once, not once a fault
     assert 'Traceback' in err and 'ValueError: a bad message' in err and 'in tick' in err
@@ -90,14 +94,7 @@ def test_a_warning_and_a_failing_callback_in_either_order_leave_the_node_serving
         else:
             raise ValueError('a callback that fails')
     node.create_timer(0.005, tick)
-    executor = SingleThreadedExecutor(context=ros_context)
-    executor.add_node(node)
-    try:
-        spin_until_stopped(executor, StopWhen(lambda: len(ticks) >= 8))
-        assert len(ticks) >= 8, 'the node stopped serving after a warning and a fault'
-    finally:
-        executor.shutdown()
-        node.destroy_node()
+    serve(SingleThreadedExecutor(context=ros_context), node, ticks, 8)
     err = capfd.readouterr().err
     warnings = [line for line in err.splitlines() if 'a bad message number' in line]
     assert len(warnings) >= 3 and all(line.startswith('[WARN]') for line in warnings), err
