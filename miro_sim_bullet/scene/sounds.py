@@ -39,7 +39,7 @@ class Sound:
     position: tuple  # x, y, z (m)
     kind: str  # file | tone | noise
     level_db: float  # RMS 1 m away, dB of full scale
-    file: str = ''  # absolute path, for a file (checked: sound_file)
+    file: str = ''  # absolute path, for a file (checked: _sound_file)
     frequency: float = 0.0  # Hz, for a tone
     loop: bool = False  # a file starts again when it ends
     start: float = 0.0  # s of simulated time
@@ -108,8 +108,8 @@ def _sound(parser, where, index, table):
 
 def bundled_sound(name):
     """The path of a bundled sound file (worlds/sounds/), or None when there is none."""
-    bundled = importlib.resources.files('miro_sim_bullet.worlds') / 'sounds' / name
-    return Path(str(bundled)) if bundled.is_file() else None
+    bundled = _bundled_folder() / name
+    return bundled if bundled.is_file() else None
 
 
 def sound_folders(text):
