@@ -104,7 +104,10 @@ def test_it_reads_where_the_robot_is_and_its_sensors(sim):
         assert sensors.sonar > 0 and len(sensors.light) == 4 and sensors.touch_body == 0
         before = miro.now
         miro.sleep(0.5)
-        assert miro.now == pytest.approx(before + 0.5, abs=0.03)
+        # Never early by more than a 20 ms tick; late by as long as this thread waits for a
+        # core while the simulator runs on in real time (0.18 s once, in CI beside another
+        # test file).
+        assert 0.5 - 0.021 <= miro.now - before <= 0.8
     sim.script(script)
 
 
