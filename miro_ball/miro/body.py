@@ -3,8 +3,9 @@
 Everything that draws or simulates MiRo reads this: the URDF (urdf.py, for
 robot_description, RViz, Foxglove and the GUI's world view), the simulator's physics
 body (which the eyes of the other robots draw) and the simulator's /tf and joint_states.
-Pure Python; the numbers are MiRo's published geometry (shared/reference/miro_facts.md,
-sections 1.3 to 1.5), the shapes are ours: primitives a URDF, PyBullet and three.js all
+Pure Python; the numbers are MiRo's published geometry (Consequential Robotics' MiRo-E
+documentation, https://labs.consequentialrobotics.com/miro-e/docs/?page=Technical_Platform_Geometry,
+and the MDK's ``miro2.constants``), the shapes are ours: primitives a URDF, PyBullet and three.js all
 draw the same way.
 
 Frames (REP 103: x forward, y left, z up): ``base_link`` is the MDK's FOOT, on the floor
@@ -49,8 +50,8 @@ TAIL_JOINT_IN_BODY = (-0.143, 0.0, floor(0.085))
 TAIL_MIC_IN_BODY = (-0.160, 0.0, floor(0.085))
 IMU_IN_BODY = (-0.095, 0.048, 0.010)
 IMU_IN_HEAD = (0.050, 0.040, 0.025)
-# The head's microphone: its place is not published; taken on the head's midline between the
-# ears (miro_facts.md). The speaker: not published either; taken behind the muzzle, under
+# The head's microphone: its place is not published (the MiRo-E specification says only "one
+# inside the head"); taken on the head's midline between the ears. The speaker: not published either; taken behind the muzzle, under
 # the sonar, where MiRo's voice seems to come from.
 MIC_C_IN_HEAD = (EAR_IN_HEAD[0], 0.0, EAR_IN_HEAD[2])
 SPEAKER_IN_HEAD = (0.060, 0.0, 0.0)

@@ -16,7 +16,9 @@ Frames (REP 103: x forward, y left, z up), each a child of the one before:
 - CAML / CAMR: each eye at its optical centre, x along the optical axis, y left, z up.
 - SONAR: at the nose sonar, x along its beam.
 
-Numbers: MiRo-E's published geometry (shared/reference/miro_facts.md, section 1.4 and 2).
+Numbers: MiRo-E's published geometry (Consequential Robotics' MiRo-E documentation, "Platform
+geometry": https://labs.consequentialrobotics.com/miro-e/docs/?page=Technical_Platform_Geometry,
+and the MDK's ``miro2.constants``).
 """
 import math
 
