@@ -123,10 +123,23 @@ def gui_url(log, procs, wait_s=20.0):
     return None
 
 
+# How a run that did not end with its kick ended, in words (other outcomes are sentences
+# already: 'node ... exited with code ...', 'not started within ...').
+ENDINGS = {'limit': 'at the time limit', 'fell': 'a robot fell',
+           'interrupted': 'interrupted (Ctrl+C)'}
+
+
+def outcome_lines(kicked, outcome):
+    """Whether the ball was kicked and, unless the kick is what ended the run, why it ended."""
+    lines = [f'  kicked:               {"yes" if kicked else "no"}']
+    if outcome != 'kicked':
+        lines.append(f'  ended:                {ENDINGS.get(outcome, outcome)}')
+    return lines
+
+
 def summary(outcome, monitor, rtf, video, killed, record=None):
     judge = monitor.judge
-    lines = ['', 'summary',
-             f'  kicked:               {"yes" if judge.kicked else "no"} ({outcome})']
+    lines = ['', 'summary', *outcome_lines(judge.kicked, outcome)]
     if judge.kicked:
         by = f' by {judge.kicker}' if judge.kicker and len(monitor.robots) > 1 else ''
         lines.append(f'  time to kick:         {judge.kick_time:.1f} s simulated{by}')

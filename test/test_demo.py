@@ -102,7 +102,8 @@ def test_every_node_of_the_football_demo_has_a_name_of_its_own(tmp_path):
     finally:
         demo.proc.send_signal(signal.SIGINT)
         _, output = demo.finish()
-    assert re.search(r'^  kicked: +(yes|no) \(interrupted\)$', output, re.M), output
+    assert re.search(r'^  kicked: +(yes|no)\n  ended: +interrupted \(Ctrl\+C\)$', output,
+                     re.M), output
     simulated = float(re.search(r'simulated time: +([0-9.]+) s', output).group(1))
     assert simulated > 0, output
     assert 'FAILED' not in output, output

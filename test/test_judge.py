@@ -180,3 +180,24 @@ def test_a_node_that_left_while_it_was_looked_at_is_no_failure():
     from miro_ball.grading.watch import GraphWatch, verdict
 
     assert verdict(GraphWatch(_Graph(still_there=False)), 'miro') == []
+
+
+def test_the_demo_summary_says_kicked_once_and_how_a_run_without_its_kick_ended():
+    from types import SimpleNamespace
+
+    from miro_ball.demo import summary
+
+    def said(judge, outcome):
+        monitor = SimpleNamespace(judge=judge, robots={}, frames=0)
+        return [line for line in summary(outcome, monitor, 1.0, None, []).splitlines()
+                if line.startswith(('  kicked:', '  ended:'))]
+
+    kicked = judged([(1.1, 0.0, False), (1.2, 0.0, True), (1.8, KICK_DISTANCE_M, False)])
+    assert said(kicked, 'kicked') == ['  kicked:               yes']
+    assert said(kicked, 'interrupted') == ['  kicked:               yes',
+                                          '  ended:                interrupted (Ctrl+C)']
+    untouched = judged([(1.1, 0.0, False)])
+    assert said(untouched, 'limit') == ['  kicked:               no',
+                                        '  ended:                at the time limit']
+    assert said(untouched, 'node miro_sim exited with code 1')[1] == \
+        '  ended:                node miro_sim exited with code 1'
