@@ -238,6 +238,18 @@ def test_head_slider_moves_the_head(rig):
     page.close()
 
 
+def test_every_slider_shows_its_value_as_it_moves(rig):
+    page = rig.open_page()
+    shown = page.evaluate("""() => [...document.querySelectorAll('input[type=range]')].map(
+      (input) => [input.id, (input.parentElement.querySelector('output') || {}).textContent])""")
+    assert shown and all(text for _, text in shown), f'sliders without a value: {shown}'
+    page.locator('#wagperiod').fill('1.1')
+    assert page.locator('#wagperiod_out').text_content() == '1.10'
+    page.locator('#led_white').click()  # a preset moves the brightness slider
+    assert page.locator('#led_bright_out').text_content() == '63'
+    page.close()
+
+
 def test_reset_puts_miro_back(rig):
     page = rig.open_page()
     page.keyboard.down('ArrowUp')

@@ -633,6 +633,15 @@ function slider(parent, id, label, lo, hi, step, value, onInput) {
   return input;
 }
 
+// A range input of the page's own (not made by slider()) shows its value beside it, in its
+// <output id="<id>_out">, now and as it moves (as slider()'s: two decimals for a fine step).
+function showValue(id) {
+  const decimals = Number($(id).step || 1) < 1 ? 2 : 0;
+  const show = () => { $(id + '_out').textContent = Number($(id).value).toFixed(decimals); };
+  show();
+  $(id).addEventListener('input', show);
+}
+
 const COSMETIC = ['tail droop', 'tail wag', 'eyelid L', 'eyelid R', 'ear L', 'ear R'];
 let cosmeticInputs = [];
 let animation = null;
@@ -675,8 +684,7 @@ function sendLeds() {
 
 function ledPreset(colours, brightness) {
   ['front', 'middle', 'rear'].forEach((p, i) => { $('led_' + p).value = colours[i]; });
-  $('led_bright').value = brightness;
-  sendLeds();
+  setSlider($('led_bright'), brightness);  // its value shown, and the LEDs sent
 }
 
 // The simulator's real_time_factor as last set or read, in the speed menu.
@@ -717,9 +725,8 @@ function setUp(config) {
   for (const [id, max] of [['linear', config.max_linear], ['angular', config.max_angular]]) {
     $(id).max = max;
     $(id).value = max / 2;
-    $(id + '_out').textContent = Number($(id).value).toFixed(2);
-    $(id).addEventListener('input', () => { $(id + '_out').textContent = Number($(id).value).toFixed(2); });
   }
+  ['linear', 'angular', 'wagperiod', 'led_bright'].forEach(showValue);
   for (const joint of ['lift', 'yaw', 'pitch']) {
     const [lo, hi] = config.head[joint];
     slider($('headsliders'), joint, joint, lo, hi, 1, config.head_calib[joint], sendHead);
