@@ -46,7 +46,7 @@ class AnimalRig:
         mics = self.sim_node.robots[self.robot.name]
         now = self.sim.time
         deadline = time.monotonic() + TICK_TIMEOUT_S
-        while not (self.frames_seen() >= wanted and self.node.mic_blocks >= mics.mic_blocks
+        while not (self.frames_seen() >= wanted and self.node.mic_blocks >= mics.sent['mics']
                    and self.node.last_tick is not None and self.node.last_tick >= now - 1e-9):
             if time.monotonic() > deadline:
                 raise TimeoutError(f'demo mode did not tick at {now:.2f} s')

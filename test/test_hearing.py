@@ -26,20 +26,13 @@ THREE = dataclasses.replace(EMPTY, robots=(RobotSpec('a', (0.0, 0.0, 0.0)),
 def hear(world, seconds):
     """{robot: (4, samples) of full scale} heard over the next ``seconds``; the blocks
     follow each other with no gap, 40 a simulated second."""
-    world.acoustics.take()
     first = world.acoustics.next_block
-    blocks, heard = [], {}
-    left = seconds
-    while left > 1e-9:
-        world.run(min(left, 0.5))  # the acoustics keep 1 s of blocks
-        left -= 0.5
-        for block, robots in world.acoustics.take():
-            blocks.append(block)
-            for name, samples in robots.items():
-                heard.setdefault(name, []).append(samples)
-    assert blocks == list(range(first, first + len(blocks)))
-    assert abs(len(blocks) - seconds * 40) <= 1
-    return {name: mic_window(np.concatenate(parts, axis=1)) for name, parts in heard.items()}
+    heard = world.listen(seconds)
+    for blocks in heard.values():
+        assert [block.index for block in blocks] == list(range(first, first + len(blocks)))
+        assert abs(len(blocks) - seconds * 40) <= 1
+    return {name: mic_window(np.concatenate([block.samples for block in blocks], axis=1))
+            for name, blocks in heard.items()}
 
 
 def band_db(signal, low, high):
@@ -169,17 +162,12 @@ def test_the_same_world_gives_the_same_samples_and_a_moving_speaker_no_clicks():
 
 
 def test_blocks_are_heard_only_for_robots_someone_listens_to_and_stay_aligned(three):
-    three.listened = lambda name: name == 'c'
-    try:
-        three.run(0.1)
-        blocks = three.acoustics.take()
-    finally:
-        three.listened = lambda name: True
-    assert blocks and all(set(heard) == {'c'} for _, heard in blocks)
-    assert all(heard['c'].shape == (4, MIC_BLOCK_SAMPLES) for _, heard in blocks)
+    heard = three.listen(0.1, listening=['c'])
+    assert set(heard) == {'c'}
+    assert all(block.samples.shape == (4, MIC_BLOCK_SAMPLES) for block in heard['c'])
     # Block k covers samples 500 k .. 500 k + 499 of simulated time, whoever listens: the
     # last is the one that ended at the last platform tick.
-    assert blocks[-1][0] == int(three.time * MIC_SAMPLE_RATE_HZ) // MIC_BLOCK_SAMPLES - 1
+    assert heard['c'][-1].index == int(three.time * MIC_SAMPLE_RATE_HZ) // MIC_BLOCK_SAMPLES - 1
 
 
 def test_echoes_and_wheels_are_heard_when_the_world_asks_for_them():

@@ -63,17 +63,43 @@ def test_the_interface_is_one_table_with_one_eye_qos():
 
 
 def test_every_row_of_the_interface_is_served_by_the_simulator():
-    """A sensor row is drawn by the eyes (CAMERA), heard by the ears (MICS) or made by a
-    producer at its rate; a control row is applied (RobotInterface refuses to start
-    without a handler)."""
-    from miro_ball.miro.interface import CAMERA, CONTROL, MICS, ONCE, ROBOT_INTERFACE, SENSOR
+    """A sensor row is drawn by the eyes (CAMERA) or made by its producer when its kind says;
+    a control row is applied (RobotInterface refuses to start without a handler)."""
+    from miro_ball.miro.interface import CAMERA, CONTROL, ROBOT_INTERFACE, SENSOR
+    from miro_ball.miro.stream_kinds import BLOCK, LATCHED, Periodic
     from miro_sim_bullet.ros.streams import PRODUCERS
 
     streams = {row.key for row in ROBOT_INTERFACE if row.direction == SENSOR
-               and row.rate not in (CAMERA, MICS)}
+               and row.kind != CAMERA}
     assert set(PRODUCERS) == streams
     for row in ROBOT_INTERFACE:
         if row.direction == SENSOR:
-            assert row.rate in (CAMERA, MICS, ONCE) or 0 < row.rate <= 1000, row
+            assert row.kind in (CAMERA, BLOCK, LATCHED) or (
+                isinstance(row.kind, Periodic) and 0 < row.kind.hz <= 1000), row
         else:
-            assert row.direction == CONTROL and row.rate is None, row
+            assert row.direction == CONTROL and row.kind is None, row
+
+
+def test_each_kind_of_stream_is_due_on_its_own_steps():
+    """At a 2 ms step: 50 Hz on every 10th step, 40 Hz on the step nearest each k / 40 s, a
+    microphone block (25 ms) on the first platform tick that has all its samples, the eyes
+    at camera_rate from the first step; a latched stream on none (sent when made)."""
+    from miro_ball.miro.interface import PLATFORM
+    from miro_ball.miro.stream_kinds import BLOCK, CAMERA, LATCHED, Periodic, Schedule, \
+        Timing
+
+    hum = Periodic(40.0)
+    schedule = Schedule([PLATFORM, CAMERA, hum, BLOCK, LATCHED, PLATFORM],
+                        Timing(dt=0.002, platform_steps=10, camera_rate=15.0))
+    assert schedule.kinds == [PLATFORM, CAMERA, hum, BLOCK]
+    due = {}
+    for step in range(1, 251):  # half a simulated second
+        for kind in schedule.due(step):
+            due.setdefault(kind, []).append(step)
+    assert due[PLATFORM] == list(range(10, 251, 10))
+    assert due[hum] == [round(k / 40 / 0.002) for k in range(1, 21)]  # 12 or 13 apart
+    assert due[BLOCK][:5] == [20, 30, 40, 50, 70]  # blocks end at 25, 50, 75, 100, 125 ms
+    assert len(due[BLOCK]) == 20  # 40 a second
+    assert due[CAMERA] == [1] + [round(k / 15 / 0.002) for k in range(1, 8)]
+    schedule.restart()  # a world reset: counted from its start again
+    assert schedule.due(10) == [PLATFORM, CAMERA]

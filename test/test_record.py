@@ -55,7 +55,8 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
                       and interface.publisher('joint_states').get_subscription_count()
                       and paused_sim.tf.pub.get_subscription_count()
                       and interface.pub_eyes['caml'][0].get_subscription_count()
-                      and interface.hears() and latched.get_subscription_count())
+                      and interface.publisher('mics').get_subscription_count()
+                      and latched.get_subscription_count())
     advance_ticks(paused_sim, executor)  # the first /clock starts the recording
     first_clock = round(paused_sim.sim.time * 1e9)
     start = paused_sim.sim.time

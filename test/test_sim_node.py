@@ -4,8 +4,10 @@ The world is stepped by the test (the node starts paused), never by wall-clock t
 """
 import math
 import os
+import re
 import subprocess
 import sys
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -16,17 +18,19 @@ from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Imu, JointState, \
     Range
-from std_msgs.msg import Float32, Float32MultiArray, Int16MultiArray, UInt16MultiArray, UInt32, \
+from std_msgs.msg import Float32MultiArray, Int16MultiArray, UInt16MultiArray, UInt32, \
     UInt32MultiArray
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics, default_robot_name, robot_name
+from miro_ball.miro.stream_kinds import BLOCK
 from miro_sim_bullet.physics.world import PHYSICS_DT_S
 from miro_sim_bullet.scene.world_file import WorldError
 from rostools import Probe, drain, spin_until
 
+DEVELOPMENT = Path(__file__).resolve().parent.parent / 'docs' / 'development.md'
 T = RobotTopics(default_robot_name())
 SIM = SimTopics()
 
@@ -317,15 +321,15 @@ def test_tone_and_stream_reach_the_robots_speaker(sim_node, probe, executor):
 def test_the_microphones_hear_the_speaker_40_blocks_a_second_and_stream_reports_room(
         sim_node, probe, executor):
     interface = sim_node.robots[T.name]
-    sent = []
-    interface.publish_mics = sent.append
-    run(sim_node, executor, 0.2)
-    assert not sent  # nobody listens: no block is worked out or sent
-    del interface.publish_mics
+    heard = []
+    run(sim_node, executor, 0.2, each_tick=lambda: heard.append(sim_node.sim.robot.heard))
+    # Nobody listens: no block is worked out or sent.
+    assert heard == [None] * 10 and sim_node.sim.robot.heard is None
+    assert not interface.sent['mics']
     mics = probe.watch(Int16MultiArray, T.mics)
     room = probe.watch(UInt16MultiArray, T.stream_state)
     tone = probe.publisher(UInt16MultiArray, T.tone)
-    assert spin_until(executor, lambda: interface.hears() and tone.get_subscription_count())
+    assert spin_until(executor, lambda: interface.wants(BLOCK) and tone.get_subscription_count())
     run(sim_node, executor, 0.5)
     assert spin_until(executor, lambda: len(mics) >= 20)
     quiet = len(mics)
@@ -370,26 +374,41 @@ def test_sounds_are_played_and_stopped_through_the_simulator_and_shown_in_the_sc
     assert spin_until(executor, lambda: not acoustics.sounds)
 
 
-def test_a_stream_is_one_row_and_its_producer(make_sim, probe, executor, monkeypatch):
-    """What adding a stream takes (docs/development.md): a row of the interface table with
-    its rate, and a producer; the simulator publishes it at that rate of simulated time."""
+def test_the_worked_example_adds_a_sensor_of_each_kind(make_sim, probe, executor, monkeypatch):
+    """docs/development.md's "Adding a sensor", run as written there: its rows go into the
+    interface table, its producers at the end of streams.py; the simulator then publishes a
+    10 Hz compass and a level of each microphone block, the block of sensors/mics."""
     from miro_ball.miro import interface
+    from miro_ball.miro.hearing import level_db, mic_window
     from miro_sim_bullet.ros import robot_interface, streams
 
-    row = interface.Topic('hum', 'sensors/hum', 'std_msgs/msg/Float32', interface.SENSOR,
-                          interface.SENSOR_QOS, 'a made-up 40 Hz stream', 40.0)
-    monkeypatch.setattr(robot_interface, 'ROBOT_INTERFACE', interface.ROBOT_INTERFACE + (row,))
-    monkeypatch.setitem(streams.PRODUCERS, 'hum',
-                        lambda robot, when, name: Float32(data=seconds(when)))
+    blocks = dict(re.findall(r'^```python (row|producer)\n(.*?)^```$', DEVELOPMENT.read_text(),
+                             re.M | re.S))
+    rows = tuple(interface.Topic(*row) for row in eval('(' + blocks['row'] + ')',
+                                                      vars(interface)))
+    monkeypatch.setattr(robot_interface, 'ROBOT_INTERFACE', interface.ROBOT_INTERFACE + rows)
+    in_streams = {**vars(streams), 'PRODUCERS': {}}
+    exec(blocks['producer'], in_streams)
+    for key, make in in_streams['PRODUCERS'].items():
+        monkeypatch.setitem(streams.PRODUCERS, key, make)
+    assert [row.key for row in rows] == list(in_streams['PRODUCERS']) == ['compass',
+                                                                         'mic_levels']
     node = make_sim()
-    hums = probe.watch(Float32, T.topic('sensors/hum'))
-    assert spin_until(executor, lambda: node.robots[T.name].publisher('hum')
-                      .get_subscription_count() > 0)
+    compass = probe.watch(Float32MultiArray, T.topic('sensors/compass'))
+    levels = probe.watch(Float32MultiArray, T.topic('sensors/mic_levels'))
+    mics = probe.watch(Int16MultiArray, T.mics)
+    robot = node.robots[T.name]
+    assert spin_until(executor, lambda: all(robot.publisher(key).get_subscription_count()
+                                            for key in ('compass', 'mic_levels', 'mics')))
+    node.sim.robot.play_tone(600, 200, 60)  # something to hear
     run(node, executor, 1.0)
-    assert spin_until(executor, lambda: len(hums) >= 40)
-    # 40 a simulated second, each on the physics step nearest its instant k / 40 s.
-    assert [m.data for m in hums] == pytest.approx([0.025 * k for k in range(1, 41)],
-                                                   abs=node.sim.dt / 2 + 1e-6)
+    assert spin_until(executor, lambda: len(compass) >= 10 and len(levels) >= 40
+                      and len(mics) >= 40)
+    assert (len(compass), len(levels), len(mics)) == (10, 40, 40)
+    assert compass[-1].data[0] == pytest.approx(node.sim.robot.sensors.pose[2])
+    assert [list(m.data) for m in levels] == [
+        pytest.approx([level_db(mic) for mic in mic_window(block.data)]) for block in mics]
+    assert max(levels[-1].data) > -30  # the tone, loud
 
 
 def test_a_twist_on_cmd_vel_is_said_once_with_the_type_it_wants(sim_node, executor, capfd):

@@ -5,7 +5,8 @@ A world runs as fast as it can, its robots driving in circles, three cases takin
 as it was before it had ears), with hearing but nobody listening (every source sends its
 samples, no microphone block is worked out), and with a listener on every robot's
 sensors/mics in a process of its own. The simulator's own work: the sound's tick (the
-sources, and the blocks heard) and publishing the blocks.
+sources, and the blocks heard) and publishing the robots' sensor streams (the blocks are
+the only ones listened to; the others cost a look at their subscribers).
 
 Default: the default world, one MiRo. --pitch: the football pitch, three MiRos, and three
 sounds beside them (noise, a tone and the radio's tune). --eyes: every robot's eyes
@@ -43,7 +44,7 @@ def main(argv=None):
         def enter(sim):
             acoustics = sim.sim.acoustics
             ticks.setdefault('on', acoustics.tick)
-            acoustics.tick = ticks['on'] if on else (lambda: None)
+            acoustics.tick = ticks['on'] if on else (lambda listening: None)
             if args.pitch and on:
                 for sound in PITCH_SOUNDS:
                     if sound.name not in acoustics.sounds:
@@ -59,7 +60,7 @@ def main(argv=None):
           f'rounds of {args.seconds:g} s a case, taking turns', flush=True)
 
     def timed(sim):
-        return [(sim.sim.acoustics, 'tick')] + [(interface, 'publish_mics')
+        return [(sim.sim.acoustics, 'tick')] + [(interface, 'publish_streams')
                                                 for interface in sim.robots.values()]
     medians, figures = compare('miro_ball.bench.hearing_bench', world, cases,
                                rounds=args.rounds, seconds=args.seconds, eyes=args.eyes,

@@ -41,10 +41,8 @@ def measure(step_deg=10, distance=1.5, seconds=0.2):
             where = head + distance * np.array([math.cos(a), math.sin(a), 0.0])
             world.acoustics.add_sound(Sound('hiss', tuple(where), 'noise', -30.0))
             world.run(0.3)
-            world.acoustics.take()
-            world.run(seconds)
-            blocks = [heard[world.robot.name] for _, heard in world.acoustics.take()]
-            window = mic_window(np.concatenate(blocks, axis=1))
+            blocks = world.listen(seconds)[world.robot.name]
+            window = mic_window(np.concatenate([block.samples for block in blocks], axis=1))
             found = locate(window)
             x, y, _ = rotation.T @ (where - head)
             rows.append((math.degrees(math.atan2(y, x)), found.lags[0],

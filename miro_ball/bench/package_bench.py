@@ -10,7 +10,7 @@ import time
 
 from rclpy.serialization import serialize_message
 
-from miro_ball.miro.interface import PLATFORM_HZ, ROBOT_INTERFACE, SENSOR
+from miro_ball.miro.interface import PLATFORM, ROBOT_INTERFACE, SENSOR
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.ros.convert import stamp
 from miro_sim_bullet.ros.streams import PRODUCERS
@@ -41,7 +41,7 @@ def main(argv=None):
         world.step()
     when = stamp(world.time)
     rows = [(row.key, holes) for row in ROBOT_INTERFACE
-            if row.direction == SENSOR and row.rate == PLATFORM_HZ and row.key != 'package'
+            if row.direction == SENSOR and row.kind == PLATFORM and row.key != 'package'
             for holes, relative in row.names() if relative.startswith('sensors/')]
     cases = {
         'separate topics': lambda: [serialize_message(PRODUCERS[key](robot, when, name, **holes))

@@ -17,6 +17,8 @@ import os
 import re
 from dataclasses import dataclass
 
+from miro_ball.miro.stream_kinds import BLOCK, CAMERA, LATCHED, Periodic
+
 DEFAULT_ROBOT_NAME = 'miro'
 ROBOT_NAME_ENV = 'MIRO_ROBOT_NAME'
 CLOCK = '/clock'
@@ -61,12 +63,9 @@ TF_STATIC_QOS = Qos(depth=1, latched=True)
 
 SENSOR, CONTROL = 'sensor', 'control'  # out of the robot, into the robot
 PLATFORM_HZ = 50.0  # MiRo's platform tick: its sensors, /clock
-CAMERA = 'camera'  # a stream at the eyes' rate (the simulator's camera_rate parameter)
-ONCE = 'once'  # a stream sent once and kept for late subscribers (latched)
-# The microphones: 40 blocks of 25 ms a simulated second, each published as soon as all its
-# samples are heard (at the platform tick after its end); a second of them queued, so that
-# a reader that is a little late loses none.
-MICS = 'mics'
+PLATFORM = Periodic(PLATFORM_HZ)
+# The microphones: 40 blocks of 25 ms a simulated second (BLOCK); a second of them queued,
+# so that a reader that is a little late loses none.
 MIC_QOS = Qos(depth=40)
 DESCRIPTION_QOS = Qos(depth=1, latched=True)  # robot_state_publisher's robot_description
 
@@ -74,8 +73,9 @@ DESCRIPTION_QOS = Qos(depth=1, latched=True)  # robot_state_publisher's robot_de
 @dataclass(frozen=True)
 class Topic:
     """One row of MiRo's interface; ``name`` is relative to the robot's namespace and may
-    hold ``{eye}`` or ``{part}``. ``rate``: how often a sensor stream is published, in Hz
-    of simulated time (or CAMERA); a control topic is taken as it comes (None)."""
+    hold ``{eye}`` or ``{part}``. ``kind``: when a sensor stream is published (stream_kinds:
+    Periodic(hz) in Hz of simulated time, BLOCK, LATCHED or CAMERA); a control topic is
+    taken as it comes (None)."""
 
     key: str
     name: str
@@ -83,7 +83,7 @@ class Topic:
     direction: str
     qos: Qos
     about: str
-    rate: object = None
+    kind: object = None
 
     @property
     def holes(self):
@@ -101,7 +101,7 @@ class Topic:
 
 
 ROBOT_INTERFACE = tuple(Topic(*row[:6], *(row[6:] or (None,))) for row in (
-    # key, relative name, type, direction, QoS, what it carries[, rate of a sensor]
+    # key, relative name, type, direction, QoS, what it carries[, a sensor's kind]
     ('eye_compressed', 'sensors/{eye}/compressed', 'sensor_msgs/msg/CompressedImage', SENSOR,
      EYE_QOS, 'eye image, JPEG', CAMERA),
     ('eye_raw', 'sensors/{eye}', 'sensor_msgs/msg/Image', SENSOR, EYE_QOS,
@@ -109,43 +109,43 @@ ROBOT_INTERFACE = tuple(Topic(*row[:6], *(row[6:] or (None,))) for row in (
     ('camera_info', 'sensors/{eye}/camera_info', 'sensor_msgs/msg/CameraInfo', SENSOR, EYE_QOS,
      "the eye's camera model, with each frame", CAMERA),
     ('kinematic_joints', 'sensors/kinematic_joints', 'sensor_msgs/msg/JointState', SENSOR,
-     SENSOR_QOS, 'tilt, lift, yaw, pitch, rad', PLATFORM_HZ),
+     SENSOR_QOS, 'tilt, lift, yaw, pitch, rad', PLATFORM),
     ('odom', 'sensors/odom', 'nav_msgs/msg/Odometry', SENSOR, SENSOR_QOS,
-     'pose in <robot>/odom, twist in <robot>/base_link', PLATFORM_HZ),
+     'pose in <robot>/odom, twist in <robot>/base_link', PLATFORM),
     ('body_pose', 'sensors/body_pose', 'geometry_msgs/msg/Pose2D', SENSOR, SENSOR_QOS,
-     'x, y, theta in <robot>/odom', PLATFORM_HZ),
+     'x, y, theta in <robot>/odom', PLATFORM),
     ('body_vel', 'sensors/body_vel', 'geometry_msgs/msg/Twist', SENSOR, SENSOR_QOS,
-     'body velocity', PLATFORM_HZ),
+     'body velocity', PLATFORM),
     ('wheel_speed_cmd', 'sensors/wheel_speed_cmd', 'std_msgs/msg/Float32MultiArray', SENSOR,
-     SENSOR_QOS, 'commanded wheel speeds [L, R], m/s', PLATFORM_HZ),
+     SENSOR_QOS, 'commanded wheel speeds [L, R], m/s', PLATFORM),
     ('wheel_speed_opto', 'sensors/wheel_speed_opto', 'std_msgs/msg/Float32MultiArray', SENSOR,
-     SENSOR_QOS, 'measured wheel speeds [L, R], m/s', PLATFORM_HZ),
+     SENSOR_QOS, 'measured wheel speeds [L, R], m/s', PLATFORM),
     ('cliff', 'sensors/cliff', 'std_msgs/msg/Float32MultiArray', SENSOR, SENSOR_QOS,
-     '[L, R]: 1 floor, below 0.7 a drop', PLATFORM_HZ),
+     '[L, R]: 1 floor, below 0.7 a drop', PLATFORM),
     ('sonar', 'sensors/sonar', 'sensor_msgs/msg/Range', SENSOR, SENSOR_QOS, 'range ahead, m',
-     PLATFORM_HZ),
+     PLATFORM),
     ('imu', 'sensors/imu_{part}', 'sensor_msgs/msg/Imu', SENSOR, SENSOR_QOS,
-     'part body or head', PLATFORM_HZ),
+     'part body or head', PLATFORM),
     ('battery', 'sensors/battery', 'sensor_msgs/msg/BatteryState', SENSOR, SENSOR_QOS,
-     'battery voltage', PLATFORM_HZ),
+     'battery voltage', PLATFORM),
     ('light', 'sensors/light', 'std_msgs/msg/Float32MultiArray', SENSOR, SENSOR_QOS,
-     'four light sensors, 0..1', PLATFORM_HZ),
+     'four light sensors, 0..1', PLATFORM),
     ('touch', 'sensors/touch_{part}', 'std_msgs/msg/UInt16', SENSOR, SENSOR_QOS,
-     'part head or body: a bit per touch sensor', PLATFORM_HZ),
+     'part head or body: a bit per touch sensor', PLATFORM),
     ('sensor_flags', 'sensors/flags', 'std_msgs/msg/UInt32', SENSOR, SENSOR_QOS,
-     'platform flags (bit 15: simulator)', PLATFORM_HZ),
+     'platform flags (bit 15: simulator)', PLATFORM),
     ('joint_states', 'joint_states', 'sensor_msgs/msg/JointState', SENSOR, SENSOR_QOS,
      "every movable joint of robot_description, rad (tilt: the body's measured pitch)",
-     PLATFORM_HZ),
+     PLATFORM),
     ('robot_description', 'robot_description', 'std_msgs/msg/String', SENSOR, DESCRIPTION_QOS,
-     'the URDF: link and joint names without the robot (its frames on /tf carry it)', ONCE),
+     'the URDF: link and joint names without the robot (its frames on /tf carry it)', LATCHED),
     ('mics', 'sensors/mics', 'std_msgs/msg/Int16MultiArray', SENSOR, MIC_QOS,
      'microphones [left ear, right ear, head, tail] x 500 samples at 20 kHz, 40 a second',
-     MICS),
+     BLOCK),
     ('stream_state', 'sensors/stream', 'std_msgs/msg/UInt16MultiArray', SENSOR, SENSOR_QOS,
-     "speaker buffer [room left, size], 8 kHz samples", PLATFORM_HZ),
+     "speaker buffer [room left, size], 8 kHz samples", PLATFORM),
     ('package', 'sensors/package', 'miro2_msg/msg/SensorsPackage', SENSOR, SENSOR_QOS,
-     "every 50 Hz reading of one tick, stamped (miro2_msg: built at set-up)", PLATFORM_HZ),
+     "every 50 Hz reading of one tick, stamped (miro2_msg: built at set-up)", PLATFORM),
     ('cmd_vel', 'control/cmd_vel', 'geometry_msgs/msg/TwistStamped', CONTROL, CONTROL_QOS,
      'body velocity, 0.4 m/s a wheel at most'),
     ('kinematic_targets', 'control/kinematic_joints', 'sensor_msgs/msg/JointState', CONTROL,

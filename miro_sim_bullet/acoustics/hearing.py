@@ -4,12 +4,13 @@ microphones hear, block by block (no ROS; the world ticks it with simulated time
 Sources: the world file's [[sound]]s (and any placed while it runs), every robot's speaker
 (in its head) and, when the world asks for it, every robot's wheels. Each platform tick
 each source sends one tick of samples into its ring buffer; each time the samples of a
-microphone block (500, 25 ms) are all sent, the block is heard by every robot someone
-listens to, with the microphones and sources where they are then (propagation.render),
-plus each microphone's own seeded noise floor. Block k of every robot covers the same
-samples, whoever listens and whenever.
+microphone block (500, 25 ms) are all sent, the block is heard by every robot listening
+(the tick is told which), with the microphones and sources where they are then
+(propagation.render), plus each microphone's own seeded noise floor, and left in the
+robot's ``heard`` until the next tick. Block k of every robot covers the same samples,
+whoever listens and whenever.
 """
-import collections
+from typing import NamedTuple
 
 import numpy as np
 
@@ -24,28 +25,28 @@ TICK = round(PLATFORM_TICK_S * RATE)  # ring samples a source sends a tick
 BLOCK = OVERSAMPLE * MIC_BLOCK_SAMPLES  # ring samples of a microphone block
 SELF_NOISE_DB = -60.0  # each microphone's own noise floor, RMS
 WHEEL_NOISE_DB = -50.0  # the wheels at full speed, RMS 1 m away
-BLOCKS_KEPT = 40  # heard blocks waiting to be taken: 1 s (a reader that never takes loses
-#                   the oldest, memory stays bounded)
+# A block (25 ms) is longer than a tick (20 ms), so a tick ends at most one block: a robot's
+# ``heard`` holds every block it hears, each for one tick.
 _QUIET_AFTER = HISTORY - 2 * BLOCK  # a source silent this long (ring samples) is heard no more
+
+
+class MicBlock(NamedTuple):
+    """A block of a robot's microphones: the k-th of the world's (25 ms from k * 25 ms)."""
+
+    index: int
+    samples: np.ndarray  # int16 (4, 500): the microphones in sensors/mics' order
 
 
 class Acoustics:
     """Sound for ``robots`` ({name: MiroRobot}) and the world's ``sounds`` (scene.sounds)
-    with ``hearing`` (scene.sounds.Hearing); ``seed`` makes every noise.
+    with ``hearing`` (scene.sounds.Hearing); ``seed`` makes every noise."""
 
-    ``listened(name)`` says whether a robot's microphones are wanted now; ``take()`` gives
-    the blocks heard since the last take.
-    """
-
-    def __init__(self, robots, sounds=(), hearing=Hearing(), seed=0, ground=0.0,
-                 listened=lambda name: True):
+    def __init__(self, robots, sounds=(), hearing=Hearing(), seed=0, ground=0.0):
         self.robots = robots
         self.hearing = hearing
         self.seed = seed
-        self.listened = listened
         self.sent = 0  # ring samples every source has sent
         self.next_block = 0
-        self._blocks = collections.deque(maxlen=BLOCKS_KEPT)
         capacity = MAX_SOUNDS + 2 * len(robots)
         self.history = np.zeros((capacity, WIDTH), np.float32)
         # Each row's source: None while the row is free, else one past the last ring sample
@@ -101,13 +102,16 @@ class Acoustics:
         """{name: world position} of every world sound and every robot's speaker (the
         ground truth a test or a lab compares with what the ears make of it)."""
         out = {name: source.position for name, (_, source) in self.sounds.items()}
-        out.update({name: robot.hearing_frame()[2] for name, robot in self.robots.items()})
+        out.update({name: robot.hearing_frame().speaker for name, robot in self.robots.items()})
         return out
 
     # -- time ---------------------------------------------------------------------------------
-    def tick(self):
-        """One platform tick: every source sends its samples; every block whose samples are
-        all sent is heard."""
+    def tick(self, listening):
+        """One platform tick: every source sends its samples; a block whose samples are now
+        all sent is heard by the robots named in ``listening`` (the others' microphones are
+        not worked out) and left in each one's ``heard``."""
+        for robot in self.robots.values():
+            robot.heard = None
         n0 = self.sent
         chunks = [(row, source.emit(n0, TICK)) for row, source in self.sounds.values()]
         chunks += [(self._speaker_rows[name], robot.sound) for name, robot in self.robots.items()]
@@ -128,21 +132,22 @@ class Acoustics:
             write(self.history, row, n0, samples)
         self.sent = n0 + TICK
         while (self.next_block + 1) * BLOCK <= self.sent:
-            self._hear_block()
+            self._hear_block(listening)
 
     def _geometry(self):
         """({robot: its hearing_frame()}, {row: position of its source}) now."""
         frames = {name: robot.hearing_frame() for name, robot in self.robots.items()}
         sources = {row: source.position for row, source in self.sounds.values()}
-        sources.update({self._speaker_rows[name]: frame[2] for name, frame in frames.items()})
-        sources.update({self._wheel_rows[name]: frame[3] for name, frame in frames.items()
+        sources.update({self._speaker_rows[name]: frame.speaker
+                        for name, frame in frames.items()})
+        sources.update({self._wheel_rows[name]: frame.wheels for name, frame in frames.items()
                         if name in self._wheel_rows})
         return frames, sources
 
-    def _hear_block(self):
+    def _hear_block(self, listening):
         block = self.next_block
         self.next_block += 1
-        heard = [name for name in self.robots if self.listened(name)]
+        heard = [name for name in self.robots if name in listening]
         if not heard:  # nothing worked out; the next heard block starts from where it is
             self._before = None
             return
@@ -161,8 +166,8 @@ class Acoustics:
         mics = sound + rms_scale(SELF_NOISE_DB) * noise.reshape(-1, MIC_BLOCK_SAMPLES)
         samples = np.clip(np.rint(mics * MIC_FULL_SCALE), -MIC_FULL_SCALE,
                           MIC_FULL_SCALE - 1).astype(np.int16)
-        self._blocks.append((block, {name: samples[4 * index:4 * index + 4]
-                                     for index, name in enumerate(heard)}))
+        for index, name in enumerate(heard):
+            self.robots[name].heard = MicBlock(block, samples[4 * index:4 * index + 4])
 
     def _hear_sources(self, block, rows, heard):
         """(4 x robots heard, 500): what the listened robots' microphones hear of the
@@ -212,12 +217,6 @@ class Acoustics:
             mirrored[:, axis] = 2 * value - mirrored[:, axis]
             images.append(mirrored)
             gains.append(np.full(count, self._reflected))
-        mics = np.concatenate([frames[name][0] for name in heard])
-        outward = np.concatenate([frames[name][1] for name in heard])
+        mics = np.concatenate([frames[name].mics for name in heard])
+        outward = np.concatenate([frames[name].outward for name in heard])
         return np.concatenate(gains), (np.concatenate(images), mics, outward)
-
-    def take(self):
-        """[(block index, {robot: int16 (4, 500)})] heard since the last take, oldest first."""
-        blocks = list(self._blocks)
-        self._blocks.clear()
-        return blocks

@@ -5,6 +5,7 @@ the command timeout and the cliff reflex, drives the wheel motors and samples
 every sensor, so readers get one consistent snapshot per tick (``sensors``).
 """
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -37,6 +38,15 @@ _SPEAKER_IN_HEAD = np.array(LINK['speaker'].xyz)
 # The ear microphones face out of the head's sides (+y left, -y right); the others, on its
 # top and on the body, are not shadowed by it.
 _EAR_SIDES = np.array([1.0, -1.0, 0.0, 0.0])
+
+
+class HearingFrame(NamedTuple):
+    """Where MiRo hears and speaks from, in the world (arrays of metres)."""
+
+    mics: np.ndarray  # the four microphones (4, 3), in sensors/mics' order
+    outward: np.ndarray  # their outward normals where the head shadows them (4, 3; zero else)
+    speaker: np.ndarray  # (3,)
+    wheels: np.ndarray  # the wheels' middle on the floor (3,)
 
 
 class MiroRobot:
@@ -72,6 +82,9 @@ class MiroRobot:
         self.illum = [0] * 6
         self.speaker = Speaker()
         self.sound = None  # what the speaker sent into the world over the last tick
+        # What the microphones heard (acoustics.hearing.MicBlock): the block that ended at the
+        # last platform tick, None if none did or nobody listened.
+        self.heard = None
         self.touched_at = {part: [-math.inf] * TOUCH_PADS for part in TOUCH_PARTS}
         for accelerometer in self.imu.values():
             accelerometer.reset()
@@ -270,17 +283,15 @@ class MiroRobot:
         )
 
     def hearing_frame(self):
-        """Where MiRo hears and speaks from, in the world: (the four microphones (4, 3) in
-        sensors/mics' order, their outward normals where the head shadows them (4, 3; zero
-        else), the speaker (3,), the wheels' middle on the floor (3,))."""
+        """Where MiRo hears and speaks from now (a HearingFrame)."""
         head_pos, head_rot = self.link_frame(rb.HEAD)
         body_pos, body_rot = self.link_frame(-1)
         frames = {'head': (head_pos, head_rot), 'body': (body_pos, body_rot)}
         mics = np.array([frames[link][0] + frames[link][1] @ xyz for link, xyz in _MIC_POINTS])
         outward = _EAR_SIDES[:, None] * head_rot[:, 1]
         x, y, _ = self.pose()
-        return mics, outward, head_pos + head_rot @ _SPEAKER_IN_HEAD, \
-            np.array([x, y, body_pos[2] - rb.AXLE_HEIGHT])
+        return HearingFrame(mics, outward, head_pos + head_rot @ _SPEAKER_IN_HEAD,
+                            np.array([x, y, body_pos[2] - rb.AXLE_HEIGHT]))
 
     # -- cameras ----------------------------------------------------------------------------
     def eye_pose(self, side):

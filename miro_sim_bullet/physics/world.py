@@ -58,8 +58,6 @@ class SimWorld:
         self.dt = physics_dt
         self.ticks_per_platform_tick = max(1, round(PLATFORM_TICK_S / physics_dt))
         self.client = pb.connect(pb.DIRECT)
-        # Whose microphones are worked out (the ROS node: those someone listens to).
-        self.listened = lambda name: True
         self.generation = 0
         self._build()
 
@@ -115,8 +113,7 @@ class SimWorld:
             self.body_labels[robot.body_id] = (name, 'robot')
         self._pictures()  # last, so that the other bodies keep their ids
         self.acoustics = Acoustics(self.robots, world.sounds, world.hearing,
-                                   ground=world.ground_height or 0.0,
-                                   listened=lambda name: self.listened(name))
+                                   ground=world.ground_height or 0.0)
         self.generation += 1
 
     def _shape(self, shape):
@@ -225,19 +222,33 @@ class SimWorld:
     def time(self):
         return self.step_index * self.dt
 
-    def step(self, n=1):
-        """Advance n physics steps; every robot's platform ticks every 20 ms of them."""
+    def step(self, n=1, listening=None):
+        """Advance n physics steps; every robot's platform ticks every 20 ms of them, and the
+        world's sound with it: the microphones of the robots named in ``listening`` (default
+        all; the ROS node: those someone listens to) hear each block as it ends."""
         kw = self._kw()
+        listening = self.robots if listening is None else listening
         for _ in range(n):
             pb.stepSimulation(**kw)
             self.step_index += 1
             if self.step_index % self.ticks_per_platform_tick == 0:
                 for robot in self.robots.values():
                     robot.tick()
-                self.acoustics.tick()
+                self.acoustics.tick(listening)
 
-    def run(self, seconds):
-        self.step(round(seconds / self.dt))
+    def run(self, seconds, listening=None):
+        self.step(round(seconds / self.dt), listening)
+
+    def listen(self, seconds, listening=None):
+        """Run ``seconds`` a platform tick at a time; {robot: [acoustics.hearing.MicBlock]} of
+        every block the microphones of ``listening`` (default all) heard meanwhile."""
+        heard = {}
+        for _ in range(round(seconds / PLATFORM_TICK_S)):
+            self.step(self.ticks_per_platform_tick, listening)
+            for name, robot in self.robots.items():
+                if robot.heard is not None:
+                    heard.setdefault(name, []).append(robot.heard)
+        return heard
 
     # -- copies ---------------------------------------------------------------------------------
     def snapshot(self):

@@ -36,8 +36,9 @@ from miro_ball.common.qos import profile
 from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.interface import CLOCK, CLOCK_QOS, PLATFORM_HZ, robot_name, SIM_NODE_NAME, \
+from miro_ball.miro.interface import CLOCK, CLOCK_QOS, PLATFORM, robot_name, SIM_NODE_NAME, \
     TF, TF_STATIC, TF_TYPE
+from miro_ball.miro.stream_kinds import BLOCK, CAMERA, Schedule, Timing
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.eye_pipeline import EyePipeline
@@ -109,8 +110,6 @@ class SimNode(Node):
         ros = Endpoints.of(self)
         self.robots = {name: RobotInterface(name, ros, self._robot_lookup(name), self.warn)
                        for name in self.sim.robots}
-        # A robot's microphones are worked out only while someone subscribes to them.
-        self.sim.listened = lambda name: self.robots[name].hears()
         self.sim_interface = self.scene = None
         if privileged:
             self.sim_interface = SimInterface(ros, self.sim, self.cameras, reset=self.reset,
@@ -135,10 +134,11 @@ class SimNode(Node):
             self.get_logger().warning(
                 f'{name} not published: its type {type_name} is not installed (build it: '
                 'python -m miro_ball.build_interfaces)')
-        # The rates of the robots' sensor streams (the interface table's); /clock and the
+        # When the eyes and each kind of the robots' sensor streams are due; /clock and the
         # ground truth go with the platform tick.
-        self._stream_rates = sorted({PLATFORM_HZ}.union(*(i.streams for i in
-                                                          self.robots.values())))
+        self.schedule = Schedule(
+            [PLATFORM, CAMERA, *(kind for i in self.robots.values() for kind in i.streams)],
+            Timing(self.sim.dt, self.sim.ticks_per_platform_tick, p.camera_rate))
         self._restart_schedule()
         self._progress = (time.monotonic(), 0.0)
         self.timer = self._make_timer()
@@ -215,15 +215,9 @@ class SimNode(Node):
     def _restart_schedule(self, keep_time=False):
         self._anchor = (time.monotonic(), self.sim.time)
         if not keep_time:
-            self._next_frame = 0
-            # The index of each rate's next message: the k-th is due at the physics step
-            # nearest k / rate (50 Hz falls on every 5th step of 4 ms, 40 Hz between).
-            self._next_stream = dict.fromkeys(self._stream_rates, 1)
+            self.schedule.restart()
             self._next_overhead = 0.0
             self._next_scene = 0.0
-
-    def _frame_step(self, index):
-        return round(index / self.params.camera_rate / self.sim.dt)
 
     def _on_timer(self):
         if self.paused:
@@ -267,26 +261,25 @@ class SimNode(Node):
         sim = self.sim
         spent = self.stage_seconds
         clock = time.perf_counter
+        # A robot's microphones are worked out only while someone wants its BLOCK streams.
+        listening = [name for name, interface in self.robots.items()
+                     if interface.wants(BLOCK)]
         for _ in range(steps):
             started = clock()
-            sim.step()
+            sim.step(listening=listening)
             spent['physics'] += clock() - started
             if self.sim_interface is not None:
                 self.sim_interface.look_for_touches()
             for observe in self.step_observers:
                 observe(sim)
+            due = self.schedule.due(sim.step_index)
             # Images of an instant go out before its /clock when drawn here, so a controller
             # on sim time has them when its timer fires for that instant.
-            if sim.step_index >= self._frame_step(self._next_frame):
+            if CAMERA in due:
+                due.remove(CAMERA)
                 self._publish_eyes(wait=True)  # the previous instant, before the next
                 self._submit_eyes(overlap)
-                while self._frame_step(self._next_frame) <= sim.step_index:
-                    self._next_frame += 1
-            due = [rate for rate, k in self._next_stream.items()
-                   if sim.step_index >= round(k / rate / sim.dt)]
             if due:
-                for rate in due:
-                    self._next_stream[rate] += 1
                 self._publish_eyes(wait=False)
                 started = clock()
                 self._publish_streams(due)
@@ -305,20 +298,16 @@ class SimNode(Node):
                 spent['overhead'] += clock() - started
 
     # -- publishing ---------------------------------------------------------------------------
-    def _publish_streams(self, rates):
-        """The sensor streams of the rates due now, after /clock on a platform tick, and
+    def _publish_streams(self, kinds):
+        """The sensor streams of the kinds due now, after /clock on a platform tick, and
         then the ground truth."""
         when = convert.stamp(self.sim.time)
-        platform_tick = PLATFORM_HZ in rates
+        platform_tick = PLATFORM in kinds
         if platform_tick:
             self.pub_clock.publish(ClockMsg(clock=when))
-        for rate in rates:
+        for kind in kinds:
             for interface in self.robots.values():
-                interface.publish_streams(rate, when)
-        if platform_tick:  # the microphone blocks this tick completed
-            for _, heard in self.sim.acoustics.take():
-                for name, samples in heard.items():
-                    self.robots[name].publish_mics(samples)
+                interface.publish_streams(kind, when)
         if platform_tick and self.tf is not None:
             self.tf.publish(when)
         if platform_tick and self.sim_interface is not None:

@@ -1,56 +1,43 @@
 """MiRo's ROS interface for one robot of the simulated world, under /<name>/.
 
-It publishes the robot's sensor streams and its eyes, and turns control messages
+It publishes the robot's sensor streams (each when the node says its kind is due) and its
+eyes, and turns control messages
 into platform commands after checking them: wrong lengths and non-finite values
 are ignored, finite values out of range are clamped, both with a rate-limited
 warning. The robot is looked up each time, so a world reset (which rebuilds
 every robot) needs nothing from here.
 """
-import array
-import functools
+import collections
 import math
 
-import numpy as np
-
-from std_msgs.msg import Int16MultiArray, MultiArrayDimension, UInt16
+from std_msgs.msg import UInt16
 
 from miro_ball.common.checks import finite, finite_values
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
 from miro_ball.miro.body import optical_frame
 from miro_ball.miro.constants import JOINT_NAMES, JOINT_POSITIONS
-from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id, MICS,
-                                      ONCE, ROBOT_INTERFACE, RobotTopics, SimTopics, TOPIC,
+from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id, LATCHED,
+                                      ROBOT_INTERFACE, RobotTopics, SimTopics, TOPIC,
                                       TOUCH_PARTS)
 from miro_ball.miro.touch import ALL_PADS
 from miro_sim_bullet.render.eye_images import EyeWants
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.endpoints import send_if_listened
-from miro_sim_bullet.ros.refill import prefix
 from miro_sim_bullet.ros.streams import PRODUCERS
-
-@functools.cache
-def _mics_prefix(channels, count):
-    """sensors/mics' bytes before its samples, its layout [channels, samples] (serialised
-    once: building the message took ~10 us a block, 40 blocks a second a robot)."""
-    zeros = np.zeros((channels, count), '<i2')
-    msg = Int16MultiArray(data=array.array('h', zeros.tobytes()))
-    msg.layout.dim = [MultiArrayDimension(label='channels', size=channels,
-                                          stride=channels * count),
-                      MultiArrayDimension(label='samples', size=count, stride=count)]
-    return prefix(msg, zeros.tobytes())
-
 
 # An eye's three rows, in the order of pub_eyes[eye].
 EYE_ROWS = ('eye_compressed', 'eye_raw', 'camera_info')
+
 
 class RobotInterface:
     """The topics of robot ``name``: ros (Endpoints) makes them, robot() gives the robot
     (a MiroRobot) as it is now, warn(kind, message) is a rate-limited warning.
 
-    Every row of MiRo's interface table is one endpoint here: a SENSOR row with a producer
-    (streams.PRODUCERS) is published at its rate by publish_streams(), the eyes' rows by
-    publish_eye(), a CONTROL row is applied to the robot by its handler below.
+    Every row of MiRo's interface table is one endpoint here: a SENSOR row is made by its
+    producer (streams.PRODUCERS) and published by publish_streams() when the node says its
+    kind is due (a LATCHED one once, now), the eyes' (CAMERA) by publish_eye(); a CONTROL
+    row is applied to the robot by its handler below.
     """
 
     def __init__(self, name, ros, robot, warn):
@@ -62,9 +49,9 @@ class RobotInterface:
                  'cosmetic_joints': self._on_cosmetic, 'illum': self._on_illum,
                  'tone': self._on_tone, 'stream': self._on_stream,
                  'control_flags': self._on_flags}
-        self.pub_eyes = {eye: [None] * 3 for eye in EYES}
-        self.streams = {}  # rate -> [(producer, fields, publisher)]
-        self.mic_blocks = 0  # published (in-process rigs wait until a listener has them all)
+        self.streams = {}  # kind -> [(row key, producer, fields, publisher)]
+        self.sent = collections.Counter()  # messages published, by row key (in-process rigs
+        #                                    wait until a listener has them all)
         self._publishers = {}  # (row key, its placeholder's value if any) -> publisher
         self.subs = []
         self.controls = []  # (topic, the type it takes)
@@ -83,15 +70,13 @@ class RobotInterface:
                     continue
                 publisher = ros.publisher(msg_type, topic, qos)
                 self._publishers[row.key, *fields.values()] = publisher
-                if row.rate == CAMERA:
-                    self.pub_eyes[fields['eye']][EYE_ROWS.index(row.key)] = publisher
-                elif row.rate == MICS:
-                    self.pub_mics = publisher
-                elif row.rate == ONCE:  # the same for the robot's whole life: kept (latched)
-                    publisher.publish(PRODUCERS[row.key](None, None, name, **fields))
-                else:
-                    self.streams.setdefault(row.rate, []).append(
-                        (PRODUCERS[row.key], fields, publisher))
+                if row.kind != CAMERA:  # the eyes are drawn by the eye pipeline
+                    self.streams.setdefault(row.kind, []).append(
+                        (row.key, PRODUCERS[row.key], fields, publisher))
+        self.pub_eyes = {eye: [self.publisher(key, eye) for key in EYE_ROWS] for eye in EYES}
+        # The same for the robot's whole life: sent once, now, and kept for late subscribers.
+        for _, make, fields, publisher in self.streams.pop(LATCHED, ()):
+            publisher.publish(make(self.robot, None, name, **fields))
         # The hand: the simulator's input for touching this robot (not part of MiRo's own
         # interface: a real MiRo is touched by people, not by topics).
         sim = SimTopics()
@@ -170,22 +155,20 @@ class RobotInterface:
         self.robot.flags = msg.data
 
     # -- publishing ---------------------------------------------------------------------------
-    def publish_streams(self, rate, when):
-        """The sensor streams of this rate (Hz of simulated time), stamped ``when``. A message
-        is built only for a topic someone subscribes to (building and publishing them all
-        took ~10 % of the simulator's time, listened to or not)."""
+    def publish_streams(self, kind, when):
+        """The sensor streams of this kind (miro.stream_kinds), due now, stamped ``when``. A
+        message is built only for a topic someone subscribes to (building and publishing
+        them all took ~10 % of the simulator's time, listened to or not)."""
         robot, name = self.robot, self.name
-        for make, fields, publisher in self.streams.get(rate, ()):
-            send_if_listened(publisher, lambda: make(robot, when, name, **fields))
+        for key, make, fields, publisher in self.streams.get(kind, ()):
+            if send_if_listened(publisher, lambda: make(robot, when, name, **fields)):
+                self.sent[key] += 1
 
-    def hears(self):
-        """Whether someone subscribes to the microphones (else they are not worked out)."""
-        return self.pub_mics.get_subscription_count() > 0
-
-    def publish_mics(self, samples):
-        """One block of the microphones, int16 (channels, samples), channel by channel."""
-        self.mic_blocks += 1
-        self.pub_mics.publish(_mics_prefix(*samples.shape) + samples.astype('<i2').tobytes())
+    def wants(self, kind):
+        """Whether someone subscribes to a stream of this kind (the microphones are worked
+        out only for a robot whose BLOCK streams someone wants)."""
+        return any(publisher.get_subscription_count()
+                   for *_, publisher in self.streams.get(kind, ()))
 
     def wanted_eyes(self):
         """[(eye, side, EyeWants)] of the eyes someone subscribes to (images or only
