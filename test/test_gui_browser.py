@@ -384,6 +384,43 @@ def test_the_world_view_shows_the_ball_and_miro_driving(rig, tmp_path):
     assert not rig.errors
 
 
+def test_the_first_view_of_the_den_shows_miro_and_the_ball_not_only_the_boards(rig):
+    """framing.js on the den world's boxes (its boards are named objects, MiRo and the ball
+    are far from them), checked with three.js's own camera: every box is in the picture, and
+    the picture is not mostly empty."""
+    from miro_sim_bullet.scene.world_file import load_world
+    den = load_world('den')
+    boxes = [[[x - sx / 2, y - sy / 2, z - sz / 2], [x + sx / 2, y + sy / 2, z + sz / 2]]
+             for (x, y, z), (sx, sy, sz) in ((s.position, s.size) for s in den.shapes)]
+    (bx, by), r = den.ball.position, den.ball.radius
+    boxes.append([[bx - r, by - r, 0.0], [bx + r, by + r, 2 * r]])
+    mx, my, _ = den.robots[0].pose
+    boxes.append([[mx - 0.2, my - 0.1, 0.0], [mx + 0.1, my + 0.1, 0.35]])  # MiRo's size
+    page = rig.browser.new_page(viewport={'width': 1400, 'height': 900})
+    rig.pages.append(page)
+    page.goto(rig.url)
+    reach = page.evaluate("""async (boxes) => {
+      const THREE = await import('/static/vendor/three/three.module.js');
+      const { homeView } = await import('/static/framing.js');
+      const view = homeView(boxes, 45, 16 / 9);
+      const camera = new THREE.PerspectiveCamera(45, 16 / 9, 0.02, 200);
+      camera.up.set(0, 0, 1);
+      camera.position.fromArray(view.position);
+      camera.lookAt(new THREE.Vector3().fromArray(view.target));
+      camera.updateMatrixWorld();
+      return boxes.map(([lo, hi]) => {
+        const xs = [], ys = [];
+        for (const x of [lo[0], hi[0]]) for (const y of [lo[1], hi[1]]) for (const z of [lo[2], hi[2]]) {
+          const v = new THREE.Vector3(x, y, z).project(camera);
+          xs.push(v.x); ys.push(v.y);
+        }
+        return Math.max(...xs.map(Math.abs), ...ys.map(Math.abs));
+      });
+    }""", boxes)
+    assert all(r < 1.0 for r in reach), f'a box out of the picture: {reach}'
+    assert max(reach) > 0.5, f'everything small in the middle of the picture: {reach}'
+
+
 def test_the_world_view_builds_miro_from_its_robot_description(rig, tmp_path):
     """Every primitive <visual> of the URDF is a mesh of the page, hung on the frame of its
     link ('<robot>/<link>', placed by /tf), and the head sits above the wheels."""

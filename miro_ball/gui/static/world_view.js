@@ -7,6 +7,7 @@
 // as the "hand" says; the page (app.js) does the talking to the server.
 import * as THREE from './vendor/three/three.module.js';
 import { OrbitControls } from './vendor/three/OrbitControls.js';
+import { homeView } from './framing.js';
 
 const WORLD = 'world';
 // Unnamed static shapes carry their world-file table as namespace; everything else in the
@@ -19,7 +20,6 @@ const PLACE_PERIOD_MS = 40;  // 25 places a second while dragging (the server ta
 const HOLD_PERIOD_MS = 100;  // a held drag keeps re-placing: a robot stays under the pointer
 const LABEL_ABOVE_M = 0.4;
 const FOV_LENGTH_M = 1.0;
-const FIT_MARGIN = 1.15;
 
 function unitGeometries() {
   const cylinder = new THREE.CylinderGeometry(0.5, 0.5, 1, 24);
@@ -131,6 +131,7 @@ export class WorldView {
       group.quaternion.fromArray(t.q);
       group.visible = true;
     }
+    if (!this.fitted && !this.userMoved) this.home();  // the robots may come after the scene
     this.dirty = true;
   }
 
@@ -350,23 +351,23 @@ export class WorldView {
   }
 
   // ---- camera -------------------------------------------------------------------------------
-  // The whole of the static world, seen from the south (-y) and above.
+  // Everything that matters (framing.js): the robots, the objects and the walls, not the
+  // ground. Fitted once every robot of the scene is placed by /tf.
   home() {
-    const box = new THREE.Box3();
     this.scene.updateMatrixWorld();
+    const boxes = [];
+    const placed = new Set();
     for (const { data, obj } of this.markers.values()) {
-      if (data.frame === WORLD && STATIC_TABLES.has(data.ns) && data.ns !== 'ground') {
-        box.expandByObject(obj);
-      }
+      const robot = this.robotOf(data);
+      if (robot ? !this.worldOf(`${robot}/body`) : data.frame !== WORLD || data.ns === 'ground') continue;
+      if (robot) placed.add(robot);
+      const box = new THREE.Box3().setFromObject(obj);
+      if (!box.isEmpty()) boxes.push([box.min.toArray(), box.max.toArray()]);
     }
-    if (box.isEmpty()) box.set(new THREE.Vector3(-1.3, -1.3, 0), new THREE.Vector3(1.3, 1.3, 0.3));
-    else this.fitted = true;
-    const centre = box.getCenter(new THREE.Vector3());
-    const size = box.getSize(new THREE.Vector3());
-    const reach = (FIT_MARGIN * Math.max(size.x, size.y, 1)) / 2
-      / Math.tan((this.camera.fov * Math.PI) / 360);
-    centre.z = 0;
-    this.setView([centre.x, centre.y - 0.75 * reach, 0.85 * reach], centre.toArray());
+    const view = homeView(boxes, this.camera.fov, this.camera.aspect)
+      || homeView([[[-1.3, -1.3, 0], [1.3, 1.3, 0.3]]], this.camera.fov, this.camera.aspect);
+    this.fitted = boxes.length > 0 && this.robotNames().every((name) => placed.has(name));
+    this.setView(view.position, view.target);
     this.userMoved = false;
   }
 
