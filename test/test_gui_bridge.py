@@ -188,6 +188,33 @@ def test_eyes_are_subscribed_only_while_a_page_shows_them(bridge, executor):
     assert eye_subscribers(bridge) == {'caml': 0, 'camr': 0}
 
 
+def test_a_page_opened_when_no_new_frame_comes_shows_the_last_one(bridge, ros_context,
+                                                                  executor):
+    """As when the simulator is paused: the eye's subscription went with the last page, its
+    last frame did not."""
+    import cv2
+    import numpy as np
+    from sensor_msgs.msg import CompressedImage
+
+    probe = Probe(ros_context, executor)
+    probe.publisher(Odometry, T.odom)  # the robot runs: the bridge keeps its part
+    camera = probe.publisher(CompressedImage, T.eye_compressed('caml'))
+    assert spin_until(executor, lambda: bridge.robots == [T.name])
+    jpeg = cv2.imencode('.jpg', np.zeros((240, 320, 3), np.uint8))[1].tobytes()
+    opened(bridge, executor, 1)
+    assert spin_until(executor, lambda: camera.get_subscription_count() == 1)
+    msg = CompressedImage(format='jpeg', data=jpeg)
+    msg.header.stamp.sec = 7
+    camera.publish(msg)
+    caml = p.CHANNELS.index('caml')
+    assert spin_until(executor, lambda: caml in bridge.frames(1))
+    bridge.release(1)
+    assert spin_until(executor, lambda: camera.get_subscription_count() == 0)
+    opened(bridge, executor, 2)
+    shown = bridge.frames(2).get(caml)
+    assert shown is not None and shown.stamp == 7.0 and shown.jpeg == jpeg
+
+
 def test_each_page_watches_and_drives_its_own_robot(ros_context, executor, events):
     probe = Probe(ros_context, executor)
     for name in ('robot_b', 'robot_a'):

@@ -79,6 +79,16 @@ class Rig:
                 return True
         return False
 
+    def paused_until(self, predicate, wall_guard_s=30.0):
+        """Serve the graph without stepping the world (as a paused simulator does) until
+        predicate() holds; the page lives on wall-clock time, so a guard limits this."""
+        deadline = time.monotonic() + wall_guard_s
+        while time.monotonic() < deadline:
+            self.executor.spin_once(timeout_sec=0.05)
+            if predicate():
+                return True
+        return False
+
     def run(self, sim_seconds, stop_when=None):
         """Step sim_seconds, no faster than real time, as a simulator runs for a user (the
         GUI's key and deadman handling is wall-clock time); returns the simulated seconds
@@ -183,6 +193,19 @@ def test_page_shows_both_eyes_live_the_ball_and_the_readouts(rig, tmp_path):
     print(f'\nscreenshot of the GUI: {shot}')
     page.close()
     assert not rig.errors
+
+
+def test_a_page_opened_while_the_simulator_is_paused_shows_the_last_instant(rig):
+    rig.open_page().close()  # the world has run: the GUI has seen it
+    page = rig.browser.new_page(viewport={'width': 1400, 'height': 900})
+    rig.pages.append(page)
+    page.goto(rig.url)  # and now nothing new comes: the simulator stays paused
+    assert rig.paused_until(lambda: frames(page, 'caml') > 0 and frames(page, 'camr') > 0), \
+        'the eyes stay black'
+    assert rig.paused_until(lambda: page.evaluate(
+        'miroGui.state && miroGui.state.readouts.battery > 4')), 'no readouts'
+    assert rig.paused_until(lambda: world_ready(page)), 'no ball or robot in the world view'
+    assert max(page.evaluate(BLUE_BALL_JS, eye) for eye in ('caml', 'camr')) > 20
 
 
 def test_arrow_key_drives_forward_and_release_stops_within_half_a_second(rig):

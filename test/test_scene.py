@@ -39,6 +39,15 @@ def test_a_late_viewer_gets_the_whole_football_pitch(make_sim, probe, executor):
     assert (ball.color.r, ball.color.g, ball.color.b) == pytest.approx(description.colour)
 
 
+def test_a_simulator_started_paused_shows_its_world_before_its_first_step(
+        make_sim, probe, executor):
+    make_sim(world='den')  # paused, and never stepped
+    scene = probe.watch(MarkerArray, SIM.scene, AS_RVIZ)
+    assert spin_until(executor, lambda: len(scene) >= 2)  # the layout and the movers
+    namespaces = {m.ns for array in scene for m in array.markers}
+    assert {BALL_NAME, 'face_board', 'tag_board'} <= namespaces
+
+
 def test_the_drag_moves_the_ball(make_sim, probe, executor):
     node = make_sim()
     ball_z = node.sim.ball_position()[2]

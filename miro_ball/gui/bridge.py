@@ -234,7 +234,6 @@ class GuiBridge(Node):
         elif not wanted and self._overhead_sub is not None:
             self.destroy_subscription(self._overhead_sub)
             self._overhead_sub = None
-            self.images.forget(None, overhead)
         self._update_scene_subscriptions()
         with self._lock:
             self._page_robot = {owner: page.robot for owner, page in self.pages.items()}

@@ -1,5 +1,8 @@
 """The images the pages show: newest-only, one slot per robot and channel, kept as the JPEG
-bytes that arrived (checked for size first) and handed to the web server's thread."""
+bytes that arrived (checked for size first) and handed to the web server's thread.
+
+A channel's last frame stays when no page shows it any more (its subscription is dropped):
+a page opened while the simulator is paused, when no new frame comes, shows the last one."""
 import threading
 from dataclasses import dataclass
 
@@ -63,9 +66,7 @@ class FrameStore:
         with self._lock:
             return {ch: f for (who, ch), f in self._frames.items() if who in (robot, None)}
 
-    def forget(self, robot, channel=None):
-        """No page shows it any more (every channel of ``robot`` when channel is None): a
-        page that shows it again waits for a new frame."""
+    def forget(self, robot):
+        """``robot`` has gone: none of its frames is shown again."""
         with self._lock:
-            self._frames = {key: f for key, f in self._frames.items()
-                            if not (key[0] == robot and channel in (None, key[1]))}
+            self._frames = {key: f for key, f in self._frames.items() if key[0] != robot}

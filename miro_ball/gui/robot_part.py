@@ -211,7 +211,6 @@ class RobotPart(Node):
         for channel in set(self._image_subs) - channels:
             for sub in self._image_subs.pop(channel):
                 self.destroy_subscription(sub)
-            self.frames.forget(self.robot, channel)
         for channel in channels - set(self._image_subs):
             name = p.CHANNELS[channel]
             eye = name.removeprefix('debug_')

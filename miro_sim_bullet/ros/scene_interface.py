@@ -27,6 +27,8 @@ class SceneInterface:
         self.pub_layout = ros.publisher(MarkerArray, topics.scene, LATCHED)
         self.pub_movers = ros.publisher(MarkerArray, topics.scene, LATCHED)
         self.generation = None
+        # Out at once, not at the first step: a simulator started paused shows its world.
+        self.publish()
 
     def _rebuild(self):
         self.generation = self.world.generation
