@@ -88,9 +88,12 @@ class Schedule:
     def restart(self):
         # Each kind's next message: (its index, the step it is due on).
         self._next = {kind: (0, kind.step(0, self.timing)) for kind in self.kinds}
+        self._soonest = min((step for _, step in self._next.values()), default=math.inf)
 
     def due(self, step_index):
         """The kinds due once the world has taken step ``step_index``, in the order given."""
+        if step_index < self._soonest:  # most steps: nothing (the world steps 500 a second)
+            return []
         due = []
         for kind, (k, step) in self._next.items():
             if step_index >= step:
@@ -99,4 +102,5 @@ class Schedule:
                     k += 1
                     step = kind.step(k, self.timing)
                 self._next[kind] = (k, step)
+        self._soonest = min(step for _, step in self._next.values())
         return due
