@@ -234,6 +234,8 @@ class FakeBridge:
     def __init__(self):
         self.commands = []
         self.scene = SceneState()
+        self.shown = {}  # channel: Frame
+        self.overlays = {}  # channel: (stamp, overlay) paired with its frame
 
     def open(self, owner):
         self.commands.append(('open', owner))
@@ -245,7 +247,10 @@ class FakeBridge:
         self.commands.append(('release', owner))
 
     def frames(self, owner):
-        return {}
+        return dict(self.shown)
+
+    def overlay(self, owner, channel, frame):
+        return self.overlays.get(channel)
 
     def state(self, owner):
         return json.dumps({'t': 'state', 'robot': None})
@@ -377,6 +382,36 @@ def test_a_drag_reaches_the_simulator_at_most_30_times_a_second_the_newest_last(
     places, elapsed = asyncio.run(run())
     assert len(places) <= 2 + elapsed * web_server.PLACE_RATE_HZ
     assert places[0].x == 0.0 and places[-1] == p.Place(BALL_NAME, 1.99, 0.0)
+
+
+def test_a_frames_overlay_goes_before_it_and_again_when_a_later_one_of_that_frame_comes():
+    from miro_ball.gui.frames import Frame
+
+    async def run():
+        bridge = FakeBridge()
+        caml = p.CHANNELS.index('caml')
+        bridge.shown[caml] = Frame(seq=1, stamp=2.0, jpeg=b'jpeg')
+        bridge.overlays[caml] = (2.0, {'objects': [{'kind': 'ball'}], 'view': None})
+        async with web_gui(bridge) as (server, address, warnings), \
+                aiohttp.ClientSession() as session, \
+                session.ws_connect(address + 'ws') as ws:
+            said = []
+            while not said or said[-1] != 'frame':
+                msg = await ws.receive(timeout=5.0)
+                if msg.type == aiohttp.WSMsgType.BINARY:
+                    said.append('frame')
+                elif json.loads(msg.data)['t'] == 'overlay':
+                    said.append(json.loads(msg.data))
+            bridge.overlays[caml] = (2.04, {'objects': [], 'view': None})
+            later = await next_of_kind(ws, 'overlay')
+            return said, later
+
+    said, later = asyncio.run(run())
+    first, frame = said[-2:]
+    assert frame == 'frame' and first == {'t': 'overlay', 'ch': 0, 'frame': 2.0, 'stamp': 2.0,
+                                          'objects': [{'kind': 'ball'}], 'view': None}
+    assert later == {'t': 'overlay', 'ch': 0, 'frame': 2.0, 'stamp': 2.04, 'objects': [],
+                     'view': None}
 
 
 def test_a_page_that_shows_the_world_gets_it_whole_then_what_moved_and_its_pictures():

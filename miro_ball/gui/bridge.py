@@ -100,6 +100,7 @@ class GuiBridge(Node):
         self._commands = collections.deque(maxlen=10000)
         self.pages = {}  # owner: _Page (ROS thread)
         self._page_robot = {}  # owner: robot, for the web server's thread
+        self._page_demo = set()  # owners showing demo mode, for the web server's thread
         self.watches = {}  # robot: RobotPart
         self.status = ''
         self.robots = []
@@ -146,6 +147,13 @@ class GuiBridge(Node):
         with self._lock:
             robot = self._page_robot.get(owner)
         return self.images.shown_with(robot)
+
+    def overlay(self, owner, channel, frame):
+        """(stamp, overlay) of demo mode to draw on ``frame`` of ``channel`` for page
+        ``owner`` (while it shows demo mode), or None."""
+        with self._lock:
+            robot = self._page_robot.get(owner) if owner in self._page_demo else None
+        return None if robot is None else self.images.overlay_on(robot, channel, frame)
 
     def state(self, owner):
         """JSON text of everything page ``owner`` shows besides images and the scene (made
@@ -237,6 +245,7 @@ class GuiBridge(Node):
         self._update_scene_subscriptions()
         with self._lock:
             self._page_robot = {owner: page.robot for owner, page in self.pages.items()}
+            self._page_demo = {owner for owner, page in self.pages.items() if page.demo}
 
     def _update_scene_subscriptions(self):
         world = any(page.world for page in self.pages.values())

@@ -9,7 +9,6 @@ import sys
 import threading
 
 from miro_ball.animal.actions import ACTIONS
-from miro_ball.miro.interface import EYES
 
 MAX_VIEW_PIXELS = 64 * 36 * 4  # an attention view larger than this is not passed on
 STOP_TIMEOUT_S = 5.0
@@ -63,13 +62,13 @@ def attention_view(msg):
     return {'w': msg.width, 'h': msg.height, 'data': base64.b64encode(bytes(msg.data)).decode()}
 
 
-# (row key, {eye} or not, convert, key in the page's demo readout)
+# The page's demo readout: (row key, convert, its key there).
 READ = [('animal_state', animal_state, 'state'), ('selection_priority', priorities,
                                                    'priorities'),
-        ('selection_action', action, 'action')] + [
-    (key, convert, f'{key}_{eye}') for key, convert in (('detect_objects', objects),
-                                                          ('attention_view', attention_view))
-    for eye in EYES]
+        ('selection_action', action, 'action')]
+# What is drawn over each eye, each with the frame it goes with (pairing.py): (row key of an
+# {eye} row, convert, its key in the overlay).
+OVERLAY = (('detect_objects', objects, 'objects'), ('attention_view', attention_view, 'view'))
 
 
 class DemoRunner:

@@ -2,16 +2,21 @@
 bytes that arrived (checked for size first) and handed to the web server's thread.
 
 A channel's last frame stays when no page shows it any more (its subscription is dropped):
-a page opened while the simulator is paused, when no new frame comes, shows the last one."""
+a page opened while the simulator is paused, when no new frame comes, shows the last one.
+Demo mode's overlays of each eye are kept here too, so that each goes with its own frame
+(pairing.py)."""
 import threading
+from collections import defaultdict
 from dataclasses import dataclass
+from typing import Optional
 
 from sensor_msgs.msg import CompressedImage
 
 from miro_ball.common.jpeg import MAX_SIDE, ImageRejected, jpeg_size
 from miro_ball.common.qos import profile
 from miro_ball.common.stamps import seconds
-from miro_ball.gui.protocol import MAX_FRAME_BYTES
+from miro_ball.gui.pairing import Overlays, window_end
+from miro_ball.gui.protocol import CHANNELS, MAX_FRAME_BYTES
 from miro_ball.miro.interface import EYE_QOS
 
 
@@ -20,6 +25,7 @@ class Frame:
     seq: int
     stamp: float
     jpeg: bytes
+    previous: Optional[float] = None  # the stamp of the channel's frame before this one
 
 
 def _problem(data):
@@ -44,6 +50,7 @@ class FrameStore:
         self.on_frame = on_frame
         self._lock = threading.Lock()
         self._frames = {}
+        self._overlays = defaultdict(Overlays)  # (robot, eye): demo mode's overlays
         self._seq = 0
 
     def subscribe(self, node, topic, channel, robot=None):
@@ -57,7 +64,9 @@ class FrameStore:
             stamp = seconds(msg.header.stamp)
             with self._lock:
                 self._seq += 1
-                self._frames[(robot, channel)] = Frame(self._seq, stamp, data)
+                last = self._frames.get((robot, channel))
+                self._frames[(robot, channel)] = Frame(self._seq, stamp, data,
+                                                       last.stamp if last else None)
             self.on_frame(channel)
         return node.create_subscription(CompressedImage, topic, on_image, profile(EYE_QOS))
 
@@ -70,3 +79,24 @@ class FrameStore:
         """``robot`` has gone: none of its frames is shown again."""
         with self._lock:
             self._frames = {key: f for key, f in self._frames.items() if key[0] != robot}
+        self.forget_overlays(robot)
+
+    def add_overlay(self, robot, eye, stamp, overlay):
+        """Demo mode's overlay of ``robot``'s ``eye`` for the instant ``stamp`` (s)."""
+        with self._lock:
+            self._overlays[(robot, eye)].add(stamp, overlay)
+
+    def overlay_on(self, robot, channel, frame):
+        """(stamp, overlay) to draw on ``frame`` of ``robot``'s ``channel`` (an eye's, or
+        its debug image's), or None (thread-safe)."""
+        eye = CHANNELS[channel].removeprefix('debug_')
+        with self._lock:
+            overlays = self._overlays.get((robot, eye))
+            return overlays and overlays.on(frame.stamp, window_end(frame.stamp,
+                                                                    frame.previous))
+
+    def forget_overlays(self, robot):
+        """Demo mode is no longer shown for ``robot``: its overlays go."""
+        with self._lock:
+            for key in [key for key in self._overlays if key[0] == robot]:
+                del self._overlays[key]

@@ -7,7 +7,9 @@ knows about ROS or the web server, so it is tested on its own.
 
 Server -> page: JSON text for the readouts, the scene, the tones and the sound, and images as
 binary messages: a FRAME_HEADER (channel number, stamp in seconds) followed by the
-JPEG bytes as the robot sent them (the browser decodes them; the server never does).
+JPEG bytes as the robot sent them (the browser decodes them; the server never does). Demo
+mode's overlay of a frame goes before it (and again when a later one for the same frame
+comes), naming the frame's stamp.
 """
 import json
 import math
@@ -377,6 +379,14 @@ def page_config():
 def frame_message(channel, stamp, jpeg):
     """The binary WebSocket message of one image."""
     return FRAME_HEADER.pack(channel, stamp) + jpeg
+
+
+def overlay_message(channel, frame_stamp, paired):
+    """What demo mode made of the frame of ``channel`` stamped ``frame_stamp`` (pairing.py):
+    paired is (its stamp, {objects, view}); the page draws it on that frame only."""
+    stamp, overlay = paired
+    return json.dumps({'t': 'overlay', 'ch': channel, 'frame': frame_stamp, 'stamp': stamp,
+                       **overlay})
 
 
 def tone_message(values):

@@ -7,6 +7,7 @@ the newest command winning, however fast a page sends.
 """
 import time
 from dataclasses import dataclass, field
+from functools import partial
 
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
@@ -17,6 +18,7 @@ from std_msgs.msg import Float32MultiArray, Int16MultiArray, UInt16, UInt16Multi
 
 from miro_ball.common.messages import drive_command, message_class
 from miro_ball.common.qos import profile
+from miro_ball.common.stamps import seconds
 from miro_ball.controller.names import debug_topic
 from miro_ball.gui import protocol as p
 from miro_ball.gui import demo
@@ -134,6 +136,7 @@ class RobotPart(Node):
         self.meter = MicMeter()
         self._mics_sub = None
         self._demo_subs = []
+        self._objects = {}  # eye: what demo mode last found in it
 
     # -- what it reads ------------------------------------------------------------------------
     def watch_sensors(self, on):
@@ -176,35 +179,53 @@ class RobotPart(Node):
 
     def watch_demo(self, on):
         """Subscribe to demo mode's topics (while a page shows its demo panel), or not; what
-        they say goes to the pages in the readouts' 'demo'."""
+        they say goes to the pages in the readouts' 'demo', and what is drawn over the eyes
+        to the frames it goes with."""
         if on == bool(self._demo_subs):
             return
         for sub in self._demo_subs:
             self.destroy_subscription(sub)
         self._demo_subs = []
         self.values.pop('demo', None)
+        self.frames.forget_overlays(self.robot)
         if not on:
             return
+        rows = [(key, {}, convert, partial(self._demo_readout, slot))
+                for key, convert, slot in demo.READ]
+        rows += [(key, {'eye': eye}, convert, partial(self._overlay_part, eye, part))
+                 for key, convert, part in demo.OVERLAY for eye in EYES]
         try:
-            for key, convert, slot in demo.READ:
+            for key, fields, convert, take in rows:
                 row = CORE_TOPIC[key]
-                fields = {'eye': slot.rsplit('_', 1)[1]} if '{eye}' in row.name else {}
                 self._demo_subs.append(self.create_subscription(
                     message_class(row.type), self.topics.core(key, **fields),
-                    self._demo_handler(convert, slot), profile(row.qos)))
+                    self._demo_handler(convert, take, key), profile(row.qos)))
         except ValueError as err:  # miro2_msg not built
             self.warn('demo', f'demo mode cannot be shown: {err}')
 
-    def _demo_handler(self, convert, slot):
+    def _demo_handler(self, convert, take, key):
         def on_message(msg):
             try:
                 value = convert(msg)
             except (TypeError, ValueError, IndexError) as err:
-                self.warn(f'demo:{self.robot}', f'{self.robot}: demo mode\'s {slot} ignored: '
+                self.warn(f'demo:{self.robot}', f'{self.robot}: demo mode\'s {key} ignored: '
                           f'{err}')
                 return
-            self.values.setdefault('demo', {})[slot] = value
+            take(value, msg)
         return on_message
+
+    def _demo_readout(self, slot, value, msg):
+        self.values.setdefault('demo', {})[slot] = value
+
+    def _overlay_part(self, eye, part, value, msg):
+        """Demo mode publishes an eye's objects and then its attention view at each of its
+        ticks, from the same percepts: the view's stamp dates both (the MDK's Objects has no
+        header), and the two go to the frames as one overlay."""
+        if part == 'objects':
+            self._objects[eye] = value
+            return
+        self.frames.add_overlay(self.robot, eye, seconds(msg.header.stamp),
+                                {'objects': self._objects.get(eye, []), part: value})
 
     def show(self, channels):
         """Subscribe to exactly these image channels (numbers) of the robot."""

@@ -83,6 +83,7 @@ class Page:
         self.wake = asyncio.Event()
         self.sent = {}  # channel: seq of the last frame sent
         self.in_flight = {}  # channel: when the unacknowledged frame went out
+        self.overlaid = {}  # channel: (frame seq, overlay stamp) of the last overlay sent
         self.state_sent = 0.0
         self.outbox = collections.deque(maxlen=OUTBOX_LENGTH)  # JSON texts
         self.world = False  # it shows the world view
@@ -281,23 +282,35 @@ class GuiServer:
                 await page.wake.wait()
                 page.wake.clear()
                 now = time.monotonic()
+                state_due = now - page.state_sent >= STATE_PERIOD_S * 0.9
                 for channel, frame in self.bridge.frames(page.number).items():
                     sent_at = page.in_flight.get(channel)
-                    if page.sent.get(channel) == frame.seq or (
-                            sent_at is not None and now - sent_at < ACK_TIMEOUT_S):
+                    if page.sent.get(channel) == frame.seq:
+                        if state_due:  # a later overlay of the frame the page has
+                            await self._send_overlay(page, channel, frame)
+                        continue
+                    if sent_at is not None and now - sent_at < ACK_TIMEOUT_S:
                         continue
                     page.sent[channel] = frame.seq
                     page.in_flight[channel] = now
+                    await self._send_overlay(page, channel, frame)
                     await ws.send_bytes(protocol.frame_message(channel, frame.stamp, frame.jpeg))
                 while page.outbox:
                     await ws.send_str(page.outbox.popleft())
                 if page.world and now - page.world_sent >= 0.9 / WORLD_RATE_HZ:
                     await self._send_world(page, now)
-                if now - page.state_sent >= STATE_PERIOD_S * 0.9:
+                if state_due:
                     page.state_sent = now
                     await ws.send_str(self.bridge.state(page.number))
         except (ConnectionError, RuntimeError):
             pass  # the page went away; _receive ends too
+
+    async def _send_overlay(self, page, channel, frame):
+        """Demo mode's overlay of the frame, unless the page has it already."""
+        paired = self.bridge.overlay(page.number, channel, frame)
+        if paired is not None and page.overlaid.get(channel) != (frame.seq, paired[0]):
+            page.overlaid[channel] = (frame.seq, paired[0])
+            await page.ws.send_str(protocol.overlay_message(channel, frame.stamp, paired))
 
     async def _send_world(self, page, now):
         """The scene's and the frames' changes since the page last heard."""

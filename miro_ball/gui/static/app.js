@@ -16,9 +16,10 @@ const HINT_MS = 4000;
 const TONE_GAIN = 0.3;  // at volume 255: loud enough, never harsh
 const $ = (id) => document.getElementById(id);
 
-// What tests and the benchmark read: frames drawn per channel, and when.
+// What tests and the benchmark read: frames drawn per channel, and when; demo mode's overlays
+// drawn, and on which frame.
 const gui = window.miroGui = { frames: {}, drawn: [], state: null, config: null, connected: false,
-                               world: null, tones: [], mics: null, audio: [] };
+                               world: null, tones: [], mics: null, audio: [], overlaid: [] };
 
 let ws = null;
 let channels = [];
@@ -55,6 +56,7 @@ function onText(message) {
   else if (message.t === 'state') showState(message);
   else if (message.t === 'scene') { if (gui.world) gui.world.applyScene(message); }
   else if (message.t === 'tf') { if (gui.world) gui.world.applyTf(message); }
+  else if (message.t === 'overlay') onOverlay(message);
   else if (message.t === 'tone') playTone(message);
   else if (message.t === 'mics') showMics(message);
   else if (message.t === 'audio') playAudio(message);
@@ -370,11 +372,27 @@ function drawAffect({ emotion, mood, sleep }) {
   $('demo_pressure_bar').firstChild.style.width = `${100 * pressure}%`;
 }
 
-// The attention map as this eye sees it, in red, and what the detectors found, labelled.
-function demoOverlay(ctx, eye, w, h) {
-  const demo = gui.demo;
-  if (!demo || !$('demo').open || !$('demo_overlay').checked) return;
-  const view = demo[`attention_view_${eye}`];
+// Demo mode's overlay of each channel, as the server paired it with one of the channel's
+// frames (gui/pairing.py): drawn on that frame only.
+const overlays = {};
+
+function onOverlay(message) {
+  const name = channels[message.ch];
+  if (!name) return;
+  overlays[name] = message;
+  const target = name.replace(/^debug_/, '');
+  const picture = shown[target];
+  if (picture && picture.name === name && picture.stamp === message.frame) paint(target, picture);
+}
+
+// The attention map as this eye sees it, in red, and what the detectors found, labelled: the
+// overlay that goes with the frame of `stamp` on channel `name`, if the page has it.
+function demoOverlay(ctx, name, stamp, w, h) {
+  const overlay = overlays[name];
+  if (!overlay || overlay.frame !== stamp || !$('demo').open || !$('demo_overlay').checked) return;
+  gui.overlaid.push({ ch: name, frame: stamp, stamp: overlay.stamp });
+  if (gui.overlaid.length > LOG_LENGTH) gui.overlaid.splice(0, gui.overlaid.length - LOG_LENGTH);
+  const view = overlay.view;
   if (view && view.w > 0 && view.h > 0 && typeof view.data === 'string') {
     const bytes = Uint8Array.from(atob(view.data), (c) => c.charCodeAt(0));
     if (bytes.length === view.w * view.h) {
@@ -389,7 +407,7 @@ function demoOverlay(ctx, eye, w, h) {
   }
   ctx.lineWidth = Math.max(1, w / 320);
   ctx.font = `${Math.round(w / 40)}px system-ui, sans-serif`;
-  for (const thing of demo[`detect_objects_${eye}`] || []) {
+  for (const thing of Array.isArray(overlay.objects) ? overlay.objects : []) {
     const x = thing.x * w, y = thing.y * h;
     ctx.strokeStyle = ctx.fillStyle = thing.kind === 'ball' ? '#00e5ff' : thing.kind === 'face' ? '#ffeb3b' : '#76ff03';
     ctx.beginPath();
@@ -408,24 +426,42 @@ function onFrame(buffer) {
   const stamp = view.getFloat64(1, true);
   const blob = new Blob([new Uint8Array(buffer, 9)], { type: 'image/jpeg' });
   createImageBitmap(blob)
-    .then((bitmap) => { draw(channels[ch], stamp, bitmap); bitmap.close(); })
+    .then((bitmap) => { if (!draw(channels[ch], stamp, bitmap)) bitmap.close(); })
     .catch(() => {})  // a corrupt JPEG: skip it, the next one comes
     .finally(() => send({ t: 'ack', ch }));
 }
 
+// The picture each canvas shows ({name, stamp, bitmap}), kept to be drawn again when the
+// overlay of its frame comes after it.
+const shown = {};
+
+// Draw a frame of channel `name`; true if the page keeps its bitmap (shown[target]).
 function draw(name, stamp, bitmap) {
   const now = performance.now();
   let target = name;
   if (name.startsWith('debug_')) {
     target = name.slice(6);
     lastDebug[target] = now;
-    if (!$('detections').checked) return;
+    if (!$('detections').checked) return false;
   } else if (name !== 'overhead' && $('detections').checked
              && now - (lastDebug[name] || -1e9) < DEBUG_FRESH_MS) {
-    return;  // this eye is shown with the controller's detections drawn
+    return false;  // this eye is shown with the controller's detections drawn
   }
+  if (!$(target)) return false;
+  if (shown[target]) shown[target].bitmap.close();
+  shown[target] = { name, stamp, bitmap };
+  paint(target, shown[target]);
+  gui.frames[name] = (gui.frames[name] || 0) + 1;
+  gui.drawn.push({ ch: name, stamp, at: performance.timeOrigin + now });
+  if (gui.drawn.length > LOG_LENGTH) gui.drawn.splice(0, gui.drawn.length - LOG_LENGTH);
+  const times = frameTimes[target] = frameTimes[target] || [];
+  times.push(now);
+  if (times.length > FPS_FRAMES) times.shift();
+  return true;
+}
+
+function paint(target, { name, stamp, bitmap }) {
   const canvas = $(target);
-  if (!canvas) return;
   if (canvas.width !== bitmap.width || canvas.height !== bitmap.height) {
     canvas.width = bitmap.width;
     canvas.height = bitmap.height;
@@ -433,13 +469,7 @@ function draw(name, stamp, bitmap) {
   const ctx = canvas.getContext('2d');
   ctx.drawImage(bitmap, 0, 0);
   if (target !== 'overhead') crossHairs(ctx, bitmap.width, bitmap.height, target === 'caml' ? 0.75 : 0.25);
-  if (target === 'caml' || target === 'camr') demoOverlay(ctx, target, bitmap.width, bitmap.height);
-  gui.frames[name] = (gui.frames[name] || 0) + 1;
-  gui.drawn.push({ ch: name, stamp, at: performance.timeOrigin + now });
-  if (gui.drawn.length > LOG_LENGTH) gui.drawn.splice(0, gui.drawn.length - LOG_LENGTH);
-  const times = frameTimes[target] = frameTimes[target] || [];
-  times.push(now);
-  if (times.length > FPS_FRAMES) times.shift();
+  if (target === 'caml' || target === 'camr') demoOverlay(ctx, name, stamp, bitmap.width, bitmap.height);
 }
 
 // The MDK GUI's magenta centre cross and the "dead ahead" tick of each eye.
