@@ -1,4 +1,5 @@
 """The processes a process started (children, theirs, ...), by psutil."""
+import os
 import time
 
 import psutil
@@ -10,6 +11,29 @@ def descendants(pid):
         return [child.pid for child in psutil.Process(pid).children(recursive=True)]
     except psutil.Error:
         return []
+
+
+def in_my_group(pids):
+    """Those of pids in this process's group: what a Ctrl+C in its terminal reaches too
+    (a child started in a session of its own is its parent's to stop)."""
+    mine = os.getpgrp()
+    found = []
+    for pid in pids:
+        try:
+            if os.getpgid(pid) == mine:
+                found.append(pid)
+        except ProcessLookupError:
+            pass
+    return found
+
+
+def send(pids, signum):
+    """Send signum to each of pids that still runs (one gone meanwhile is skipped)."""
+    for pid in pids:
+        try:
+            psutil.Process(pid).send_signal(signum)
+        except psutil.Error:
+            pass
 
 
 def _alive(proc):

@@ -38,6 +38,10 @@ class StopRequest:
     def _note(self, signum, frame):
         self.signum = signum
 
+    def request(self):
+        """Stop as if signalled: the program itself is ending (its server failed)."""
+        self.signum = self.signum or 0
+
     @property
     def requested(self):
         return self.signum is not None

@@ -13,22 +13,19 @@ import math
 import sys
 import time
 
-import rclpy
 from sensor_msgs.msg import CameraInfo, CompressedImage
 from std_msgs.msg import Int16MultiArray
 from rclpy.clock import Clock, ClockType
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.signals import SignalHandlerOptions
 
 from miro_ball.common.checks import finite_values
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_guard import guard_clock
+from miro_ball.common.lifecycle import run_node
 from miro_ball.common.messages import drive_command, message_class
 from miro_ball.common.qos import profile
 from miro_ball.common.robots import missing_robot
 from miro_ball.common.sim_time import sim_time_overrides
-from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_POSITIONS
@@ -217,27 +214,11 @@ def run(client_class, parser, argv=None):
     """Run the client until it is done, or Ctrl+C; returns the exit code."""
     argv = list(sys.argv if argv is None else argv)
     options = parse(parser, argv)
-    stop = StopRequest()
-    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    try:
-        node = client_class(options)
-    except (OSError, ValueError) as err:  # e.g. a folder it can not create
-        rclpy.try_shutdown()
-        parser.error(str(err))
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    code = 0
-    try:
-        spin_until_stopped(executor, stop)
-    except SystemExit as done:  # the client finished its job
-        code = done.code or 0
-    finally:
-        if rclpy.ok():
-            node.stop()
-        # Shut the executor down while its handles are valid: left to the garbage
-        # collector after rclpy's shutdown, Executor.__del__ printed an InvalidHandle
-        # traceback on every normal exit.
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return code
+    # OSError: e.g. a folder it can not create
+    return run_node(parser.prog, lambda: client_class(options), argv, on_stop=_stop_moving,
+                    bad_start=(OSError,))
+
+
+def _stop_moving(client):
+    if client.context.ok():  # else there is no graph to send a stop to
+        client.stop()

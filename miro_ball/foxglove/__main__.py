@@ -9,7 +9,7 @@ import argparse
 import sys
 
 from miro_ball.common.cli import user_args
-from miro_ball.common.stopping import spin_until_stopped, StopRequest
+from miro_ball.common.lifecycle import run_node
 from miro_ball.miro.interface import DEFAULT_ROBOT_NAME
 
 PROG = 'python -m miro_ball.foxglove'
@@ -36,38 +36,31 @@ def build_parser():
     return parser
 
 
+class CannotServe(Exception):
+    """The address or port given can not be served on."""
+
+
 def main(argv=None):
     argv = sys.argv if argv is None else argv
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.signals import SignalHandlerOptions
-
     parser = build_parser()
     args = parser.parse_args(user_args(argv, PROG))
     if not 0 <= args.port <= 65535:
         parser.error(f'--port must be in 0..65535, got {args.port}')
-    stop = StopRequest()
-    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    from miro_ball.foxglove.bridge import FoxgloveBridge
 
-    try:
-        bridge = FoxgloveBridge(args.host, args.port, args.allow_publish, args.topics,
-                                origins=args.allow_origin)
-    except (RuntimeError, OSError) as err:  # the port is taken, or no such address
-        print(f'{PROG}: cannot serve on {args.host}:{args.port}: {err}', file=sys.stderr)
-        rclpy.try_shutdown()
-        return 1
-    print(f'{PROG}: Foxglove can connect to ws://{args.host}:{bridge.port}'
-          + (' (clients may publish)' if args.allow_publish else ''), flush=True)
-    executor = SingleThreadedExecutor()
-    executor.add_node(bridge)
-    try:
-        spin_until_stopped(executor, stop)
-    finally:
-        bridge.close()
-        bridge.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    def make_bridge():
+        from miro_ball.foxglove.bridge import FoxgloveBridge
+
+        try:
+            bridge = FoxgloveBridge(args.host, args.port, args.allow_publish, args.topics,
+                                    origins=args.allow_origin)
+        except (RuntimeError, OSError) as err:  # the port is taken, or no such address
+            raise CannotServe(f'cannot serve on {args.host}:{args.port}: {err}') from None
+        print(f'{PROG}: Foxglove can connect to ws://{args.host}:{bridge.port}'
+              + (' (clients may publish)' if args.allow_publish else ''), flush=True)
+        return bridge
+
+    return run_node(PROG, make_bridge, argv, on_stop=lambda bridge: bridge.close(),
+                    bad_start=(CannotServe,))
 
 
 if __name__ == '__main__':

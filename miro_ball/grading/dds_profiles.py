@@ -10,20 +10,15 @@ and heartbeats every 50 ms over a loopback cost nothing measurable.
 import os
 from pathlib import Path
 
-ENV = 'FASTRTPS_DEFAULT_PROFILES_FILE'
+from miro_ball.common.fast_acks import ENV, profile, WRITER
+
 _PARTICIPANT = """  <participant profile_name="miro_grading" is_default_profile="true">
     <rtps><builtin><discovery_config>
       <leaseAnnouncement><sec>0</sec><nanosec>200000000</nanosec></leaseAnnouncement>
     </discovery_config></builtin></rtps>
   </participant>
 """
-_WRITER = """  <data_writer profile_name="miro_grading_writer" is_default_profile="true">
-    <times><heartbeatPeriod><sec>0</sec><nanosec>50000000</nanosec></heartbeatPeriod></times>
-  </data_writer>
-"""
-PROFILE = ('<?xml version="1.0" encoding="UTF-8" ?>\n'
-           '<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">\n'
-           f'{_PARTICIPANT}{_WRITER}</profiles>\n')
+PROFILE = profile(_PARTICIPANT, WRITER)
 
 
 def write_profile(folder):

@@ -6,10 +6,9 @@ main thread; neither waits for the other (bridge.py and server.py say how).
 import argparse
 import asyncio
 import sys
-import threading
 
 from miro_ball.common.cli import user_args
-from miro_ball.common.stopping import StopRequest, spin_until_stopped
+from miro_ball.common.lifecycle import run_node
 from miro_ball.miro.interface import robot_name
 
 DEFAULT_HOST = '127.0.0.1'
@@ -48,10 +47,6 @@ def parse_args(argv):
 
 def main(argv=None):
     argv = sys.argv if argv is None else argv
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-    from rclpy.signals import SignalHandlerOptions
-
     args, parser = parse_args(user_args(argv, PROG))
     try:
         default = robot_name()
@@ -65,28 +60,24 @@ def main(argv=None):
         sock = listen(args.host, args.port)
     except OSError as err:
         parser.error(f'cannot listen on {args.host}:{args.port}: {err.strerror or err}')
-    stop = StopRequest()
-    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    server = None
-    bridge = GuiBridge(args.robot, on_frame=lambda channel: server.frame_arrived(channel),
-                       on_event=lambda owners, text: server.event(owners, text),
-                       default_robot=default)
-    log = bridge.get_logger()
-    server = GuiServer(bridge, loopback_only=is_loopback(args.host), log=log.info,
-                       warn=log.warning)
-    if not is_loopback(args.host):
-        log.warning(f'listening on {args.host}, not only on this machine: anyone who can reach '
-                    'it can drive the robot')
-    executor = SingleThreadedExecutor()
-    executor.add_node(bridge)
-    spinner = threading.Thread(target=spin_until_stopped, args=(executor, stop), daemon=True)
-    spinner.start()
-    print(f'{PROG}: open {url(sock)}', flush=True)
-    try:
+    server = None  # the bridge and the server each call the other
+
+    def make_bridge():
+        nonlocal server
+        bridge = GuiBridge(args.robot, on_frame=lambda channel: server.frame_arrived(channel),
+                           on_event=lambda owners, text: server.event(owners, text),
+                           default_robot=default)
+        log = bridge.get_logger()
+        server = GuiServer(bridge, loopback_only=is_loopback(args.host), log=log.info,
+                           warn=log.warning)
+        if not is_loopback(args.host):
+            log.warning(f'listening on {args.host}, not only on this machine: anyone who can '
+                        'reach it can drive the robot')
+        return bridge
+
+    def serve_pages(bridge, stop):
+        print(f'{PROG}: open {url(sock)}', flush=True)
         asyncio.run(serve(server, sock, stop))
-    finally:
-        stop.signum = stop.signum or 0  # after an error: ends the spin thread too
-        spinner.join(timeout=2.0)
-        bridge.stop_driving('miro_gui is stopping')
-        bridge.destroy_node()
-        rclpy.try_shutdown()
+
+    return run_node(PROG, make_bridge, argv, serve=serve_pages,
+                    on_stop=lambda bridge: bridge.stop_driving('miro_gui is stopping'))

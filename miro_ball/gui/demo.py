@@ -7,6 +7,7 @@ import math
 import subprocess
 import sys
 import threading
+import time
 
 from miro_ball.animal.actions import ACTIONS
 
@@ -99,18 +100,24 @@ class DemoRunner:
         return None
 
     def stop(self, robot):
-        proc, _ = self.procs.pop(robot, (None, None))
-        if proc is not None and proc.poll() is None:
-            proc.terminate()  # as Ctrl+C: it stops the wheels on its way out
+        self._stop([robot])
+
+    def stop_all(self):
+        self._stop(list(self.procs))
+
+    def _stop(self, robots):
+        """Told all at once, they stop side by side: the slowest sets the time, not the sum."""
+        procs = [self.procs.pop(robot)[0] for robot in robots if robot in self.procs]
+        for proc in procs:
+            if proc.poll() is None:
+                proc.terminate()  # as Ctrl+C: it stops the wheels on its way out
+        deadline = time.monotonic() + STOP_TIMEOUT_S
+        for proc in procs:
             try:
-                proc.wait(timeout=STOP_TIMEOUT_S)
+                proc.wait(timeout=max(0.0, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
-
-    def stop_all(self):
-        for robot in list(self.procs):
-            self.stop(robot)
 
     def reap(self):
         """[(robot, its last line)] of the demo modes that ended by themselves (forgotten

@@ -21,16 +21,13 @@ import sys
 import time
 from collections import defaultdict, deque
 
-import rclpy
 from rclpy.clock import Clock, ClockType
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock as ClockMsg
 
 from miro_ball.common.cli import user_args
-from miro_ball.common.stopping import spin_until_stopped, StopRequest
+from miro_ball.common.lifecycle import run_node
 from miro_ball.common.throttle import Throttled
 from miro_ball.recording.bag import BagError, SplitBag, TYPESTORE, describe, offered_qos
 
@@ -220,26 +217,19 @@ def main(argv=None):
         bag = SplitBag(args.output, split_s=args.split_seconds)
     except BagError as err:
         parser.error(str(err))
-    stop = StopRequest()
-    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    node = Recorder(bag, selection)
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
+    return run_node(parser.prog, lambda: Recorder(bag, selection), argv,
+                    on_stop=lambda node: finish(bag, node), fatal=(RecordingFailed,))
+
+
+def finish(bag, node):
+    """Close the bag (its last file finished) and say what it holds; 1 if it could not."""
     code = 0
     try:
-        spin_until_stopped(executor, stop, fatal=(RecordingFailed,))
-    except RecordingFailed as err:
-        node.get_logger().error(f'{err}: recording stopped')
+        bag.close()
+    except OSError as err:
+        bag.abort()
+        node.get_logger().error(f'finishing the last file: {err}')
         code = 1
-    finally:
-        try:
-            bag.close()
-        except OSError as err:
-            bag.abort()
-            node.get_logger().error(f'finishing the last file: {err}')
-            code = 1
-        for line in describe(bag.path, bag.contents()):
-            print(line, flush=True)
-        node.destroy_node()
-        rclpy.try_shutdown()
+    for line in describe(bag.path, bag.contents()):
+        print(line, flush=True)
     return code

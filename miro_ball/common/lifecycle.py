@@ -1,0 +1,159 @@
+"""One life for every node run as a program: start, spin until Ctrl+C, stop, end.
+
+Every entry point that runs a node (the simulator, the controllers, the recorder, the GUI,
+the Foxglove bridge, the clients) goes through run_node, so they all start, stop and fail
+alike:
+
+- our own SIGINT/SIGTERM handling (stopping.StopRequest): the spin ends with the context
+  still up, so what the node does on its way out (a zero twist) still reaches the graph;
+- a node that can not be built from what the user gave (a parameter, a name, a world) is
+  said in one line on stderr, exit status 2, no traceback;
+- the way out, in this order: the node's own last act while the context is up (bounded,
+  and quick: fast_acks.py), the executor shut down while the node's handles are valid (else its
+  ``__del__`` printed an InvalidHandle traceback at exit), the node destroyed, rclpy shut
+  down; and the processes it started ended with it.
+
+Ended by a signal, the process ends within a second. What took the time was not the
+node's clean-up (10-100 ms) but a wait for an acknowledgement (the controller's zero
+twist: its whole 0.5 s bound, see fast_acks.py), Python freeing every module after it
+(0.2-0.9 s on a loaded machine, measured), and for the GUI its demo-mode child stopped
+only after the GUI was done. So the children are told to stop first, and stop while the
+node cleans up; and once everything is closed and flushed, the process ends without the
+interpreter's teardown: there is nothing left for it to do but spend time.
+"""
+import ctypes
+import logging
+import os
+import signal
+import sys
+import threading
+import time
+
+from miro_ball.common import proc_tree
+from miro_ball.common.fast_acks import use_fast_acks
+
+# What a node factory raises when the user's input (a parameter, a name) is wrong. rclpy's
+# own classes are added where rclpy is imported (in run_node: a program's --help stays
+# quick).
+BAD_START = (ValueError,)
+# How long the children have to stop once told (they stop as this process does, in a few
+# tenths of a second); then they are killed, so that nothing outlives the program.
+CHILD_GRACE_S = 0.8
+KILL_WAIT_S = 0.1  # for the kernel to take a killed child away
+# A spin thread (serve=) ends within a wake-up period; a callback stuck for longer than
+# this is left behind with the daemon thread it runs in.
+SPIN_JOIN_S = 1.0
+
+
+def first_line(err):
+    """The first line of an error's message (its class name when it has none)."""
+    return (str(err).strip().splitlines() or [type(err).__name__])[0]
+
+
+def refuse(prog, err, code=2):
+    """Say what the user gave wrong in one line on stderr and end with exit status code."""
+    print(f'{prog}: error: {first_line(err)}', file=sys.stderr, flush=True)
+    raise SystemExit(code)
+
+
+def run_node(prog, make_node, argv=None, *, make_executor=None, on_stop=None,
+             bad_start=(), fatal=(), serve=None):
+    """Run the node make_node() builds until Ctrl+C, SIGTERM or its own end; the exit code.
+
+    prog: the program's name, for its one-line errors. argv: the whole command line, its
+    --ros-args included (default sys.argv; the caller has checked it with cli.user_args).
+    make_executor(): what to spin on (default a SingleThreadedExecutor).
+    on_stop(node): the node's last act, after the spin and before anything is shut down
+    (the context is up unless something else shut it down: stop the wheels, close a file).
+    It must be quick and bounded (a wait for acknowledgements takes a timeout). It may
+    return an exit code for the program (a file it could not finish).
+    bad_start: exception classes that mean the user's input was wrong when make_node()
+    raises them (besides ValueError and rclpy's parameter and name errors): one line, exit 2.
+    fatal: exception classes from a callback that end the spin: logged as one error line,
+    exit code 1 (spin_until_stopped says why the others do not).
+    serve(node, stop): run in the main thread while the node spins in a thread of its own
+    (the GUI's web server), until stop.requested.
+
+    A callback that raises SystemExit (a client that has done its job) ends the spin with
+    its code. Ended by a signal, the process ends here once all is closed (see the module's
+    docstring); otherwise the exit code is returned.
+    """
+    import rclpy
+    from rclpy.exceptions import NameValidationException, ParameterException
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.signals import SignalHandlerOptions
+
+    from miro_ball.common.stopping import spin_until_stopped, StopRequest
+
+    argv = list(sys.argv if argv is None else argv)
+    # Before rclpy.init: a signal from now on is noted, never a KeyboardInterrupt; and
+    # the last message's acknowledgement comes in tens of milliseconds, not seconds.
+    stop = StopRequest()
+    use_fast_acks()
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        node = make_node()
+    except BAD_START + (ParameterException, NameValidationException) + tuple(bad_start) as err:
+        rclpy.try_shutdown()
+        refuse(prog, err)
+    except BaseException:
+        rclpy.try_shutdown()
+        raise
+    executor = (make_executor or SingleThreadedExecutor)()
+    executor.add_node(node)
+    code = 0
+    try:
+        if serve is None:
+            spin_until_stopped(executor, stop, fatal=fatal)
+        else:
+            _serve_beside_the_spin(serve, node, executor, stop)
+    except SystemExit as done:  # a client that has done its job
+        code = done.code or 0
+    except tuple(fatal) as err:
+        node.get_logger().error(f'{err}: {prog} stopped')
+        code = 1
+    finally:
+        # Told first, the children stop while this node cleans up, not after it: those a
+        # Ctrl+C in the terminal reaches too (the simulator's eye workers, in a session of
+        # their own, are stopped by its destroy_node). Whatever is left at the end is killed.
+        children = proc_tree.descendants(os.getpid())
+        proc_tree.send(proc_tree.in_my_group(children), signal.SIGINT)
+        children_by = time.monotonic() + CHILD_GRACE_S
+        try:
+            if on_stop is not None:
+                code = on_stop(node) or code
+        finally:
+            executor.shutdown()
+            node.destroy_node()
+            rclpy.try_shutdown()
+            left = proc_tree.wait_gone(children, max(0.0, children_by - time.monotonic()))
+            proc_tree.send(left, signal.SIGKILL)
+            proc_tree.wait_gone(left, KILL_WAIT_S)
+    if stop.signum:  # a signal, not the program's own request
+        _end_process(code)
+    return code
+
+
+def _serve_beside_the_spin(serve, node, executor, stop):
+    from miro_ball.common.stopping import spin_until_stopped
+
+    spinner = threading.Thread(target=spin_until_stopped, args=(executor, stop), daemon=True)
+    spinner.start()
+    try:
+        serve(node, stop)
+    finally:
+        stop.request()  # a server that ended by itself (or failed) ends the spin too
+        spinner.join(timeout=SPIN_JOIN_S)
+
+
+def _end_process(code):
+    """End the process now, all of it closed already: what it printed is flushed (Python's
+    and C's buffers), the interpreter's teardown is skipped."""
+    logging.shutdown()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe: nobody reads it any more
+            pass
+    ctypes.CDLL(None).fflush(None)
+    os._exit(code if isinstance(code, int) else 1)  # SystemExit('why') has said why
