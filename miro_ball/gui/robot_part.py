@@ -187,6 +187,7 @@ class RobotPart(Node):
             self.destroy_subscription(sub)
         self._demo_subs = []
         self.values.pop('demo', None)
+        self._objects.clear()
         self.frames.forget_overlays(self.robot)
         if not on:
             return
