@@ -10,7 +10,8 @@ import time
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
-from miro_ball.animal.node import MiroAnimal
+from miro_ball.animal.node import DEMO_MODE
+from miro_ball.controller.host import ControllerHost
 from miro_sim_bullet.ros.node import SimNode
 
 TICK_TIMEOUT_S = 10.0
@@ -25,8 +26,9 @@ class AnimalRig:
             Parameter('camera_rate', value=camera_rate)])
         self.sim = self.sim_node.sim
         self.robot = self.sim.robot
-        self.node = MiroAnimal(context=context, robot=self.robot.name, parameter_overrides=[
-            Parameter('use_sim_time', value=True)]
+        self.node = ControllerHost(
+            DEMO_MODE, context=context, robot=self.robot.name,
+            parameter_overrides=[Parameter('use_sim_time', value=True)]
             + [Parameter(name, value=value) for name, value in params.items()])
         self.animal = self.node.controller
         self.executor = SingleThreadedExecutor(context=context)

@@ -128,7 +128,7 @@ def test_a_tired_miro_left_alone_falls_asleep_and_a_touch_wakes_it(rig, ros_cont
     what sleep looks like on the body is judged."""
     from miro2_msg.msg import AnimalAdjust
 
-    rig = rig(camera_rate=5.0, fast_sleep=True)
+    rig = rig(camera_rate=5.0, **{'sleep.fast_sleep': True})
     rig.sim.place_ball(*FAR)
     tell = rig.node.create_publisher(AnimalAdjust, 'core/animal/adjust', 10)
     tired = AnimalAdjust()
@@ -174,7 +174,7 @@ def test_the_mdk_clients_switch_parts_and_nudge_the_state(rig, capsys):
     code = run_client(rig, client_demo_config, ['v', 'T'], limit_s=3.0)
     out = capsys.readouterr().out
     assert code == 0 and 'switches on: trnscudMSFBhaHm' in out and 'off: vT' in out
-    assert not rig.node.get_parameter('voice').value and not rig.animal.config.flags.tail
+    assert not rig.node.get_parameter('flags.voice').value and not rig.animal.config.flags.tail
     assert rig.run(1.0) and all(a.cosmetic[1] == 0.5 for _, a in rig.actions[-50:])  # no wag
     code = run_client(rig, client_demo_config, ['--set', 'vtrn'], limit_s=3.0)
     assert code == 0 and 'switches on: vtrn\n' in capsys.readouterr().out
@@ -189,9 +189,10 @@ def test_the_mdk_clients_switch_parts_and_nudge_the_state(rig, capsys):
 
 def test_each_robot_has_its_own_demo_mode_in_its_namespace(ros_context):
     """Two robots, two demo modes: every topic of each under its own robot's name."""
-    from miro_ball.animal.node import MiroAnimal
+    from miro_ball.animal.node import DEMO_MODE
+    from miro_ball.controller.host import ControllerHost
 
-    nodes = [MiroAnimal(context=ros_context, robot=name) for name in ('miro01', 'miro02')]
+    nodes = [ControllerHost(DEMO_MODE, context=ros_context, robot=name) for name in ('miro01', 'miro02')]
     try:
         for node, name in zip(nodes, ('miro01', 'miro02')):
             assert node.get_fully_qualified_name() == f'/{name}/miro_animal'
@@ -212,8 +213,8 @@ def test_help_and_a_typo_in_a_parameter_is_refused_in_one_line():
     shown = subprocess.run([sys.executable, '-m', 'miro_ball.animal', '--help'],
                            capture_output=True, text=True, timeout=60)
     assert shown.returncode == 0
-    assert 'fast_sleep' in shown.stdout and 'core/animal/state' in shown.stdout
+    assert 'sleep.fast_sleep' in shown.stdout and 'core/animal/state' in shown.stdout
     typo = subprocess.run([sys.executable, '-m', 'miro_ball.animal', '--ros-args', '-p',
                            'fast_sleeep:=true'], capture_output=True, text=True, timeout=60)
     assert typo.returncode == 2 and typo.stderr.count('\n') == 1
-    assert "did you mean fast_sleep" in typo.stderr
+    assert "did you mean sleep.fast_sleep" in typo.stderr

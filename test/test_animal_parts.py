@@ -321,17 +321,18 @@ def test_asleep_the_wheels_stop_and_the_head_hangs():
 
 
 def test_every_parameter_is_in_the_docs_and_a_part_can_be_replaced():
-    from dataclasses import fields
     from pathlib import Path
 
-    from miro_ball.animal.params import PART_GROUPS
+    from miro_ball.animal.params import PART_PARAMS
+    from miro_ball.common.params import table
     from miro_ball.controller.behaviour import BehaviourParams
     from miro_ball.controller.controllers import make_controller
 
     text = (Path(__file__).resolve().parent.parent / 'docs' / 'demo_mode.md').read_text()
-    # (the detectors' own are the controller's: docs/controller.md)
-    missing = [f.name for cls in (AnimalNodeParams,) + PART_GROUPS for f in fields(cls)
-               if f'`{f.name}`' not in text]
+    # Each by its full (dotted) name; the detectors' own are the controller's
+    # (docs/controller.md).
+    missing = [name for name, _, _ in table(AnimalNodeParams, *PART_PARAMS)
+               if f'`{name}`' not in text]
     assert not missing
     # The docs' own example selector, as -p selector:= names it: it dithers where the basal
     # ganglia hold one action.
@@ -340,9 +341,11 @@ def test_every_parameter_is_in_the_docs_and_a_part_can_be_replaced():
     close = [[0.5 + 0.01 * (-1) ** i, 0.5 - 0.01 * (-1) ** i] for i in range(100)]
     picks = [greedy.selector.select(i * DT, each) for i, each in enumerate(close)]
     assert sum(a != b for a, b in zip(picks, picks[1:])) == 99
-    # The whole animal as a mode of the controller node: the contract is all it needs.
-    mode = make_controller('miro_ball.animal.animal:Animal', BehaviourParams())
-    assert mode.config == Config() and mode.act(percepts(0.0, ball_at(0.8, 0.0))).wheels
+    # The whole animal as a mode of kick_blue_ball, which has none of demo mode's
+    # parameters: refused in one line, never run on defaults nobody chose.
+    with pytest.raises(ValueError, match='python -m miro_ball.animal') as refused:
+        make_controller('miro_ball.animal.animal:Animal', BehaviourParams())
+    assert '\n' not in str(refused.value)
 
 
 def test_reflexes_have_the_last_word_a_drop_backs_it_off_a_wall_slows_it():

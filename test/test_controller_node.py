@@ -19,7 +19,8 @@ from std_msgs.msg import (Float32MultiArray, Int16MultiArray, UInt16, UInt16Mult
 
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
 from miro_ball.controller.contract import Action
-from miro_ball.controller.node import build_parser, KickBlueBall, main
+from miro_ball.controller.host import ControllerHost
+from miro_ball.controller.node import build_parser, KICK_BLUE_BALL, main
 from miro_ball.bench.synthetic import Disc, jpeg, render
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, COSMETIC_CALIB, JOINT_NAMES
@@ -48,7 +49,7 @@ class Rig:
     def __init__(self, context, executor, overrides=(), robot=None, **kwargs):
         robot = robot or default_robot_name()
         # No use_sim_time: the node follows /clock by default.
-        self.node = KickBlueBall(context=context, parameter_overrides=list(overrides),
+        self.node = ControllerHost(KICK_BLUE_BALL, context=context, parameter_overrides=list(overrides),
                                  robot=robot, **kwargs)
         self.probe = rclpy.create_node('fake_sim', context=context)
         self.executor = executor
@@ -122,9 +123,9 @@ class Rig:
                         != before, 'the node to take a camera_info')
 
     def cliff(self, values):
-        before = self.node.cliff.stamp, sum(self.node.rejected.values())
+        before = self.node.readings['cliff'].stamp, sum(self.node.rejected.values())
         self.pub_cliff.publish(Float32MultiArray(data=list(values)))
-        self.wait_until(lambda: (self.node.cliff.stamp, sum(self.node.rejected.values()))
+        self.wait_until(lambda: (self.node.readings['cliff'].stamp, sum(self.node.rejected.values()))
                         != before, 'the node to take a cliff reading')
 
     def last_twist(self):
@@ -271,7 +272,7 @@ def test_survives_bad_inputs(make_rig):
     for values in ([1.0], [1.0, 1.0, 1.0], [float('nan'), 1.0], [1.0, 7.5]):
         rig.cliff(values)
     assert rig.node.rejected == {'empty': 1, 'corrupt': 3, 'size': 1, 'cliff': 4}
-    assert rig.node.frames_processed == 0 and rig.node.cliff.value is None
+    assert rig.node.frames_processed == 0 and rig.node.readings['cliff'].value is None
     # Still alive, still driving, and still taking good input.
     count = len(rig.twists)
     rig.advance(0.1)
@@ -440,8 +441,8 @@ def test_a_controller_of_your_own_reads_every_percept_and_sets_every_action(make
     for pub, msg in readings:
         pub.publish(msg)
     controller = rig.node.controller
-    rig.wait_until(lambda: all(latest.value is not None for latest in rig.node.readings.values()),
-                   'the readings')
+    rig.wait_until(lambda: all(latest.value is not None for field, latest
+                               in rig.node.readings.items() if field != 'cliff'), 'the readings')
     rig.advance(0.1)
     rig.wait_until(lambda: all(got.values()) and rig.joints, 'every part of the action')
     seen = controller.percepts[-1]
@@ -462,8 +463,8 @@ def test_a_controller_of_your_own_reads_every_percept_and_sets_every_action(make
 
 
 def test_sim_time_is_the_default_and_the_command_line_can_turn_it_off(ros_context):
-    on = KickBlueBall(context=ros_context, args=['kick_blue_ball'])
-    off = KickBlueBall(context=ros_context, robot='other',
+    on = ControllerHost(KICK_BLUE_BALL, context=ros_context, args=['kick_blue_ball'])
+    off = ControllerHost(KICK_BLUE_BALL, context=ros_context, robot='other',
                        args=['kick_blue_ball', '--ros-args', '-p', 'use_sim_time:=false'])
     try:
         assert on.get_parameter('use_sim_time').value is True
@@ -485,7 +486,7 @@ def test_the_robot_is_the_namespace_and_frames_carry_it(make_rig):
 
 def test_the_namespace_defaults_to_the_environment(ros_context, monkeypatch):
     monkeypatch.setenv('MIRO_ROBOT_NAME', 'miro07')
-    node = KickBlueBall(context=ros_context)
+    node = ControllerHost(KICK_BLUE_BALL, context=ros_context)
     assert (node.robot, node.get_namespace()) == ('miro07', '/miro07')
     node.destroy_node()
 
@@ -535,7 +536,7 @@ def test_steers_by_the_camera_info_model(make_rig):
 
 def test_bad_parameter_is_refused(ros_context):
     with pytest.raises(ValueError, match='tick'):
-        KickBlueBall(context=ros_context, parameter_overrides=[Parameter('tick', value='fast')])
+        ControllerHost(KICK_BLUE_BALL, context=ros_context, parameter_overrides=[Parameter('tick', value='fast')])
 
 
 def test_help_lists_parameters_and_topics(capsys):

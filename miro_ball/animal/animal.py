@@ -51,9 +51,10 @@ class Animal:
 
     def __init__(self, config=Config(), selector='basal_ganglia', seed=0):
         if not isinstance(config, Config):
-            # Built by the controller node as a `mode` (with its BehaviourParams): demo
-            # mode's own parameters at their defaults.
-            config = Config()
+            # e.g. `-p mode:=...:Animal` of kick_blue_ball, whose parameters are not demo
+            # mode's: refused, never run on defaults the user did not choose.
+            raise ValueError('demo mode is built from its own parameters (animal.params.Config), '
+                             f'not {type(config).__name__}: run it as python -m miro_ball.animal')
         self.rng = np.random.default_rng(seed)
         self.config = config
         self.map = PriorityMap(config.spatial)

@@ -9,7 +9,7 @@ ours) the value is our own and its help says what it does.
 import math
 from dataclasses import dataclass, field, fields, make_dataclass, replace
 
-from miro_ball.common.params import check_ranges
+from miro_ball.common.params import check_ranges, Group
 from miro_ball.miro.constants import LIFT_RAD_CALIB, PLATFORM_TICK_S
 
 
@@ -34,6 +34,8 @@ class AnimalNodeParams:
     head_hold_s: float = knob(0.0, 'hold the start head pose this long first, s', 0.0, 60.0)
     head_lift_deg: float = knob(round(math.degrees(LIFT_RAD_CALIB), 6),
                                 'lift of the start head pose, deg', 8.0, 60.0)
+    save_debug_keep: int = knob(500, '--save-debug keeps only the newest this many frames',
+                                1, 1000000)
 
     def __post_init__(self):
         from miro_ball.animal.selection import selector_class
@@ -260,6 +262,12 @@ class ExpressParams:
 
 PART_GROUPS = (FlagParams, SpatialParams, ActionParams, AffectParams, SleepParams,
                ExpressParams)
+# Each part's parameters under its own dotted name, the ROS 2 way: flags.tail,
+# attention.peak_threshold, sleep.fast_sleep, ... (one namespace per part: two parts may use
+# one field name without a clash).
+PART_PARAMS = tuple(Group(prefix, cls) for prefix, cls in zip(
+    ('flags', 'attention', 'action', 'affect', 'sleep', 'express'), PART_GROUPS))
+PREFIX = {group.cls: group.prefix for group in PART_PARAMS}
 
 
 @dataclass(frozen=True)

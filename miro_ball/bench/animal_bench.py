@@ -46,15 +46,16 @@ def one_round(label, real_time_factor, seconds, env):
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
 
-    from miro_ball.animal.node import MiroAnimal
-    from miro_ball.controller.node import KickBlueBall
+    from miro_ball.animal.node import DEMO_MODE
+    from miro_ball.controller.host import ControllerHost
+    from miro_ball.controller.node import KICK_BLUE_BALL
 
     sim = subprocess.Popen(sim_command(WORLD, real_time_factor=real_time_factor), env=env,
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     context = Context()
     rclpy.init(context=context, domain_id=int(env['ROS_DOMAIN_ID']))
-    node_class = KickBlueBall if label.startswith('kick_blue_ball') else MiroAnimal
-    node = node_class(context=context, robot=env['MIRO_ROBOT_NAME'])
+    hosted = KICK_BLUE_BALL if label.startswith('kick_blue_ball') else DEMO_MODE
+    node = ControllerHost(hosted, context=context, robot=env['MIRO_ROBOT_NAME'])
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     running = [True]

@@ -76,13 +76,14 @@ def bench_latency(count):
     from rclpy.parameter import Parameter
     from sensor_msgs.msg import CompressedImage
 
-    from miro_ball.controller.node import KickBlueBall
+    from miro_ball.controller.host import ControllerHost
+    from miro_ball.controller.node import KICK_BLUE_BALL
 
     # A private domain and robot name: never talk to a real simulator or robot.
     limit_discovery()
     context = Context()
     rclpy.init(context=context, domain_id=private_domain(salt=75))
-    node = KickBlueBall(context=context, robot=BENCH_ROBOT, parameter_overrides=[
+    node = ControllerHost(KICK_BLUE_BALL, context=context, robot=BENCH_ROBOT, parameter_overrides=[
         Parameter('head_hold_s', value=0.0)])
     probe = rclpy.create_node('bench_probe', context=context)
     twists = []

@@ -6,15 +6,42 @@ so a node's declarations, its --help and the README cannot drift apart. The
 dataclass's __post_init__ calls check_ranges and validates the whole set.
 Every number is bounded: a value that is legal but absurd (a 1e9 s tick, a
 99999 px blur) would otherwise be accepted at start and hang or fail later.
+
+A node with many groups names them the ROS 2 way, with dotted names: ``Group('affect',
+AffectParams)`` declares ``affect.gain``, ... (a YAML params file nests them under
+``affect:``). A plain dataclass is a group without a prefix.
 """
 import math
 from dataclasses import fields, MISSING, replace
+from typing import NamedTuple
 
 from miro_ball.common.throttle import Throttled
 
 # Parameters every rclpy node has; a user may set them on any of ours.
 ROS_OWN_PARAMS = {'use_sim_time': False, 'start_type_description_service': True}
 ROS_OWN_PREFIXES = ('qos_overrides.',)
+
+
+class Group(NamedTuple):
+    """A params dataclass whose parameters are named '<prefix>.<field>'."""
+
+    prefix: str
+    cls: type
+
+
+def group_of(group):
+    """A Group for a Group or a plain dataclass (no prefix)."""
+    return group if isinstance(group, Group) else Group('', group)
+
+
+def full_name(prefix, name):
+    return f'{prefix}.{name}' if prefix else name
+
+
+def parameters(*groups):
+    """[(parameter name, dataclass, field)] of every field of the groups, in order."""
+    return [(full_name(prefix, f.name), cls, f)
+            for prefix, cls in map(group_of, groups) for f in fields(cls)]
 
 
 def default_of(f):
@@ -68,19 +95,30 @@ def check_ranges(values):
                              % (f.name, _show(lowest), _show(highest), _show(value)))
 
 
-def declare(node, cls):
-    """Declare every field of cls on the node and return the filled-in dataclass (the
-    command line's values checked: coerce, then the dataclass's ranges)."""
+def declare(node, group):
+    """Declare every field of a group (a dataclass, or a Group) on the node and return the
+    filled-in dataclass (the command line's values checked: coerce, then the dataclass's
+    ranges)."""
     from rcl_interfaces.msg import ParameterDescriptor
 
     values = {}
-    for f in fields(cls):
+    prefix, cls = group_of(group)
+    for name, _, f in parameters(group):
         default = default_of(f)
         descriptor = ParameterDescriptor(description=f.metadata['help'], dynamic_typing=True)
         declared = list(default) if isinstance(default, tuple) else default
-        value = node.declare_parameter(f.name, declared, descriptor).value
-        values[f.name] = coerce(f.name, value, default)
-    return cls(**values)
+        value = node.declare_parameter(name, declared, descriptor).value
+        values[f.name] = coerce(name, value, default)
+    try:
+        return cls(**values)
+    except ValueError as err:
+        raise ValueError(_in_group(prefix, err)) from None
+
+
+def _in_group(prefix, err):
+    """A dataclass's own complaint ('parameter gain must be ...') with the group's prefix."""
+    text = str(err)
+    return f'{prefix}: {text}' if prefix else text
 
 
 def ros_overrides(argv, node_name):
@@ -142,7 +180,7 @@ def check_overrides(overrides, *groups):
     A typo must not run the defaults as if nothing had been said."""
     import difflib
 
-    known = {f.name: f for cls in groups for f in fields(cls)}
+    known = {name: f for name, _, f in parameters(*groups)}
     for name, value in overrides.items():
         if name.startswith(ROS_OWN_PREFIXES):
             continue
@@ -173,7 +211,7 @@ def _help(f):
 
 def table(*groups):
     """(name, default as text, help with the range) for every parameter of the groups."""
-    return [(f.name, _show(default_of(f)), _help(f)) for cls in groups for f in fields(cls)]
+    return [(name, _show(default_of(f)), _help(f)) for name, _, f in parameters(*groups)]
 
 
 def help_lines(*groups):
@@ -188,18 +226,22 @@ class LiveParams:
     """Run-time set_parameters for a node whose parameters are dataclass fields.
 
     A change is checked exactly as at start (coerce, the ranges, the dataclass's own
-    checks) and handed to apply(updated dataclass); a change to a name in ``fixed``, or one
-    that fails a check, is refused with the reason. Never accepted and then ignored.
+    checks) and handed to apply(updated dataclass), which may refuse it with ValueError; a
+    change to a name in ``fixed``, or one that fails a check, is refused with the reason.
+    Never accepted and then ignored.
     Parameters that are not fields (use_sim_time) are left to rclpy.
     """
 
-    def __init__(self, node, values, apply, fixed=()):
+    def __init__(self, node, values, apply, fixed=(), groups=None):
+        """values: the declared dataclasses; groups: how each was declared (the dataclasses
+        or Groups, in the same order; default: no prefixes)."""
         self.values = {type(v): v for v in values}
         self.apply = apply
         # A client may toggle a switch a thousand times a second: a few lines, not a flood.
         self.log = Throttled(node.get_logger().info)
         self.fixed = set(fixed)
-        self._owner = {f.name: (cls, f) for cls in self.values for f in fields(cls)}
+        self._owner = {name: (cls, f) for name, cls, f
+                       in parameters(*(groups or list(self.values)))}
         node.add_on_set_parameters_callback(self._on_set)
 
     def _on_set(self, parameters):
@@ -214,15 +256,18 @@ class LiveParams:
                     f'{parameter.name} is read at start only: restart the node to change it'))
             cls, f = self._owner[parameter.name]
             try:
-                value = coerce(f.name, parameter.value, default_of(f))
+                value = coerce(parameter.name, parameter.value, default_of(f))
                 updated[cls] = replace(updated[cls], **{f.name: value})
             except (ValueError, TypeError) as err:
                 return SetParametersResult(successful=False, reason=str(err))
-            said.append(f'{f.name} := {_show(value)}')
+            said.append(f'{parameter.name} := {_show(value)}')
         changed = [v for cls, v in updated.items() if v != self.values[cls]]
-        self.values = updated
         for values in changed:
-            self.apply(values)
+            try:
+                self.apply(values)  # ValueError: the node can not take it (a mode that
+            except ValueError as err:  # needs other parameters): refused, nothing changed
+                return SetParametersResult(successful=False, reason=str(err))
+            self.values[type(values)] = values
         if said:
             self.log('set', 'set at run time: ' + ', '.join(said))
         return SetParametersResult(successful=True)

@@ -42,7 +42,8 @@ class SteppedRig:
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.parameter import Parameter
 
-        from miro_ball.controller.node import KickBlueBall
+        from miro_ball.controller.host import ControllerHost
+        from miro_ball.controller.node import KICK_BLUE_BALL
         from miro_sim_bullet.ros.node import SimNode
 
         self._quieten(SIM_NODE_NAME)
@@ -54,8 +55,8 @@ class SteppedRig:
         self.executor.add_node(self.sim_node)
         for index, name in enumerate(self.sim.robots):
             self._quieten(f'{name}.{CONTROLLER}')  # the logger of node /<name>/<CONTROLLER>
-            self.controllers[name] = KickBlueBall(
-                context=self.context, robot=name, parameter_overrides=[
+            self.controllers[name] = ControllerHost(
+                KICK_BLUE_BALL, context=self.context, robot=name, parameter_overrides=[
                     Parameter('use_sim_time', value=True), Parameter('mode', value=self.mode),
                     Parameter('seed', value=self.seed + index)]
                 + [Parameter(n, value=v) for n, v in self.controller_params])
