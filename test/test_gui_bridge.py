@@ -284,13 +284,18 @@ def test_the_real_time_factor_is_set_on_the_simulator_and_read_back(
         return response
 
     def get_parameters(request, response):
+        assert request.names == ['real_time_factor', 'paused']
         response.values = [ParameterValue(type=ParameterType.PARAMETER_DOUBLE,
-                                          double_value=1.0)]
+                                          double_value=1.0),
+                           ParameterValue(type=ParameterType.PARAMETER_BOOL, bool_value=True)]
         return response
 
+    assert not json.loads(bridge.state(1))['sim']['paused']
     sim.node.create_service(SetParameters, SIM.topic('set_parameters'), set_parameters)
     sim.node.create_service(GetParameters, SIM.topic('get_parameters'), get_parameters)
     assert spin_until(executor, lambda: json.loads(bridge.state(1))['rtf_set'] == 1.0)
+    # Started paused, its clock has not run: the page says paused (no time stood still).
+    assert json.loads(bridge.state(1))['sim']['paused'] is True
     assert spin_until(executor, lambda: bridge.sim.clients['set_parameters'].service_is_ready())
     bridge.submit(p.SetRtf(0.0), owner=1)
     assert spin_until(executor, lambda: json.loads(bridge.state(1))['rtf_set'] == 0.0)

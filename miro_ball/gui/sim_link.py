@@ -21,6 +21,7 @@ from miro_ball.common.throttle import Throttled
 from miro_ball.miro.interface import CLOCK, CONTROL_QOS, SimTopics
 
 RTF_PARAMETER = 'real_time_factor'
+PAUSED_PARAMETER = 'paused'
 GUI_SOUND_DB = -30.0  # a sound placed from the page: its RMS 1 m away, dB of full scale
 RTF_WINDOW_S = 2.0  # the real-time factor shown is measured over this much wall time
 
@@ -38,6 +39,7 @@ class SimLink:
         self.topics = SimTopics()
         self.time = None
         self.paused = None  # known only when paused or resumed from here
+        self.started_paused = None  # the paused parameter, read with the real-time factor
         self.rtf_set = None  # the simulator's real_time_factor as last set or read
         self._rtf_asked = False
         self._clock_samples = []  # (wall, sim) of the last RTF_WINDOW_S of /clock
@@ -59,10 +61,16 @@ class SimLink:
         # Two simulators' clocks side by side make a speed of nonsense: none is shown.
         contested = self._clock_watch.contested
         rtf = None if contested else self._rtf()
+        # Known when paused from here; else guessed from time standing still, or read from
+        # the simulator's parameter while its clock has not yet run.
+        if self.paused is not None:
+            paused = self.paused
+        elif self.time is not None:
+            paused = rtf == 0.0
+        else:
+            paused = bool(self.started_paused)
         sim = {'present': self.clients['reset'].service_is_ready(), 'time': self.time,
-               'rtf': rtf,
-               # Known when paused from here; else guessed from time standing still.
-               'paused': rtf == 0.0 if self.paused is None else self.paused}
+               'rtf': rtf, 'paused': paused}
         status = (shared_domain_line(clock_publishers(self.node),
                                      self.node.context.get_domain_id())
                   if contested else None)
@@ -148,7 +156,8 @@ class SimLink:
         client.call_async(request).add_done_callback(done)
 
     def read_rtf(self):
-        """Ask for the simulator's real_time_factor unless known or being asked."""
+        """Ask for the simulator's real_time_factor (and whether it is paused) unless known
+        or being asked."""
         client = self.clients['get_parameters']
         if self.rtf_set is not None or self._rtf_asked or not client.service_is_ready():
             return
@@ -160,7 +169,10 @@ class SimLink:
             values = response.values if response is not None else []
             if values and values[0].type == ParameterType.PARAMETER_DOUBLE:
                 self.rtf_set = values[0].double_value
-        client.call_async(GetParameters.Request(names=[RTF_PARAMETER])).add_done_callback(done)
+            if len(values) > 1 and values[1].type == ParameterType.PARAMETER_BOOL:
+                self.started_paused = values[1].bool_value
+        client.call_async(GetParameters.Request(names=[RTF_PARAMETER, PAUSED_PARAMETER])) \
+            .add_done_callback(done)
 
     # -- the clock ------------------------------------------------------------------------------
     def _on_clock(self, msg):
