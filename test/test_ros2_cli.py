@@ -39,6 +39,52 @@ def test_topic_list_names_every_topic_of_the_robot_with_its_type(paused_sim, exe
     assert listed[T.cmd_vel] == '[geometry_msgs/msg/TwistStamped]'
 
 
+def test_listings_wait_for_the_whole_graph_and_agree_run_after_run(paused_sim, executor):
+    """Each process is heard of in its own time (seconds apart on a busy machine): a listing
+    that answered after a fixed moment left nodes and topics out, differently each run."""
+    env = isolated_env(int(os.environ['ROS_DOMAIN_ID']))
+    others = [subprocess.Popen([sys.executable, '-m', 'miro_ball.ros2', 'topic', 'pub',
+                                f'/listed_{k}', 'std_msgs/msg/String', '{data: hi}'],
+                               env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                               text=True) for k in range(2)]
+    try:
+        for proc in others:  # its node is made before it says so
+            assert proc.stdout.readline().startswith('publisher: beginning loop')
+        nodes = {f'/miro_ball_ros2_{proc.pid}' for proc in others} | {SIM}
+        for verb, runs, expected in (('node', 2, nodes),
+                                     ('topic', 3, {'/listed_0', '/listed_1', *T.all()})):
+            answers = [ros2([verb, 'list'], paused_sim, executor) for _ in range(runs)]
+            assert all(code == 0 and 'incomplete' not in err for code, _, err in answers)
+            assert len({out for _, out, _ in answers}) == 1
+            assert expected <= set(answers[0][1].split())
+    finally:
+        for proc in others:
+            kill_if_running(proc)
+
+
+def test_topic_info_names_the_node_of_each_endpoint(paused_sim, executor):
+    # It answered as soon as the topic was heard of, before the name of its node.
+    code, out, _ = ros2(['topic', 'info', '-v', T.package], paused_sim, executor)
+    assert code == 0 and 'Publisher count: 1' in out
+    assert f'Node name: {SIM_NODE_NAME}\n' in out and '_NODE_NAME_UNKNOWN_' not in out
+
+
+@pytest.mark.parametrize('changes,consistent,whole', [
+    ((0.0,), True, True),  # all heard of at once: answered at MIN_S
+    ((0.0, 3.0), True, True),  # the last process heard of 3 s in: answered STABLE_S later
+    ((0.0,), False, False),  # an endpoint never has its node: at LIMIT_S, said partial
+    (tuple(round(0.8 * k, 1) for k in range(13)), True, False),  # never still to the end
+])
+def test_a_listing_is_the_answer_once_still_and_consistent(changes, consistent, whole):
+    from miro_ball.ros2.settling import LIMIT_S, MIN_S, Settling, STABLE_S
+
+    settling, now = Settling(0.0), 0.0
+    while not settling.see(now, sum(t <= now for t in changes), consistent):
+        now = round(now + 0.1, 1)
+    assert settling.whole == whole and settling.listing == sum(t <= now for t in changes)
+    assert now == (max(MIN_S, changes[-1] + STABLE_S) if whole else LIMIT_S)
+
+
 def test_echo_once_prints_a_message_as_yaml_and_a_field_alone(paused_sim, executor):
     code, out, _ = ros2(['topic', 'echo', T.battery, '--once'], paused_sim, executor)
     assert code == 0 and out.endswith('---\n')
@@ -112,6 +158,8 @@ def test_params_and_services_of_the_simulator(paused_sim, executor):
      'no interface geometry_msgs/msg/Twistt'),
     (['interface', 'show', 'nonsense'], 'is not a type name'),
     (['param', 'get', '/no_such_node', 'x'], 'no node /no_such_node'),
+    (['param', 'set', SIM, 'camera_rat', '10'],  # not rclpy's "Invalid access to undeclared"
+     "no parameter 'camera_rat' on /miro_sim; did you mean 'camera_rate'"),
     (['topic', 'pub', '--once', '/bad topic', 'std_msgs/msg/String', '{data: hi}'],
      "'/bad topic' is not a ROS name"),
     (['service', 'call', '/a//b', 'std_srvs/srv/Trigger'], "'/a//b' is not a ROS name"),

@@ -2,19 +2,21 @@
 finds a topic's type and its publishers' QoS, and calls a service.
 
 ``ros2`` asks a daemon that has been listening all along; without one, a fresh node must
-listen a moment before the graph is complete (DISCOVERY_S of wall time, or until what is
-asked for shows up).
+listen until the graph is complete (settling.py says when), or until what is asked for
+by name shows up.
 """
 import os
+import sys
 import time
 
 import rclpy
-from rclpy.node import Node
+from rclpy.node import Node, NodeNameNonExistentError
 
+from miro_ball.common.clock_watch import UNKNOWN
 from miro_ball.common.qos import matching
+from miro_ball.ros2.settling import incomplete_line, LIMIT_S, Settling
 
-DISCOVERY_S = 1.5  # wall seconds a listing listens before it answers
-STABLE_S = 0.5  # wall seconds a listing must stay the same to be the answer
+DISCOVERY_INFO = 'ros_discovery_info'  # each process's own topic, of no node: not checked
 WAIT_S = 5.0  # wall seconds to wait for a topic, node or service that is asked for by name
 
 
@@ -50,18 +52,34 @@ class Graph:
         return None
 
     def settle(self, listing):
-        """listing() once the graph has been listened to for DISCOVERY_S and it has not
-        changed for STABLE_S (endpoints are announced one by one), or at WAIT_S."""
-        start = time.monotonic()
-        seen, since = listing(), start
-        while time.monotonic() - start < WAIT_S:
-            rclpy.spin_once(self.node, timeout_sec=0.05)
-            now, current = time.monotonic(), listing()
-            if current != seen:
-                seen, since = current, now
-            elif seen and now - start >= DISCOVERY_S and now - since >= STABLE_S:
-                break
-        return seen
+        """listing() once the graph is complete (settling.Settling), or at its time limit,
+        then with a line on stderr that it may be incomplete."""
+        settling = Settling(time.monotonic())
+        while not settling.see(time.monotonic(), listing(), self.consistent()):
+            self.spin(0.1)
+        if not settling.whole:
+            print(incomplete_line(LIMIT_S), file=sys.stderr)
+        return settling.listing
+
+    def consistent(self):
+        """Whether every endpoint heard of has its node and every node heard of has
+        endpoints: a process's endpoints and its node names arrive apart."""
+        node = self.node
+        for topic, _ in node.get_topic_names_and_types(no_demangle=True):
+            if topic == DISCOVERY_INFO:
+                continue
+            endpoints = node.get_publishers_info_by_topic(topic, no_mangle=True) \
+                + node.get_subscriptions_info_by_topic(topic, no_mangle=True)
+            if any(info.node_name == UNKNOWN for info in endpoints):
+                return False
+        for name, namespace in node.get_node_names_and_namespaces():
+            try:
+                if not (node.get_publisher_names_and_types_by_node(name, namespace)
+                        or node.get_subscriber_names_and_types_by_node(name, namespace)):
+                    return False
+            except NodeNameNonExistentError:  # it has just gone
+                return False
+        return True
 
     def topics(self):
         """{topic: [types]} of everyone but this node."""
@@ -81,6 +99,13 @@ class Graph:
             raise CliError(f'no topic {topic} on ROS domain {self.domain} (the topics: '
                            'python -m miro_ball.ros2 topic list)')
         return types[0]
+
+    def endpoints(self, topic):
+        """([publishers], [subscriptions]) of topic (TopicEndpointInfo) but this node's."""
+        me = self.node.get_name()
+        return tuple([info for info in endpoints if info.node_name != me]
+                     for endpoints in (self.node.get_publishers_info_by_topic(topic),
+                                       self.node.get_subscriptions_info_by_topic(topic)))
 
     def qos_for(self, topic):
         """A subscription QoS every publisher of topic matches (common.qos.matching)."""

@@ -9,6 +9,7 @@ import time
 
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import GetParameters, ListParameters, SetParameters
+from rclpy.node import NodeNameNonExistentError
 
 from miro_ball.common.definitions import expanded, split_type
 from miro_ball.ros2 import convert
@@ -67,11 +68,7 @@ def topic_list(args, graph):
 def topic_info(args, graph):
     topic = absolute(args.topic)
     type_name = graph.topic_type(topic)
-    node = graph.node
-    publishers = [i for i in node.get_publishers_info_by_topic(topic)
-                  if i.node_name != node.get_name()]
-    subscribers = [i for i in node.get_subscriptions_info_by_topic(topic)
-                   if i.node_name != node.get_name()]
+    publishers, subscribers = graph.settle(lambda: graph.endpoints(topic))
     print(f'Type: {type_name}')
     for kind, endpoints in (('Publisher', publishers), ('Subscription', subscribers)):
         print(f'{kind} count: {len(endpoints)}')
@@ -169,10 +166,15 @@ def node_info(args, graph):
                 ('Publishers', node.get_publisher_names_and_types_by_node),
                 ('Service Servers', node.get_service_names_and_types_by_node),
                 ('Service Clients', node.get_client_names_and_types_by_node))
+    try:
+        found = graph.settle(lambda: [sorted(listing(name, namespace))
+                                      for _, listing in sections])
+    except NodeNameNonExistentError:
+        raise CliError(f'{args.node} left the ROS graph while it was listed') from None
     print(f'{namespace.rstrip("/")}/{name}')
-    for title, listing in sections:
+    for (title, _), listing in zip(sections, found):
         print(f'  {title}:')
-        for topic, types in sorted(listing(name, namespace)):
+        for topic, types in listing:
             print(f'    {topic}: {", ".join(types)}')
     print('  Action Servers:\n\n  Action Clients:\n')
     return 0
@@ -184,10 +186,27 @@ def _parameter_service(graph, node, service):
     return f'{namespace.rstrip("/")}/{name}/{service}'
 
 
+def _parameter_names(graph, node):
+    service = _parameter_service(graph, node, 'list_parameters')
+    return graph.call(service, ListParameters, ListParameters.Request()).result.names
+
+
+def _refuse_unknown(graph, node, name):
+    """CliError in one line, with the nearest names, if node has no parameter name (rclpy
+    would say 'Invalid access to undeclared parameter(s): []')."""
+    import difflib
+
+    known = _parameter_names(graph, node)
+    if name in known:
+        return
+    near = difflib.get_close_matches(name, known, n=3)
+    hint = ('; did you mean ' + ' or '.join(map(repr, near)) + '?' if near else
+            f' (the parameters: python -m miro_ball.ros2 param list {node})')
+    raise CliError(f'no parameter {name!r} on {node}{hint}')
+
+
 def param_list(args, graph):
-    service = _parameter_service(graph, args.node, 'list_parameters')
-    result = graph.call(service, ListParameters, ListParameters.Request())
-    for name in sorted(result.result.names):
+    for name in sorted(_parameter_names(graph, args.node)):
         print(f'  {name}')
     return 0
 
@@ -196,6 +215,7 @@ def param_get(args, graph):
     service = _parameter_service(graph, args.node, 'get_parameters')
     values = graph.call(service, GetParameters, GetParameters.Request(names=[args.name])).values
     if not values or values[0].type not in PARAMETER_VALUE:
+        _refuse_unknown(graph, args.node, args.name)
         print('Parameter not set.')
         return 1
     field, word = PARAMETER_VALUE[values[0].type]
@@ -229,6 +249,7 @@ def param_set(args, graph):
     if result.successful:
         print('Set parameter successful')
         return 0
+    _refuse_unknown(graph, args.node, args.name)
     print(f'Setting parameter failed: {result.reason}')
     return 1
 
