@@ -231,3 +231,20 @@ def test_a_request_that_is_no_websocket_is_answered_by_the_gate(bridge):
             sock.sendall(request)
             assert sock.recv(100).startswith(b'HTTP/1.1 400 ')
     assert bridge.gate.refused == 0  # not a page's WebSocket: nothing to warn of
+
+
+@pytest.mark.parametrize('offered', [['foxglove.websocket.v1'], None])
+def test_a_client_of_another_subprotocol_is_told_which_one_is_served(bridge, offered, capfd):
+    """The SDK's server answered 400 'Missing expected sec-websocket-protocol header' and
+    logged 'Dropping client ...: handshake failed', naming neither."""
+    from websockets.exceptions import InvalidStatus
+
+    with pytest.raises(InvalidStatus, match='400') as refused:
+        connect(f'ws://127.0.0.1:{bridge.port}', subprotocols=offered, close_timeout=0.5,
+                open_timeout=5)
+    body = bytes(refused.value.response.body).decode()
+    err = capfd.readouterr().err
+    for said in (body, err):
+        assert "serves 'foxglove.sdk.v1' only" in said
+        assert ("'foxglove.websocket.v1'" if offered else 'offered no subprotocol') in said
+    assert 'handshake failed' not in err

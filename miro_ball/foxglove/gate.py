@@ -8,6 +8,9 @@ request, refuses one whose Origin is not allowed (403 and one log line), and pip
 through untouched. No Origin at all is a program, not a page (a browser always sends one):
 let in. Allowed by default: the Foxglove app (https://app.foxglove.dev) and pages served by
 this machine (localhost, 127.0.0.1, [::1]); ``--allow-origin`` adds more (fnmatch patterns).
+A client that does not offer the one WebSocket subprotocol the SDK's server speaks is told
+which that is (the server answered 400 'Missing expected sec-websocket-protocol header' and
+logged only 'handshake failed').
 """
 import asyncio
 import fnmatch
@@ -25,6 +28,26 @@ FORBIDDEN = b'HTTP/1.1 403 Forbidden\r\nContent-Length: 0\r\nConnection: close\r
 # Not a WebSocket request (a page's <img> or no-cors fetch sends no Origin): answered here,
 # never passed on (the SDK's server logged a line for each, unthrottled).
 BAD_REQUEST = b'HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\nConnection: close\r\n\r\n'
+SUBPROTOCOL = 'foxglove.sdk.v1'  # the only one the SDK's server (0.30) accepts
+
+
+def subprotocol_refusal(offered):
+    """Why a WebSocket request offering these subprotocols (the Sec-WebSocket-Protocol
+    header; None: none) cannot be served, in one line; None if it can."""
+    names = [name.strip() for name in (offered or '').split(',') if name.strip()]
+    if SUBPROTOCOL in names:
+        return None
+    asked = ('asked for subprotocol ' + ', '.join(repr(n[:60]) for n in names[:4]) if names
+             else 'offered no subprotocol')
+    return (f'a Foxglove client {asked}; this bridge serves {SUBPROTOCOL!r} only (the Foxglove '
+            'SDK\'s protocol): use a client that offers it, such as the Foxglove app')
+
+
+def bad_request(text):
+    """An HTTP 400 answer whose body says why."""
+    body = text.encode() + b'\n'
+    return (b'HTTP/1.1 400 Bad Request\r\nContent-Type: text/plain; charset=utf-8\r\n'
+            b'Content-Length: %d\r\nConnection: close\r\n\r\n' % len(body)) + body
 
 
 def origin_allowed(origin, patterns=()):
@@ -111,6 +134,12 @@ class OriginGate:
                           'the Foxglove app and pages of this machine may connect '
                           '(--allow-origin adds one)')
                 writer.write(FORBIDDEN)
+                await writer.drain()
+                return
+            refusal = subprotocol_refusal(header(head, 'sec-websocket-protocol'))
+            if refusal:
+                self.warn('subprotocol', refusal)
+                writer.write(bad_request(refusal))
                 await writer.drain()
                 return
             up_reader, up_writer = await asyncio.open_connection(*self.upstream)
