@@ -100,6 +100,39 @@ def test_client_tf_says_where_the_ball_is_in_the_head_frame(paused_sim, executor
     assert x > 0.5 and y > 0.1  # ahead and to the left
 
 
+def test_client_tf_waits_for_the_frames_before_it_says_one_is_missing(ros_context):
+    """The ball comes before /tf_static: 'no frame' was said before the frames had a chance."""
+    from geometry_msgs.msg import PointStamped, TransformStamped
+    from miro_ball.miro.interface import TF, TF_STATIC
+
+    client = client_tf.WhereIsTheBall(client_tf.build_parser().parse_args([]),
+                                      context=ros_context)
+    said = []
+    client.warn = lambda key, text: said.append(text)
+
+    def ball_at(seconds):
+        msg = PointStamped()
+        msg.header.frame_id, msg.header.stamp.sec = 'world', seconds
+        client.on_ball(msg)
+
+    class Transforms:  # a TFMessage of one frame that is not the head
+        transforms = [TransformStamped(child_frame_id='elsewhere')]
+        transforms[0].header.frame_id = 'world'
+        transforms[0].transform.rotation.w = 1.0
+    try:
+        client.on_tf(Transforms, TF)
+        ball_at(10)
+        ball_at(11)
+        assert said == []  # /tf_static may be on its way
+        ball_at(12)
+        assert len(said) == 1 and f'nothing on {TF_STATIC} after 2 s' in said[0]
+        client.on_tf(Transforms, TF_STATIC)
+        ball_at(13)
+        assert len(said) == 2 and 'no frame' in said[1] and 'nothing on' not in said[1]
+    finally:
+        client.destroy_node()
+
+
 def test_read_battery_prints_the_voltage_from_the_package_each_interval(paused_sim, executor,
                                                                          ros_context, capsys):
     code = run_client(client_read_battery, ['--count', '3', '--every', '0.5'], paused_sim,
