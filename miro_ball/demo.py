@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 from miro_ball.common.isolation import isolated_env, private_domain
+from miro_ball.common.lifecycle import end_process
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
 from miro_ball.recording.node import NODE_NAME as RECORDER
@@ -222,7 +223,10 @@ def main(argv=None):
         janitor.clean()
     print(summary(outcome, monitor, rtf, video, killed, args.record))
     # A node that had to be killed did not stop as it should: that is a failure too.
-    sys.exit(0 if monitor.judge.kicked and not killed else 1)
+    code = 0 if monitor.judge.kicked and not killed else 1
+    if stop.signum:  # Ctrl+C: all is stopped and said; the interpreter's teardown only costs
+        end_process(code)
+    sys.exit(code)
 
 
 if __name__ == '__main__':

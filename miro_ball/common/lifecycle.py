@@ -130,7 +130,7 @@ def run_node(prog, make_node, argv=None, *, make_executor=None, on_stop=None,
             proc_tree.send(left, signal.SIGKILL)
             proc_tree.wait_gone(left, KILL_WAIT_S)
     if stop.signum:  # a signal, not the program's own request
-        _end_process(code)
+        end_process(code)
     return code
 
 
@@ -146,9 +146,10 @@ def _serve_beside_the_spin(serve, node, executor, stop):
         spinner.join(timeout=SPIN_JOIN_S)
 
 
-def _end_process(code):
-    """End the process now, all of it closed already: what it printed is flushed (Python's
-    and C's buffers), the interpreter's teardown is skipped."""
+def end_process(code):
+    """End the process now with exit code ``code``, all of it closed already: what it
+    printed is flushed (Python's and C's buffers), the interpreter's teardown is skipped.
+    For a program stopped by a signal (run_node, the main job)."""
     logging.shutdown()
     for stream in (sys.stdout, sys.stderr):
         try:

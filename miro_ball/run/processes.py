@@ -2,12 +2,13 @@
 as a user stops them (Ctrl+C), killed if they do not, and nothing of theirs left behind.
 
 Each child leads a process group (and session) of its own, so a Ctrl+C in the
-terminal reaches only the program that started them, which stops them one by one in
-the order they were started (a controller before the simulator whose /clock it waits
-on). Stopping one is what a terminal does to a foreground job: SIGINT to its whole
-group (a shell script passes nothing on to the program it waits for); after the
-grace period SIGKILL to the group; and once the grace is over, SIGKILL to whatever
-of the group is still there (the simulator's eye workers, a student's helpers).
+terminal reaches only the program that started them, which stops them all at once:
+side by side, the slowest sets the time, not their sum (every node stops within a
+second of its Ctrl+C, with or without the simulator's /clock). Stopping one is what a
+terminal does to a foreground job: SIGINT to its whole group (a shell script passes
+nothing on to the program it waits for); after the grace period SIGKILL to the group;
+and once the grace is over, SIGKILL to whatever of the group is still there (the
+simulator's eye workers, a student's helpers).
 """
 import os
 import signal
@@ -67,11 +68,16 @@ class Processes:
                 if child.proc.poll() is None}
 
     def stop(self, grace_s=10.0):
-        """Stop every child in the order started; returns the names of those that had to be
+        """Stop every child, all told at once; returns the names of those that had to be
         killed (they ignored Ctrl+C for grace_s)."""
+        for child in self.children:
+            if child.proc.poll() is None:
+                _signal_group(child.proc.pid, signal.SIGINT)
+        deadline = time.monotonic() + grace_s
         killed = []
         for child in self.children:
-            if not stop_group(child.proc, grace_s):
+            if not stop_group(child.proc, max(0.0, deadline - time.monotonic()),
+                              interrupted=True):
                 killed.append(child.name)
             child.log.close()
         self.children = []
@@ -84,15 +90,17 @@ class Processes:
         self.stop()
 
 
-def stop_group(proc, grace_s):
-    """Ctrl+C to proc's process group; SIGKILL to the group once grace_s have passed or, if
+def stop_group(proc, grace_s, interrupted=False):
+    """Ctrl+C to proc's process group (unless already ``interrupted``: a second one could cut
+    a student's clean-up short); SIGKILL to the group once grace_s have passed or, if
     proc stopped in time, once the rest of the group has stopped too or the grace is over
     (a shell dies at Ctrl+C at once, while the program it ran still cleans up). False if
     proc itself had to be killed."""
     deadline = time.monotonic() + grace_s
     stopped = True
     if proc.poll() is None:
-        _signal_group(proc.pid, signal.SIGINT)
+        if not interrupted:
+            _signal_group(proc.pid, signal.SIGINT)
         try:
             proc.wait(timeout=grace_s)
         except subprocess.TimeoutExpired:
