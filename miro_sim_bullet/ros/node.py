@@ -21,19 +21,17 @@ import sys
 import time
 
 import cv2
-import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock as ClockMsg
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_watch import ClockWatch
+from miro_ball.common.lifecycle import run_node
 from miro_ball.common.params import declare, help_lines, LiveParams
 from miro_ball.common.qos import profile
-from miro_ball.common.stopping import spin_until_stopped, StopRequest
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import CLOCK, CLOCK_QOS, PLATFORM, robot_name, SIM_NODE_NAME, \
@@ -382,21 +380,9 @@ def main(argv=None):
     # other core, which the eye worker and the controllers need.
     cv2.setNumThreads(1)
     overrides = [] if args.world is None else [Parameter('world', value=args.world)]
-    # Ctrl+C and SIGTERM end the spin with the context still up (see stopping.py).
-    stop = StopRequest()
-    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    try:
-        node = SimNode(parameter_overrides=overrides, robot=args.robot, guard_domain=True)
-    except (WorldError, RendererUnavailable, ValueError, SharedDomain) as err:
-        # A bad start (world, renderer, parameter, another simulator): one line. Errors
-        # once running are not the user's: spin_until_stopped logs their tracebacks.
-        rclpy.try_shutdown()
-        print(f'{SIM_NODE_NAME}: error: {err}', file=sys.stderr)
-        sys.exit(2)
-    try:
-        executor = make_executor()
-        executor.add_node(node)
-        spin_until_stopped(executor, stop)
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    # A bad start (world, renderer, parameter, another simulator) is said in one line.
+    # Errors once running are not the user's: spin_until_stopped logs their tracebacks.
+    return run_node(SIM_NODE_NAME, lambda: SimNode(parameter_overrides=overrides,
+                                                    robot=args.robot, guard_domain=True),
+                    argv, make_executor=make_executor,
+                    bad_start=(WorldError, RendererUnavailable, SharedDomain))
