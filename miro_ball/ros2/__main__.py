@@ -17,6 +17,8 @@ import math
 import os
 import sys
 
+from rclpy.executors import ExternalShutdownException
+
 from miro_ball.ros2 import verbs
 from miro_ball.ros2.convert import TRUNCATE
 from miro_ball.ros2.graph import CliError, Graph
@@ -122,10 +124,8 @@ def main(argv=None):
     except BrokenPipeError:  # `| head` has read what it wanted
         sys.stdout = open(os.devnull, 'w')
         return 0
-    except Exception as err:  # rclpy's ExternalShutdownException on Ctrl+C has no public base
-        if type(err).__name__ == 'ExternalShutdownException':
-            return 0
-        raise
+    except ExternalShutdownException:  # Ctrl+C while it waits in rclpy
+        return 0
     finally:
         if graph is not None:
             graph.close()
