@@ -80,12 +80,6 @@ def build_parser(hosted=KICK_BLUE_BALL):
     return parser
 
 
-def _fail(parser, err):
-    """Exit 2 with the first line of an error: no traceback for bad user input."""
-    first_line = (str(err).strip().splitlines() or [type(err).__name__])[0]
-    parser.exit(2, '%s: error: %s\n' % (parser.prog, first_line))
-
-
 def host_main(hosted, argv=None):
     """The command line of a hosted kind: parse, then run its host until Ctrl+C."""
     argv = list(sys.argv if argv is None else argv)
