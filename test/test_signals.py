@@ -295,3 +295,62 @@ def test_every_program_ends_within_a_second_of_one_ctrl_c_taking_its_children(
     assert not failed, (failed, {name: results[name][2][-2000:] for name in failed})
     print('seconds from one Ctrl+C to exit:', times)  # (pytest -s)
     assert max(times.values()) <= STOP_WITHIN_S, times
+
+
+@pytest.fixture
+def own_signal_handlers():
+    """run_node in the test's process takes SIGINT and SIGTERM: give them back after."""
+    saved = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    yield
+    for signum, handler in saved.items():
+        signal.signal(signum, handler)
+
+
+def test_run_node_ends_in_order_with_the_code_of_a_client_that_is_done(own_signal_handlers):
+    """The node's last act while the context is up, then the executor shut down (before the
+    node is destroyed: else an InvalidHandle traceback at exit), the node, rclpy."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+
+    from miro_ball.common.lifecycle import run_node
+
+    seen = []
+
+    class Done(Node):
+        def __init__(self):
+            super().__init__('lifecycle_probe')
+            self.create_timer(0.01, self.finish)
+
+        def finish(self):
+            raise SystemExit(3)
+
+        def destroy_node(self):
+            seen.append('node destroyed')
+            super().destroy_node()
+
+    class Executor(SingleThreadedExecutor):
+        def shutdown(self, timeout_sec=None):
+            seen.append('executor shut down')
+            return super().shutdown(timeout_sec)
+
+    code = run_node('probe', Done, ['probe'], make_executor=Executor,
+                    on_stop=lambda node: seen.append(f'last act, context up: {node.context.ok()}'))
+    assert code == 3
+    assert seen == ['last act, context up: True', 'executor shut down', 'node destroyed']
+    assert not rclpy.ok()
+
+
+def test_run_node_says_a_bad_start_in_one_line(own_signal_handlers, capsys):
+    import rclpy
+
+    from miro_ball.common.lifecycle import run_node
+
+    def bad():
+        raise ValueError("no world 'nowhere'\n(the rest of a long story)")
+
+    with pytest.raises(SystemExit) as done:
+        run_node('probe', bad, ['probe'])
+    assert done.value.code == 2
+    assert capsys.readouterr().err == "probe: error: no world 'nowhere'\n"
+    assert not rclpy.ok()

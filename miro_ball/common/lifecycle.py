@@ -86,6 +86,8 @@ def run_node(prog, make_node, argv=None, *, make_executor=None, on_stop=None,
     from miro_ball.common.stopping import spin_until_stopped, StopRequest
 
     argv = list(sys.argv if argv is None else argv)
+    # The processes this one ran before (a test that calls main()) are not the node's.
+    before = set(proc_tree.descendants(os.getpid()))
     # Before rclpy.init: a signal from now on is noted, never a KeyboardInterrupt; and
     # the last message's acknowledgement comes in tens of milliseconds, not seconds.
     stop = StopRequest()
@@ -116,7 +118,7 @@ def run_node(prog, make_node, argv=None, *, make_executor=None, on_stop=None,
         # Told first, the children stop while this node cleans up, not after it: those a
         # Ctrl+C in the terminal reaches too (the simulator's eye workers, in a session of
         # their own, are stopped by its destroy_node). Whatever is left at the end is killed.
-        children = proc_tree.descendants(os.getpid())
+        children = [pid for pid in proc_tree.descendants(os.getpid()) if pid not in before]
         proc_tree.send(proc_tree.in_my_group(children), signal.SIGINT)
         children_by = time.monotonic() + CHILD_GRACE_S
         try:
