@@ -5,18 +5,21 @@ Like the MDK's client_show. Each line starts with the simulated time.
     python -m miro_ball.examples.client_show cliff            # until Ctrl+C
     python -m miro_ball.examples.client_show odom --count 10  # ten lines, then exit
 """
+import collections
 import math
 import sys
 
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import BatteryState, Imu, JointState, Range
 from std_msgs.msg import Float32MultiArray, UInt16, UInt32
 
 from miro_ball.common.messages import message_class
+from miro_ball.common.qos import profile
 from miro_ball.common.stamps import seconds
 from miro_ball.examples._client import Client, heading, make_parser, run
-from miro_ball.miro.interface import TOPIC
+from miro_ball.miro.interface import CLOCK, CLOCK_QOS, SENSOR_QOS, TOPIC
 
 
 def pair(values, unit=''):
@@ -73,19 +76,60 @@ SIGNALS = {
 }
 
 
+class TickTimes:
+    """The simulated time of an unstamped message of the simulator: each platform tick it
+    sends /clock, then the sensor topics, so a message's time is that of the last /clock
+    sent before it, by the sender's own clock (the DDS source timestamps, wall ns).
+
+    The time it is read at will not do: rclpy's clock keeps only the newest /clock, so
+    messages read in one burst (those queued at the start, or on a busy machine) all
+    showed one time."""
+
+    KEEP = 500  # /clock messages remembered: 10 s of 50 Hz ticks
+
+    def __init__(self):
+        self.clocks = collections.deque(maxlen=self.KEEP)  # (source ns, simulated s)
+
+    def clock(self, source_ns, simulated_s):
+        self.clocks.append((source_ns, simulated_s))
+
+    def when(self, source_ns):
+        """Simulated seconds of a message sent at source_ns; None if it was sent before
+        every /clock remembered."""
+        for sent, simulated_s in reversed(self.clocks):
+            if sent <= source_ns:
+                return simulated_s
+        return None
+
+
 class Show(Client):
     def __init__(self, options, context=None):
         super().__init__('client_show', options, context)
         msg_type, topic, self.line = SIGNALS[options.signal]
         if isinstance(msg_type, str):
             msg_type = message_class(msg_type)
-        self.subscribe(msg_type, topic(self.topics), self.on_message)
         self.shown = 0
+        if 'header' in msg_type.get_fields_and_field_types():  # it says when it was measured
+            self.subscribe(msg_type, topic(self.topics),
+                           lambda msg: self.show(msg, seconds(msg.header.stamp)))
+            return
+        self.ticks = TickTimes()
+        self.create_subscription(Clock, CLOCK, self.on_clock, profile(CLOCK_QOS))
+        self.create_subscription(msg_type, topic(self.topics), self.on_unstamped,
+                                 profile(SENSOR_QOS))
 
-    def on_message(self, msg):
-        # A stamped message says when it was measured; messages that came in one burst
-        # (a slow terminal, a busy machine) would all show the time they were read.
-        when = seconds(msg.header.stamp) if hasattr(msg, 'header') else self.now()
+    def on_clock(self, msg, info):
+        self.ticks.clock(info['source_timestamp'], seconds(msg.clock))
+
+    def on_unstamped(self, msg, info):
+        if not self.ticks.clocks:  # no simulator's /clock (yet): the clock's time
+            self.show(msg, self.now())
+            return
+        when = self.ticks.when(info['source_timestamp'])
+        if when is not None:  # else sent before the first /clock heard: when is not known
+            self.show(msg, when)
+
+    def show(self, msg, when):
         self.say(f'{when:8.2f}  {self.options.signal}  {self.line(msg)}')
         self.shown += 1
         if self.shown == self.options.count:
