@@ -31,7 +31,7 @@ TIERS = {
              'test_gui_bridge', 'test_multi_robot', 'test_sim_executor', 'test_sim_node',
              'test_client_map', 'test_robot_object', 'test_scene', 'test_grade_host',
              'test_callback_faults', 'test_sensors_package', 'test_ros2_cli', 'test_foxglove',
-             'test_tf', 'test_audio_clients', 'test_animal')),
+             'test_tf', 'test_audio_clients', 'test_animal', 'test_readers')),
     'e2e': ('whole runs as processes: demo, grader, recorder, tutorial, soak, packaging',
             ('test_closed_loop', 'test_demo', 'test_grade',
              'test_record', 'test_restart', 'test_scenario_bench',

@@ -104,3 +104,51 @@ def test_demo_modes_parts_need_neither_ros_nor_pybullet():
     assert 'miro_ball.animal.animal' in parts
     loaded = loaded_by(', '.join(parts))
     assert not {m.split('.')[0] for m in loaded} & {'rclpy', 'pybullet'}
+
+
+def _private_methods(cls_node):
+    return {item.name for item in cls_node.body
+            if isinstance(item, (ast.FunctionDef, ast.AsyncFunctionDef))
+            and item.name.startswith('_') and not item.name.endswith('__')}
+
+
+def test_no_class_overrides_another_modules_private_methods():
+    """A private method is its module's own business: a class in another module that
+    replaces one (as demo mode's node once replaced the controller node's _declare,
+    _apply, _on_tick, ...) couples two modules through what neither promised. Our own base
+    classes only; a public hook, or a part handed in, is the way."""
+    modules = our_modules()
+    classes = {}  # (module, class name): (the class's AST, [(base module, base name)])
+    for name, path in modules.items():
+        tree = ast.parse(path.read_text(), str(path))
+        imported = {}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.module in modules:
+                for alias in node.names:  # a class, or a module (from package import mod)
+                    module = f'{node.module}.{alias.name}'
+                    imported[alias.asname or alias.name] = \
+                        (module, None) if module in modules else (node.module, alias.name)
+            elif isinstance(node, ast.Import):
+                imported.update({alias.asname or alias.name: (alias.name, None)
+                                 for alias in node.names if alias.name in modules})
+        for node in tree.body:
+            if not isinstance(node, ast.ClassDef):
+                continue
+            bases = []
+            for base in node.bases:
+                if isinstance(base, ast.Name):
+                    bases.append(imported.get(base.id, (name, base.id)))
+                elif isinstance(base, ast.Attribute) and isinstance(base.value, ast.Name) \
+                        and base.value.id in imported:
+                    bases.append((imported[base.value.id][0], base.attr))
+            classes[(name, node.name)] = (node, bases)
+    assert len(classes) > 100  # the scan found our classes
+    overrides = []
+    for (module, cls), (node, bases) in classes.items():
+        for base in bases:
+            if base[0] == module or base not in classes:
+                continue
+            shared = _private_methods(node) & _private_methods(classes[base][0])
+            overrides += [f'{module}.{cls}.{method} replaces {base[0]}.{base[1]}.{method}'
+                          for method in sorted(shared)]
+    assert not overrides, '\n'.join(overrides)

@@ -18,7 +18,6 @@ from std_msgs.msg import Int16MultiArray
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 
-from miro_ball.common.checks import finite_values
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.lifecycle import run_node
@@ -28,11 +27,10 @@ from miro_ball.common.robots import missing_robot
 from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.constants import JOINT_POSITIONS
-from miro_ball.miro.hearing import mic_window
 from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
                                       MIC_QOS, robot_name, robot_namespace, robot_of_namespace,
                                       RobotTopics, SENSOR_QOS)
+from miro_ball.miro.readers import read, Refused, topic_of
 from miro_ball.miro.rotations import yaw_of
 
 SILENCE_NOTICE_S = 5.0  # wall seconds without the robot before a client says so
@@ -155,12 +153,9 @@ class Client(Node):
         """The microphones: on_block(samples) for every block of sensors/mics, (4, 500)
         of full scale; a block of another length is dropped with a warning."""
         def heard(msg):
-            try:
-                block = mic_window(msg.data)
-            except ValueError as err:
-                self.warn('mics', f'{self.topics.mics} ignored: {err}')
-                return
-            on_block(block)
+            block = self.reading('mics', msg)
+            if block is not None:
+                on_block(block)
         self.subscribe(Int16MultiArray, self.topics.mics, heard, MIC_QOS)
 
     def _on_camera_info(self, eye, msg):
@@ -169,13 +164,14 @@ class Client(Node):
         except ValueError as err:
             self.warn(f'{eye}_info', f'{eye}: camera_info ignored: {err}')
 
-    def checked_joints(self, msg):
-        """sensors/kinematic_joints' (tilt, lift, yaw, pitch), or None (with a warning)
-        when the message does not hold four finite positions."""
+    def reading(self, key, msg, **fields):
+        """A sensor message's value as miro.readers reads it (the stream ``key`` of the
+        interface, e.g. 'kinematic_joints': (tilt, lift, yaw, pitch)), or None with a
+        warning when it is refused."""
         try:
-            return finite_values(msg.position, 4, JOINT_POSITIONS)
-        except ValueError as err:
-            self.warn('joints', f'{self.topics.kinematic_joints} ignored: {err}')
+            return read(key, msg)
+        except Refused as err:
+            self.warn(key, f'{topic_of(key, self.topics, **fields)} ignored: {err}')
             return None
 
     def advertise(self, msg_type, topic, qos=CONTROL_QOS):

@@ -41,7 +41,7 @@ class DriveVoice(Client):
         self.watch_mics(self.on_block)
 
     def on_joints(self, msg):
-        self.joints = self.checked_joints(msg) or self.joints
+        self.joints = self.reading('kinematic_joints', msg) or self.joints
 
     def on_block(self, block):
         now = self.now()

@@ -43,7 +43,7 @@ class Hear(Client):
         self.watch_mics(self.on_block)
 
     def on_joints(self, msg):
-        self.joints = self.checked_joints(msg) or self.joints
+        self.joints = self.reading('kinematic_joints', msg) or self.joints
 
     def on_block(self, block):
         self.blocks.append(block)

@@ -48,7 +48,7 @@ class Look(Client):
             self.warn(eye, f'{eye}: frame ignored: {err}')
 
     def on_joints(self, msg):
-        joints = self.checked_joints(msg)
+        joints = self.reading('kinematic_joints', msg)
         if joints is None:
             return
         self.joints = joints

@@ -142,7 +142,7 @@ class Mapper(Client):
         self.paint_ready()
 
     def on_joints(self, msg):
-        joints = self.checked_joints(msg)
+        joints = self.reading('kinematic_joints', msg)
         if joints is None:
             return
         self.joints.add(seconds(msg.header.stamp), joints)

@@ -10,10 +10,9 @@ from dataclasses import dataclass, field
 from functools import partial
 
 from geometry_msgs.msg import TwistStamped
-from nav_msgs.msg import Odometry
 from rclpy.node import Node
-from sensor_msgs.msg import BatteryState, CameraInfo, Imu, JointState, Range
-from std_msgs.msg import Float32MultiArray, Int16MultiArray, UInt16, UInt16MultiArray, UInt32, \
+from sensor_msgs.msg import CameraInfo, JointState
+from std_msgs.msg import Float32MultiArray, Int16MultiArray, UInt16MultiArray, UInt32, \
     UInt32MultiArray
 
 from miro_ball.common.messages import drive_command, message_class
@@ -26,10 +25,9 @@ from miro_ball.gui import readouts as r
 from miro_ball.gui.hearing import MicMeter, speaker_message
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_NAMES
-from miro_ball.miro.hearing import mic_window
 from miro_ball.miro.interface import CONTROL_QOS, CORE_TOPIC, EYE_QOS, EYES, MIC_QOS, \
     RobotTopics, SENSOR_QOS, TOPIC
-from miro_ball.miro.rotations import yaw_of
+from miro_ball.miro.readers import read, Refused, topic_of
 
 NODE_NAME = 'miro_gui'
 DEADMAN_S = 0.3  # a drive command not refreshed for this long becomes a stop
@@ -52,47 +50,28 @@ class Outbox:
     touch: dict = field(default_factory=dict)  # part: pads touched since the last tick
 
 
-def _xyz(imu):
-    a = imu.linear_acceleration
-    return (a.x, a.y, a.z)
-
-
-def _odometry(msg):
-    pose, twist = msg.pose.pose, msg.twist.twist
-    o = pose.orientation
-    return {'odom': [twist.linear.x, twist.angular.z],
-            'pose': [pose.position.x, pose.position.y, yaw_of(o.x, o.y, o.z, o.w)]}
-
-
-def _head(msg):
-    return {'head': r.head_degrees(msg.position)} if len(msg.position) >= 4 else None
-
-
-# The readouts: (type, RobotTopics attribute or (method, argument), message -> readouts).
+# The readouts: (reader of miro.readers, fields of its topic name, value -> readouts).
 READOUTS = (
-    (BatteryState, 'battery', lambda m: {'battery': m.voltage}),
-    (Range, 'sonar', lambda m: {'sonar': m.range, 'sonar_text': r.sonar_text(m.range)}),
-    (Float32MultiArray, 'light', lambda m: {'light': r.light(m.data)}),
-    (UInt16, ('touch', 'head'), lambda m: {'touch_head': m.data}),
-    (UInt16, ('touch', 'body'), lambda m: {'touch_body': m.data}),
-    (Imu, ('imu', 'body'), lambda m: {'accel_body': r.accel(_xyz(m))}),
-    (Imu, ('imu', 'head'), lambda m: {'accel_head': r.accel(_xyz(m))}),
-    (Float32MultiArray, 'cliff', lambda m: {'cliff': r.cliff(m.data)}),
-    (Float32MultiArray, 'wheel_speed_opto', lambda m: {'wheel_opto': r.wheels_mm_s(m.data)}),
-    (Float32MultiArray, 'wheel_speed_cmd', lambda m: {'wheel_cmd': r.wheels_mm_s(m.data)}),
-    (Odometry, 'odom', _odometry),
-    (JointState, 'kinematic_joints', _head),
-    (UInt32, 'sensor_flags', lambda m: {'flags': m.data}),
+    ('battery', {}, lambda v: {'battery': v}),
+    ('sonar', {}, lambda v: {'sonar': v, 'sonar_text': r.sonar_text(v)}),
+    ('light', {}, lambda v: {'light': r.light(v)}),
+    ('touch', {'part': 'head'}, lambda v: {'touch_head': v}),
+    ('touch', {'part': 'body'}, lambda v: {'touch_body': v}),
+    ('imu', {'part': 'body'}, lambda v: {'accel_body': r.accel(v)}),
+    ('imu', {'part': 'head'}, lambda v: {'accel_head': r.accel(v)}),
+    ('cliff', {}, lambda v: {'cliff': r.cliff(v)}),
+    ('wheel_speed_opto', {}, lambda v: {'wheel_opto': r.wheels_mm_s(v)}),
+    ('wheel_speed_cmd', {}, lambda v: {'wheel_cmd': r.wheels_mm_s(v)}),
+    ('odom', {}, lambda v: {'odom': [v.forward, v.turn], 'pose': list(v.pose)}),
+    ('kinematic_joints', {}, lambda v: {'head': r.head_degrees(v)}),
+    ('sensor_flags', {}, lambda v: {'flags': v}),
 )
 
 
-def _from_package(msg):
-    """Every readout from a sensors/package: each READOUTS row reads the field named as its
-    topic (sensors/battery -> battery)."""
-    values = {}
-    for _, where, handler in READOUTS:
-        values.update(handler(getattr(msg, _topic(RobotTopics(), where).split('/', 1)[1])) or {})
-    return values
+def _package_field(key, fields):
+    """The field of a sensors/package that holds a readout's message: its topic's name
+    (sensors/battery -> battery, sensors/imu_body -> imu_body)."""
+    return topic_of(key, **fields).split('/', 1)[1]
 
 
 # The page's commands that become one message on one of MiRo's control topics:
@@ -106,13 +85,6 @@ PUBLISHED = {
     p.Tone: (UInt16MultiArray, 'tone', lambda c: UInt16MultiArray(data=list(c.values))),
     p.Flags: (UInt32, 'control_flags', lambda c: UInt32(data=c.data)),
 }
-
-
-def _topic(topics, where):
-    if isinstance(where, tuple):
-        method, argument = where
-        return getattr(topics, method)(argument)
-    return getattr(topics, where)
 
 
 class RobotPart(Node):
@@ -151,12 +123,14 @@ class RobotPart(Node):
         try:  # sensors/package holds every readout of a tick: one subscription, as the MDK's
             package = message_class(TOPIC['package'].type)  # GUI does
             self._sensor_subs = [self.create_subscription(
-                package, self.topics.package, self._wrap(_from_package), profile(SENSOR_QOS))]
+                package, self.topics.package, self._on_package, profile(SENSOR_QOS))]
         except ValueError:  # miro2_msg is not built: the separate topics
             self._sensor_subs = [
-                self.create_subscription(msg_type, _topic(self.topics, where),
-                                         self._wrap(handler), profile(SENSOR_QOS))
-                for msg_type, where, handler in READOUTS]
+                self.create_subscription(message_class(TOPIC[key].type),
+                                         topic_of(key, **fields),
+                                         partial(self._take_readouts, [row]),
+                                         profile(TOPIC[key].qos))
+                for row in READOUTS for key, fields, _ in [row]]
         # A tone or a stream anyone asks MiRo for (this GUI's pages too) is heard in the
         # pages.
         self._sensor_subs += [
@@ -273,8 +247,8 @@ class RobotPart(Node):
 
     def _on_mics(self, msg):
         try:
-            block = mic_window(msg.data)
-        except ValueError as err:
+            block = read('mics', msg)
+        except Refused as err:
             self.warn(f'mics:{self.robot}', f'{self.robot}: microphones ignored: {err}')
             return
         for text in self.meter.add(block):
@@ -284,17 +258,23 @@ class RobotPart(Node):
         """The microphone the pages show the spectrum of, and whether they hear it."""
         self.meter.mic, self.meter.listen = mic, listen
 
-    def _wrap(self, handler):
-        def on_message(msg):
+    def _on_package(self, msg):
+        self._take_readouts(READOUTS, msg)
+
+    def _take_readouts(self, rows, msg):
+        """The readouts of a message (a sensors/package holds every row's): each read by
+        its reader; one that is refused is said and skipped, the others are kept."""
+        took = False
+        for key, fields, readout in rows:
+            part = msg if len(rows) == 1 else getattr(msg, _package_field(key, fields), None)
             try:
-                values = handler(msg)
-            except (TypeError, ValueError, IndexError) as err:  # garbage from the graph
-                self.warn('sensor', f'a malformed sensor message ignored: {err}')
-                return
-            if values:
-                self.values.update(values)
-                self.last_heard = time.monotonic()
-        return on_message
+                self.values.update(readout(read(key, part)))
+            except (Refused, AttributeError) as err:  # garbage from the graph
+                self.warn('sensor', f'{self.robot}: {topic_of(key, **fields)} ignored: {err}')
+                continue
+            took = True
+        if took:
+            self.last_heard = time.monotonic()
 
     # -- what it sends ------------------------------------------------------------------------
     def publish(self, command):

@@ -1,43 +1,32 @@
 """What a Robot hears: the latest of each sensor, checked, and the eyes' latest frames.
 
-Each topic's message is turned into plain Python values as it arrives; a message that
+Each topic's message is turned into plain Python values as it arrives (miro.readers); a message that
 does not make sense (wrong length, NaN, a JPEG that does not decode) is dropped with a
 rate-limited warning and the last good value stays.
 """
-import math
 from dataclasses import dataclass
-from typing import NamedTuple, Optional, Tuple
+from typing import Optional, Tuple
 
 import cv2
-from geometry_msgs.msg import Pose2D
-from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, JointState, Range
-from std_msgs.msg import Float32MultiArray, UInt16
+from sensor_msgs.msg import CameraInfo, CompressedImage
 
-from miro_ball.common.checks import finite_values
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
+from miro_ball.common.messages import message_class
 from miro_ball.miro.camera_model import CameraModel
-from miro_ball.miro.constants import JOINT_POSITIONS
-from miro_ball.miro.interface import EYE_QOS, EYES, RobotTopics, SENSOR_QOS
+from miro_ball.miro.interface import EYE_QOS, EYES, RobotTopics, TOPIC
+from miro_ball.miro.readers import Pose, read, Refused, topic_of
 
-
-class Pose(NamedTuple):
-    """Where the robot is on odometry: x, y (m) and heading theta (rad, CCW from x)."""
-
-    x: float
-    y: float
-    theta: float
-
-    def __str__(self):
-        return f'Pose(x={self.x:.3f}, y={self.y:.3f}, theta={self.theta:.3f})'
+__all__ = ['Eyes', 'Pose', 'READINGS', 'Readings', 'Sensors']
 
 
 @dataclass(frozen=True)
 class Sensors:
-    """The latest of MiRo's body sensors (None until the first message).
+    """The latest of MiRo's body sensors (None until the first message), as miro.readers
+    reads them.
 
     cliff: (left, right), 1 over the floor, below 0.7 a drop. sonar: metres to what is ahead
-    (inf: no echo). light: four light sensors, 0..1. touch_head, touch_body: a bit per touch
-    sensor. battery: volts.
+    (inf: nothing in range). light: four light sensors, 0..1. touch_head, touch_body: a bit
+    per touch sensor. battery: volts.
     """
 
     cliff: Optional[Tuple[float, float]] = None
@@ -48,27 +37,16 @@ class Sensors:
     battery: Optional[float] = None
 
 
-def _sonar(msg):
-    distance = float(msg.range)
-    if math.isnan(distance) or distance < 0:
-        raise ValueError(f'range must be a distance (inf: no echo), got {distance}')
-    return distance
-
-
-# What the robot reads: name -> (message type, topic, QoS, message -> value or ValueError)
-_T = RobotTopics()  # relative names: the node lives in the robot's namespace
+# What the robot reads: name -> (the reader and interface row, fields of its topic name).
 READINGS = {
-    'pose': (Pose2D, _T.body_pose, SENSOR_QOS,
-             lambda m: Pose(*finite_values((m.x, m.y, m.theta), 3, 'x, y, theta'))),
-    'joints': (JointState, _T.kinematic_joints, SENSOR_QOS,
-               lambda m: finite_values(m.position, 4, JOINT_POSITIONS)),
-    'cliff': (Float32MultiArray, _T.cliff, SENSOR_QOS, lambda m: finite_values(m.data, 2, 'values')),
-    'sonar': (Range, _T.sonar, SENSOR_QOS, _sonar),
-    'light': (Float32MultiArray, _T.light, SENSOR_QOS, lambda m: finite_values(m.data, 4, 'values')),
-    'touch_head': (UInt16, _T.touch('head'), SENSOR_QOS, lambda m: int(m.data)),
-    'touch_body': (UInt16, _T.touch('body'), SENSOR_QOS, lambda m: int(m.data)),
-    'battery': (BatteryState, _T.battery, SENSOR_QOS,
-                lambda m: finite_values((m.voltage,), 1, 'voltage')[0]),
+    'pose': ('body_pose', {}),
+    'joints': ('kinematic_joints', {}),
+    'cliff': ('cliff', {}),
+    'sonar': ('sonar', {}),
+    'light': ('light', {}),
+    'touch_head': ('touch', {'part': 'head'}),
+    'touch_body': ('touch', {'part': 'body'}),
+    'battery': ('battery', {}),
 }
 
 
@@ -78,15 +56,17 @@ class Readings:
     def __init__(self, connection):
         self.latest = {}
         self.count = dict.fromkeys(READINGS, 0)
-        for name, (msg_type, topic, qos, convert) in READINGS.items():
-            connection.subscribe(msg_type, topic, qos,
-                                 self._taker(name, topic, convert, connection.warn))
+        for name, (key, fields) in READINGS.items():
+            row = TOPIC[key]
+            connection.subscribe(message_class(row.type), topic_of(key, **fields), row.qos,
+                                 self._taker(name, key, topic_of(key, **fields),
+                                             connection.warn))
 
-    def _taker(self, name, topic, convert, warn):
+    def _taker(self, name, key, topic, warn):
         def take(msg):
             try:
-                self.latest[name] = convert(msg)
-            except ValueError as err:
+                self.latest[name] = read(key, msg)
+            except Refused as err:
                 warn(name, f'{topic} ignored: {err}')
                 return
             self.count[name] += 1
