@@ -218,3 +218,22 @@ def test_help_and_a_typo_in_a_parameter_is_refused_in_one_line():
                            'fast_sleeep:=true'], capture_output=True, text=True, timeout=60)
     assert typo.returncode == 2 and typo.stderr.count('\n') == 1
     assert "did you mean sleep.fast_sleep" in typo.stderr
+
+
+def test_the_attention_view_is_stamped_with_the_frame_it_was_made_of(rig, ros_context):
+    """So that a viewer (the GUI) draws it, and the objects found there, on that frame."""
+    from sensor_msgs.msg import CompressedImage, Image
+
+    from miro_ball.common.stamps import seconds
+    from miro_ball.miro.interface import RobotTopics
+    from rostools import Probe
+
+    rig = rig('den')
+    topics = RobotTopics(rig.robot.name)
+    probe = Probe(ros_context, rig.executor)
+    views = probe.watch(Image, topics.core('attention_view', eye='caml'))
+    frames = probe.watch(CompressedImage, topics.eye_compressed('caml'))
+    rig.run(1.0)
+    taken = [seconds(f.header.stamp) for f in frames]
+    assert len(views) > 20 and len(taken) >= 10
+    assert all(min(abs(seconds(v.header.stamp) - t) for t in taken) < 1e-6 for v in views[5:])

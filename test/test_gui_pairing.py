@@ -36,6 +36,11 @@ def test_the_newest_overlay_of_a_frame_is_drawn_never_one_of_the_next_frame():
     assert overlays_at(1.1, 1.2).on(1.0, end) is None
 
 
+def test_a_stamp_a_nanosecond_off_after_float_seconds_is_the_same_instant():
+    assert overlays_at(1.0 - 1e-9).on(1.0, 1.0 + PERIOD) == (1.0 - 1e-9, {'at': 1.0 - 1e-9})
+    assert overlays_at(1.0 + PERIOD - 1e-9).on(1.0, 1.0 + PERIOD) is None  # the next frame's
+
+
 def test_an_overlay_older_than_the_frame_is_not_drawn_on_it():
     assert overlays_at(0.9, 0.95).on(1.0, None) is None
 

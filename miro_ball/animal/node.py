@@ -9,6 +9,7 @@ state, the selection, the attention peak and the objects out; core/animal/adjust
 core/config/command in.
 """
 from rclpy.parameter import Parameter
+from rclpy.time import Time
 from sensor_msgs.msg import Image
 from std_msgs.msg import Float32MultiArray, String
 
@@ -135,7 +136,7 @@ class CoreTopics:
             if self._listened(objects):
                 self._publish(objects, core_messages.objects(index, eye))
             if self._listened(view):  # only for a viewer: it costs a millisecond
-                self._publish(view, self._attention_view(eye.camera, name, percepts.joints))
+                self._publish(view, self._attention_view(eye, name, percepts.joints))
 
     def _publish(self, key, msg):
         self.publishers[key].publish(msg)
@@ -143,14 +144,18 @@ class CoreTopics:
     def _listened(self, key):
         return self.publishers[key].get_subscription_count() > 0
 
-    def _attention_view(self, camera, eye, joints):
+    def _attention_view(self, seen, eye, joints):
+        """The attention map as the eye ``seen`` (a contract Eye) sees it, stamped with its
+        frame's stamp, so a viewer (the GUI) draws it, and the objects found in that frame,
+        on that very frame."""
         self._kc.set_joints(*(joints or KIN_CALIB_RAD))
         animal = self.host.controller
-        picture = map_in_eye(animal.map.values, camera, self._kc, EYE_FRAMES[eye],
+        picture = map_in_eye(animal.map.values, seen.camera, self._kc, EYE_FRAMES[eye],
                              VIEW_FULL_SCALE * animal.config.spatial.peak_threshold)
         msg = Image(height=picture.shape[0], width=picture.shape[1], encoding='mono8',
                     step=picture.shape[1], data=picture.tobytes())
-        msg.header.stamp = self.host.get_clock().now().to_msg()
+        msg.header.stamp = (self.host.get_clock().now() if seen.stamp is None else
+                            Time(nanoseconds=round(seen.stamp * 1e9))).to_msg()
         msg.header.frame_id = frame_id(self.host.robot, optical_frame(eye))
         return msg
 

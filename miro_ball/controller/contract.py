@@ -26,6 +26,8 @@ class Eye:
     camera: CameraModel  # the eye's pinhole at the size of `image`
     image: Any = field(default=None, compare=False)  # BGR frame (numpy), None: no fresh one
     detections: Mapping[str, Any] = field(default_factory=dict)  # detector name -> result
+    # The frame's header stamp (s): what is made of this frame (demo mode's overlays) says it.
+    stamp: Optional[float] = None
 
     def found(self, name):
         """The named detector's result in this eye (None: nothing found, or not run)."""

@@ -33,6 +33,7 @@ from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.messages import drive_command, message_class
 from miro_ball.common.qos import profile
 from miro_ball.common.sim_time import sim_time_overrides
+from miro_ball.common.stamps import seconds
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.behaviour import DEFAULT_CAMERAS
 from miro_ball.controller.contract import Eye, Percepts
@@ -171,7 +172,7 @@ class ControllerHost(Node):
         self.state = STARTUP
         self._warn = Throttled(self.get_logger().warning, WARN_EVERY_S)
         self._clock_watch = guard_clock(self, self._warn)
-        self.eyes = [Latest() for _ in EYES]  # (frame, {detector: result}) of each eye
+        self.eyes = [Latest() for _ in EYES]  # (frame, {detector: result}, stamp) of each eye
         self.readings = {field: Latest() for field in list(SENSED) + ['sound']}
         self._mics = None  # the microphones' subscription, while the controller hears
         self.mic_blocks = 0  # microphone blocks taken in
@@ -317,8 +318,8 @@ class ControllerHost(Node):
 
     def _on_image(self, eye, msg):
         now = self._seconds()
-        stamp = msg.header.stamp
-        self.frame_lags.append(now - (stamp.sec + stamp.nanosec * 1e-9))
+        taken = seconds(msg.header.stamp)
+        self.frame_lags.append(now - taken)
         frame = self._decode(EYES[eye], msg)
         if frame is None:
             return
@@ -327,7 +328,7 @@ class ControllerHost(Node):
         camera = self._frame_cameras[eye] = self.cameras[eye].scaled_to(width, height)
         found = {name: detect(frame, camera) for name, detect in self.detectors[eye].items()}
         self.frames_processed += 1
-        self.eyes[eye].set(now, (frame, found))
+        self.eyes[eye].set(now, (frame, found, taken))
         self._debug_image(eye, msg.header, frame, found.get('ball'))
 
     def _on_camera_info(self, eye, msg):
@@ -417,8 +418,8 @@ class ControllerHost(Node):
         stale = self.config.stale_s
         eyes = []
         for latest, camera in zip(self.eyes, self._frame_cameras):
-            frame, found = latest.fresh(now, stale) or (None, {})
-            eyes.append(Eye(camera, frame, found))
+            frame, found, taken = latest.fresh(now, stale) or (None, {}, None)
+            eyes.append(Eye(camera, frame, found, taken))
         reading = {field: latest.fresh(now, stale) for field, latest in self.readings.items()}
         return Percepts(now, tuple(eyes), **reading)
 

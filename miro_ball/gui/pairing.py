@@ -12,6 +12,9 @@ came slower than demo mode's ticks (issue 39).
 from collections import deque
 
 OVERLAYS_KEPT = 64  # demo mode says 50 a simulated second: over a second's worth
+# Stamps closer than this are one instant (a stamp that went through float seconds and back
+# may be a nanosecond off).
+SAME_INSTANT_S = 1e-6
 
 
 class Overlays:
@@ -29,9 +32,9 @@ class Overlays:
         """(stamp, overlay) to draw on the frame of ``frame_stamp``, whose overlays end at
         ``until`` (the next frame's stamp; None: not known), or None."""
         for stamp, overlay in reversed(self._kept):
-            if stamp < frame_stamp:
+            if stamp < frame_stamp - SAME_INSTANT_S:
                 return None
-            if until is None or stamp < until:
+            if until is None or stamp < until - SAME_INSTANT_S:
                 return stamp, overlay
         return None
 
