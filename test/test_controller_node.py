@@ -536,7 +536,28 @@ def test_steers_by_the_camera_info_model(make_rig):
 
 def test_bad_parameter_is_refused(ros_context):
     with pytest.raises(ValueError, match='tick'):
-        ControllerHost(KICK_BLUE_BALL, context=ros_context, parameter_overrides=[Parameter('tick', value='fast')])
+        ControllerHost(KICK_BLUE_BALL, context=ros_context,
+                       parameter_overrides=[Parameter('tick', value='fast')])
+
+
+def test_a_controller_whose_parameters_are_not_there_is_refused_never_run_on_defaults(
+        ros_context):
+    """Demo mode as a mode of kick_blue_ball has none of its own parameters: refused in one
+    line at start, and refused live with the mode left as it was."""
+    animal = 'miro_ball.animal.animal:Animal'
+    with pytest.raises(ValueError, match='python -m miro_ball.animal') as refused:
+        ControllerHost(KICK_BLUE_BALL, context=ros_context,
+                       parameter_overrides=[Parameter('mode', value=animal)])
+    assert '\n' not in str(refused.value)
+    node = ControllerHost(KICK_BLUE_BALL, context=ros_context)
+    try:
+        before = node.controller
+        result, = node.set_parameters([Parameter('mode', value=animal)])
+        assert not result.successful and 'python -m miro_ball.animal' in result.reason
+        assert node.config.mode == 'improved' and node.controller is before
+        assert node.get_parameter('mode').value == 'improved'
+    finally:
+        node.destroy_node()
 
 
 def test_help_lists_parameters_and_topics(capsys):

@@ -236,15 +236,12 @@ class ControllerHost(Node):
         self.values = new
         if self._debug_folder:
             self._debug_folder.keep = self.config.save_debug_keep
-        if isinstance(changed, DetectionParams):
+        renewed = controller is not self.controller
+        if renewed:
+            self.controller = controller
+            self._listen()
+        if renewed or isinstance(changed, DetectionParams) or controller.detectors != detectors:
             self._make_detectors()
-        else:
-            if controller is not self.controller:
-                self.controller = controller
-                self._make_detectors()
-                self._listen()
-            elif controller.detectors != detectors:
-                self._make_detectors()
         for part in self.parts:
             getattr(part, 'on_change', lambda values: None)(changed)
 
