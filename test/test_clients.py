@@ -183,6 +183,16 @@ def test_show_gives_each_unstamped_message_its_own_tick_when_read_in_a_burst(
     assert [b - a for a, b in zip(times, times[1:])] == pytest.approx([0.02] * 4, abs=0.002)
 
 
+def test_an_unstamped_message_gets_its_ticks_time_whichever_topic_is_read_first():
+    ticks = client_show.TickTimes()  # sent: /clock 10 (t 0.02), a 11, /clock 20 (t 0.04), b 21
+    assert ticks.message(5, 'before any clock') == []
+    assert ticks.message(11, 'a') == [] and ticks.message(21, 'b') == []
+    assert ticks.clock(10, 0.02) == []  # a's tick may have more to come
+    assert ticks.clock(20, 0.04) == [(0.02, 'a')]  # 'before any clock' dropped
+    assert ticks.clock(30, 0.06) == [(0.04, 'b')]
+    assert ticks.message(25, 'c') == [(0.04, 'c')]  # read after the next tick's /clock
+
+
 def test_show_cmd_vel_prints_what_someone_commands(paused_sim, executor, ros_context, capsys):
     probe = Probe(ros_context, executor)
     cmd = probe.publisher(TwistStamped, T.cmd_vel)

@@ -79,27 +79,39 @@ SIGNALS = {
 class TickTimes:
     """The simulated time of an unstamped message of the simulator: each platform tick it
     sends /clock, then the sensor topics, so a message's time is that of the last /clock
-    sent before it, by the sender's own clock (the DDS source timestamps, wall ns).
+    sent before it, by the sender's own clock (the DDS source timestamps, wall ns). A
+    message is known once a /clock sent after it has been heard (the two topics are read in
+    either order); one sent before the first /clock heard is dropped.
 
     The time it is read at will not do: rclpy's clock keeps only the newest /clock, so
     messages read in one burst (those queued at the start, or on a busy machine) all
     showed one time."""
 
-    KEEP = 500  # /clock messages remembered: 10 s of 50 Hz ticks
+    KEEP = 500  # /clock messages remembered, and messages waiting: 10 s of 50 Hz ticks
 
     def __init__(self):
         self.clocks = collections.deque(maxlen=self.KEEP)  # (source ns, simulated s)
+        self.waiting = collections.deque(maxlen=self.KEEP)  # (source ns, message)
 
     def clock(self, source_ns, simulated_s):
+        """[(simulated s, message)] of the messages this /clock makes known."""
         self.clocks.append((source_ns, simulated_s))
+        return self._known()
 
-    def when(self, source_ns):
-        """Simulated seconds of a message sent at source_ns; None if it was sent before
-        every /clock remembered."""
-        for sent, simulated_s in reversed(self.clocks):
-            if sent <= source_ns:
-                return simulated_s
-        return None
+    def message(self, source_ns, msg):
+        """[(simulated s, message)] of the messages known now (this one, if its tick's
+        next /clock came first)."""
+        self.waiting.append((source_ns, msg))
+        return self._known()
+
+    def _known(self):
+        known = []
+        while self.waiting and self.clocks and self.waiting[0][0] < self.clocks[-1][0]:
+            sent, msg = self.waiting.popleft()
+            when = next((s for source, s in reversed(self.clocks) if source <= sent), None)
+            if when is not None:
+                known.append((when, msg))
+        return known
 
 
 class Show(Client):
@@ -111,29 +123,24 @@ class Show(Client):
         self.shown = 0
         if 'header' in msg_type.get_fields_and_field_types():  # it says when it was measured
             self.subscribe(msg_type, topic(self.topics),
-                           lambda msg: self.show(msg, seconds(msg.header.stamp)))
+                           lambda msg: self.show([(seconds(msg.header.stamp), msg)]))
             return
-        self.ticks = TickTimes()
-        self.create_subscription(Clock, CLOCK, self.on_clock, profile(CLOCK_QOS))
-        self.create_subscription(msg_type, topic(self.topics), self.on_unstamped,
-                                 profile(SENSOR_QOS))
+        ticks = TickTimes()
+        self.create_subscription(
+            Clock, CLOCK, lambda msg, info: self.show(ticks.clock(info['source_timestamp'],
+                                                                  seconds(msg.clock))),
+            profile(CLOCK_QOS))
+        self.create_subscription(
+            msg_type, topic(self.topics),
+            lambda msg, info: self.show(ticks.message(info['source_timestamp'], msg)),
+            profile(SENSOR_QOS))
 
-    def on_clock(self, msg, info):
-        self.ticks.clock(info['source_timestamp'], seconds(msg.clock))
-
-    def on_unstamped(self, msg, info):
-        if not self.ticks.clocks:  # no simulator's /clock (yet): the clock's time
-            self.show(msg, self.now())
-            return
-        when = self.ticks.when(info['source_timestamp'])
-        if when is not None:  # else sent before the first /clock heard: when is not known
-            self.show(msg, when)
-
-    def show(self, msg, when):
-        self.say(f'{when:8.2f}  {self.options.signal}  {self.line(msg)}')
-        self.shown += 1
-        if self.shown == self.options.count:
-            raise SystemExit(0)
+    def show(self, known):
+        for when, msg in known:
+            self.say(f'{when:8.2f}  {self.options.signal}  {self.line(msg)}')
+            self.shown += 1
+            if self.shown == self.options.count:
+                raise SystemExit(0)
 
 
 def build_parser():
