@@ -56,7 +56,10 @@ setup() {
     say "installing miro_ball[$extras] with ROS 2 Jazzy wheels into $VENV"
     [ -x "$PY" ] || python3 -m venv "$VENV"
     "$PY" -m pip install -q --upgrade pip
-    "$PY" -m pip install -q -e ".[$extras]"
+    # setuptools says "Editable installation ... be careful with folders ... with the same
+    # name as your package" as a warning on every editable install: filtered, nothing else.
+    PYTHONWARNINGS="${PYTHONWARNINGS:+$PYTHONWARNINGS,}ignore:Editable installation" \
+      "$PY" -m pip install -q -e ".[$extras]"
     touch "$stamp"
   fi
   # MiRo's messages: built once, again only when their sources change (a second or less
