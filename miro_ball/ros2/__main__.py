@@ -10,7 +10,8 @@ with no ROS 2 of its own (the ROS wheels from PyPI), with ros2's arguments and o
     python -m miro_ball.ros2 service call /miro_sim/reset std_srvs/srv/Trigger
 
 It sees the ROS domain of the shell it runs in (ROS_DOMAIN_ID), as ros2 does. Without
-ros2's daemon, a listing listens for a moment (1.5 s) before it answers.
+ros2's daemon, a listing listens until the graph is complete (3.5 s or more; if it is still
+changing at 10 s, the answer comes with a line on stderr that it may be incomplete).
 """
 import argparse
 import math
