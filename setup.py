@@ -79,7 +79,7 @@ setup(
     entry_points={
         'console_scripts': [
             'miro_sim = miro_sim_bullet.ros.node:main',
-            'kick_blue_ball = miro_ball.controller.node:main',
+            'kick_blue_ball = miro_ball.controller.kick_blue_ball:main',
             'ball_mover = miro_ball.examples.ball_mover:main',
             'record = miro_ball.record:main',
             'client_minimal = miro_ball.examples.client_minimal:main',
@@ -99,7 +99,7 @@ setup(
             'client_stream = miro_ball.examples.client_stream:main',
             'client_drive_voice = miro_ball.examples.client_drive_voice:main',
             'miro_foxglove = miro_ball.foxglove.__main__:main',
-            'miro_animal = miro_ball.animal.node:main',
+            'miro_animal = miro_ball.animal.demo_mode:main',
             'client_demo_config = miro_ball.examples.client_demo_config:main',
             'client_demo_interact = miro_ball.examples.client_demo_interact:main',
         ],

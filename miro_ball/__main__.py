@@ -1,3 +1,3 @@
-from miro_ball.controller.node import main
+from miro_ball.controller.kick_blue_ball import main
 
 main()

@@ -10,7 +10,7 @@ import time
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
-from miro_ball.animal.node import DEMO_MODE
+from miro_ball.animal.demo_mode import DEMO_MODE
 from miro_ball.controller.host import ControllerHost
 from miro_sim_bullet.ros.node import SimNode
 

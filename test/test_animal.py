@@ -189,7 +189,7 @@ def test_the_mdk_clients_switch_parts_and_nudge_the_state(rig, capsys):
 
 def test_each_robot_has_its_own_demo_mode_in_its_namespace(ros_context):
     """Two robots, two demo modes: every topic of each under its own robot's name."""
-    from miro_ball.animal.node import DEMO_MODE
+    from miro_ball.animal.demo_mode import DEMO_MODE
     from miro_ball.controller.host import ControllerHost
 
     nodes = [ControllerHost(DEMO_MODE, context=ros_context, robot=name) for name in ('miro01', 'miro02')]

@@ -324,7 +324,7 @@ def test_every_parameter_is_in_the_docs_and_a_part_can_be_replaced():
     from pathlib import Path
 
     from miro_ball.animal.params import PART_PARAMS
-    from miro_ball.common.params import table
+    from miro_ball.common.ros_params import table
     from miro_ball.controller.behaviour import BehaviourParams
     from miro_ball.controller.controllers import make_controller
 

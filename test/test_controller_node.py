@@ -20,7 +20,8 @@ from std_msgs.msg import (Float32MultiArray, Int16MultiArray, UInt16, UInt16Mult
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
 from miro_ball.controller.contract import Action
 from miro_ball.controller.host import ControllerHost
-from miro_ball.controller.node import build_parser, KICK_BLUE_BALL, main
+from miro_ball.controller.command_line import build_parser
+from miro_ball.controller.kick_blue_ball import KICK_BLUE_BALL, main
 from miro_ball.bench.synthetic import Disc, jpeg, render
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, COSMETIC_CALIB, JOINT_NAMES
@@ -585,7 +586,7 @@ def test_bad_command_line_is_one_line(capsys):
     assert done.value.code == 2
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and 'unrecognized arguments: --speed ludicrous' in err
-    assert build_parser().parse_args(['--save-debug', 'x']).save_debug == 'x'
+    assert build_parser(KICK_BLUE_BALL).parse_args(['--save-debug', 'x']).save_debug == 'x'
 
 
 def run_controller(*args, **env):

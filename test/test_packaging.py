@@ -46,7 +46,7 @@ def test_ament_layout():
     assert '<build_type>ament_python</build_type>' in package_xml
     setup_py = (ROOT / 'setup.py').read_text()
     for script in ("'miro_sim = miro_sim_bullet.ros.node:main'",
-                   "'kick_blue_ball = miro_ball.controller.node:main'",
+                   "'kick_blue_ball = miro_ball.controller.kick_blue_ball:main'",
                    "'ball_mover = miro_ball.examples.ball_mover:main'"):
         assert script in setup_py
 

@@ -1,10 +1,10 @@
 """A parameter set on the command line that no node declares, or set to a value of the wrong
-type, is refused before anything starts: the pure part (common.params)."""
+type, is refused before anything starts: the pure part (common.ros_params)."""
 from dataclasses import dataclass, field
 
 import pytest
 
-from miro_ball.common.params import check_overrides, ros_overrides
+from miro_ball.common.ros_params import check_overrides, ros_overrides
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,5 @@
 """One reader per sensor (miro.readers), and every reader of MiRo's sensors reads through it:
 +inf sonar is "nothing in range" everywhere (REP 117), NaN is refused everywhere."""
-import math
 from types import SimpleNamespace
 
 import pytest
@@ -95,9 +94,9 @@ def test_the_gui_reads_inf_sonar_as_nothing_in_range(ros_context):
 
 @pytest.mark.parametrize('kind', ['kick_blue_ball', 'demo_mode'])
 def test_fed_inf_sonar_no_controller_complains_nan_is_refused(ros_context, executor, kind):
-    from miro_ball.animal.node import DEMO_MODE
+    from miro_ball.animal.demo_mode import DEMO_MODE
     from miro_ball.controller.host import ControllerHost
-    from miro_ball.controller.node import KICK_BLUE_BALL
+    from miro_ball.controller.kick_blue_ball import KICK_BLUE_BALL
 
     hosted = {'kick_blue_ball': KICK_BLUE_BALL, 'demo_mode': DEMO_MODE}[kind]
     node = ControllerHost(hosted, context=ros_context, robot='miro_readers',

@@ -1,6 +1,6 @@
 """python -m miro_ball.animal: MiRo's demo mode (node.py)."""
 import sys
 
-from miro_ball.animal.node import main
+from miro_ball.animal.demo_mode import main
 
 sys.exit(main())

@@ -9,7 +9,7 @@ ours) the value is our own and its help says what it does.
 import math
 from dataclasses import dataclass, field, fields, make_dataclass, replace
 
-from miro_ball.common.params import check_ranges, Group
+from miro_ball.common.ros_params import check_ranges, Group
 from miro_ball.miro.constants import LIFT_RAD_CALIB, PLATFORM_TICK_S
 
 

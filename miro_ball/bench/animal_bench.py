@@ -46,9 +46,9 @@ def one_round(label, real_time_factor, seconds, env):
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
 
-    from miro_ball.animal.node import DEMO_MODE
+    from miro_ball.animal.demo_mode import DEMO_MODE
     from miro_ball.controller.host import ControllerHost
-    from miro_ball.controller.node import KICK_BLUE_BALL
+    from miro_ball.controller.kick_blue_ball import KICK_BLUE_BALL
 
     sim = subprocess.Popen(sim_command(WORLD, real_time_factor=real_time_factor), env=env,
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

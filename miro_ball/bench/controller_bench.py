@@ -77,7 +77,7 @@ def bench_latency(count):
     from sensor_msgs.msg import CompressedImage
 
     from miro_ball.controller.host import ControllerHost
-    from miro_ball.controller.node import KICK_BLUE_BALL
+    from miro_ball.controller.kick_blue_ball import KICK_BLUE_BALL
 
     # A private domain and robot name: never talk to a real simulator or robot.
     limit_discovery()

@@ -4,13 +4,13 @@ import sys
 
 def user_args(argv, prog, params=(), node=None):
     """argv[1:] without its --ros-args part. A malformed --ros-args part, or one that sets a
-    parameter that is none of ``params`` (dataclasses of common.params) nor ROS's own, or
+    parameter that is none of ``params`` (dataclasses of common.ros_params) nor ROS's own, or
     sets one to a value of the wrong type, ends the program with one line on stderr and exit
     code 2, like any other bad command line. ``node``: the node's name in a --params-file
     (default prog)."""
     from rclpy.utilities import remove_ros_args
 
-    from miro_ball.common.params import check_overrides, ros_overrides
+    from miro_ball.common.ros_params import check_overrides, ros_overrides
 
     try:
         own = remove_ros_args(argv)[1:]

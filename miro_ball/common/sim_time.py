@@ -8,7 +8,7 @@ import sys
 
 from rclpy.parameter import Parameter
 
-from miro_ball.common.params import ros_overrides
+from miro_ball.common.ros_params import ros_overrides
 
 NAME = 'use_sim_time'
 

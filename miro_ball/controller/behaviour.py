@@ -17,7 +17,7 @@ import random
 from dataclasses import dataclass, field
 from typing import NamedTuple, Optional, Sequence, Tuple
 
-from miro_ball.common.params import check_ranges
+from miro_ball.common.ros_params import check_ranges
 from miro_ball.controller.contract import Action, Percepts
 from miro_ball.controller.detection import to_pixels
 from miro_ball.miro.camera_model import CameraModel

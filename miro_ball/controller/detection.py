@@ -20,7 +20,7 @@ from typing import NamedTuple, Optional, Tuple
 import cv2
 import numpy as np
 
-from miro_ball.common.params import check_ranges
+from miro_ball.common.ros_params import check_ranges
 
 HUE_PERIOD = 180  # OpenCV's 8-bit hue is degrees / 2
 

@@ -9,7 +9,7 @@ TwistStamped). Each eye's pinhole model comes from its camera_info (MiRo's simul
 deg eye until one arrives), so bearings stay right whatever field of view the camera has.
 
 What it hosts is described by a ``Hosted`` (hosted.py): kick_blue_ball's family
-(controller/node.py) and demo mode (animal/node.py). Their parameters are declared as
+(controller/kick_blue_ball.py) and demo mode (animal/demo_mode.py). Their parameters are declared as
 their groups say, change live, and a value that does not fit is refused in one line.
 
 The node lives in its robot's namespace and uses relative names, so
@@ -27,7 +27,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, CompressedImage, JointState
 from std_msgs.msg import Float32MultiArray, Int16MultiArray, UInt16MultiArray, UInt32MultiArray
 
-from miro_ball.common import params
+from miro_ball.common import ros_params
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.messages import drive_command, message_class
@@ -159,9 +159,9 @@ class ControllerHost(Node):
         groups = all_groups(hosted)
         self.values = {}
         for group in groups:
-            value = params.declare(self, group)
+            value = ros_params.declare(self, group)
             self.values[type(value)] = value
-        self._live = params.LiveParams(self, list(self.values.values()), self._apply,
+        self._live = ros_params.LiveParams(self, list(self.values.values()), self._apply,
                                        fixed=('tick',), groups=groups)
         self.save_debug = save_debug
         self._debug_folder = save_debug and DebugFolder(save_debug, self.config.save_debug_keep)

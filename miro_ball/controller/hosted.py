@@ -5,7 +5,7 @@ it reads MiRo's sensors into Percepts, runs the detectors the controller names, 
 and publishes its Action. A kind of controller tells the host, through a ``Hosted``:
 
     node_name, prog, about   the node's name, its command's name and its --help summary
-    groups                   its parameter groups (common.params: dataclasses or Groups):
+    groups                   its parameter groups (common.ros_params: dataclasses or Groups):
                              the first is the host's own and has the fields HOST_FIELDS
     parts                    extra topics of its own, each a class built as Part(host)
                              (e.g. demo mode's core/... topics), with ``topics()`` for
@@ -15,13 +15,13 @@ and publishes its Action. A kind of controller tells the host, through a ``Hoste
                              the same one reconfigured, or a new one
     describe(values)         a few words for the start-up log line
 
-kick_blue_ball's family (controller/node.py) and demo mode (animal/node.py) are both kinds
+kick_blue_ball's family (controller/kick_blue_ball.py) and demo mode (animal/demo_mode.py) are both kinds
 hosted this way; the learning environments build the same controllers without a host.
 """
 from dataclasses import dataclass, fields
 from typing import Any, Callable, Tuple
 
-from miro_ball.common.params import group_of
+from miro_ball.common.ros_params import group_of
 
 # What the host itself reads from a kind's first group.
 HOST_FIELDS = ('tick', 'stale_s', 'head_hold_s', 'head_lift_deg')

@@ -2,7 +2,7 @@
 import math
 from dataclasses import dataclass, field
 
-from miro_ball.common.params import check_ranges
+from miro_ball.common.ros_params import check_ranges
 from miro_ball.controller.behaviour import BehaviourParams
 from miro_ball.controller.controllers import BUILT_IN, controller_class
 from miro_ball.controller.detection import DetectionParams

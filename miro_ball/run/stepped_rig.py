@@ -43,7 +43,7 @@ class SteppedRig:
         from rclpy.parameter import Parameter
 
         from miro_ball.controller.host import ControllerHost
-        from miro_ball.controller.node import KICK_BLUE_BALL
+        from miro_ball.controller.kick_blue_ball import KICK_BLUE_BALL
         from miro_sim_bullet.ros.node import SimNode
 
         self._quieten(SIM_NODE_NAME)

@@ -30,7 +30,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_watch import ClockWatch
 from miro_ball.common.lifecycle import run_node
-from miro_ball.common.params import declare, help_lines, LiveParams
+from miro_ball.common.ros_params import declare, help_lines, LiveParams
 from miro_ball.common.qos import profile
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.camera_model import CameraModel

@@ -1,7 +1,7 @@
 """The simulator's ROS parameters: one dataclass drives declaration, checks and --help."""
 from dataclasses import dataclass, field
 
-from miro_ball.common.params import check_ranges
+from miro_ball.common.ros_params import check_ranges
 from miro_ball.miro.camera_model import LENSES, PINHOLE
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES
 from miro_sim_bullet.physics.world import PHYSICS_DT_S

@@ -1,62 +1,24 @@
-"""miro_animal: MiRo's demo mode for one robot, a ROS 2 node in the robot's namespace.
-
-Demo mode is a controller (animal.py) run by the controller host (controller/host.py: eyes
-decoded and the detectors run per eye, the percepts, the tick on simulated time, the control
-topics). This module tells the host what it needs (DEMO_MODE): its parameters, one group per
-part under a dotted name (``affect.*``, ``sleep.*``, ...), how a change reaches the animal,
-and its own topics (miro.interface.CORE_INTERFACE) as a part of the node (CoreTopics): its
-state, the selection, the attention peak and the objects out; core/animal/adjust and
-core/config/command in.
-"""
+"""Demo mode's own topics (miro.interface.CORE_INTERFACE), a part of the controller host's
+node when it runs demo mode: the animal's state, the selection, the attention peak, the
+objects found and the attention views out; core/animal/adjust and core/config/command in."""
 from rclpy.parameter import Parameter
 from rclpy.time import Time
 from sensor_msgs.msg import Image
 from std_msgs.msg import Float32MultiArray, String
 
-from miro_ball.animal.actions import ACTIONS
-from miro_ball.animal.animal import Animal
 from miro_ball.animal import core_messages
-from miro_ball.animal.params import (AnimalNodeParams, Config, config_command, FlagParams,
-                                     letters_on, PART_PARAMS, PREFIX)
 from miro_ball.animal.map_view import map_in_eye
+from miro_ball.animal.params import config_command, FlagParams, letters_on, PREFIX
 from miro_ball.common.messages import message_class
-from miro_ball.common.params import full_name
 from miro_ball.common.qos import profile
-from miro_ball.controller.hosted import Hosted
-from miro_ball.controller.node import host_main
+from miro_ball.common.ros_params import full_name
 from miro_ball.miro.body import optical_frame
 from miro_ball.miro.constants import KIN_CALIB_RAD
 from miro_ball.miro.interface import (CORE_IN, CORE_INTERFACE, CORE_TOPIC, EYES, frame_id,
                                       RobotTopics)
 from miro_ball.miro.kc import EYE_FRAMES, KinematicChain
 
-NODE_NAME = 'miro_animal'
 VIEW_FULL_SCALE = 4  # an attention view is white at four times the target threshold
-
-
-def config_of(values):
-    """Demo mode's Config from the host's parameter values ({dataclass: values})."""
-    return Config(*(values[group.cls] for group in PART_PARAMS))
-
-
-def _build(values):
-    node = values[AnimalNodeParams]
-    return Animal(config_of(values), node.selector, node.seed)
-
-
-def _update(animal, old, new):
-    """A new selector or seed starts the animal afresh; any part's change reaches it at the
-    next tick with its state kept."""
-    before, now = old[AnimalNodeParams], new[AnimalNodeParams]
-    if (before.selector, before.seed) != (now.selector, now.seed):
-        return _build(new)
-    animal.configure(config_of(new))
-    return animal
-
-
-def _describe(values):
-    return "demo mode (selector '%s', switches '%s')" % (
-        values[AnimalNodeParams].selector, letters_on(values[FlagParams]))
 
 
 class CoreTopics:
@@ -161,18 +123,3 @@ class CoreTopics:
 
     def _publish_config(self):
         self._publish('config_state', String(data=letters_on(self.host.values[FlagParams])))
-
-
-DEMO_MODE = Hosted(
-    node_name=NODE_NAME, prog='miro_animal',
-    about="MiRo's demo mode for ROS 2: an animal that notices balls, faces, tags, motion and "
-          "sounds, chooses what to do, feels, sleeps and shows it (docs/demo_mode.md). Ctrl+C "
-          "stops it with a zero twist.",
-    groups=(AnimalNodeParams,) + PART_PARAMS, build=_build, update=_update,
-    describe=_describe, parts=(CoreTopics,),
-    help_lines=('', 'actions: ' + ', '.join(ACTIONS),
-                '-p sleep.fast_sleep:=true runs the sleep cycle 25 times faster.'))
-
-
-def main(argv=None):
-    return host_main(DEMO_MODE, argv)
