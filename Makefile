@@ -1,9 +1,9 @@
 # Thin wrappers; dev.sh does the work so that a machine without make works too.
-.PHONY: setup demo test bench
+.PHONY: setup lab test bench
 setup:
 	./dev.sh setup
-demo:
-	./dev.sh demo
+lab:
+	./dev.sh lab
 test:
 	./dev.sh test
 bench:

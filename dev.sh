@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One entry point for a new user: sets up .venv (and, as root, the Debian
 # packages) on first use, then runs what was asked.
-#   ./dev.sh demo [args]   headless simulator + controller, summary and video
+#   ./dev.sh lab [args]    the lab, headless: simulator + controller, summary and video
 #   ./dev.sh test [args]   the test suite (pytest); no args: every tier once, two test files at
 #                          a time, as robot miro02; -m unit: the quick tier
 #   ./dev.sh bench         simulator, detection and scenario benchmarks
@@ -71,7 +71,7 @@ cmd=${1:-help}
 [ $# -gt 0 ] && shift
 case "$cmd" in
   setup) setup ;;
-  demo) setup; exec "$PY" -m miro_ball.demo "$@" ;;
+  lab) setup; exec "$PY" -m miro_ball.lab "$@" ;;
   test) setup test,scale
     if [ $# -gt 0 ]; then exec "$PY" -m pytest "$@"; fi
     # Every tier once, under a robot name other than the default (the MDK's multi-robot

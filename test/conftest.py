@@ -33,7 +33,7 @@ TIERS = {
              'test_callback_faults', 'test_sensors_package', 'test_ros2_cli', 'test_foxglove',
              'test_tf', 'test_audio_clients', 'test_animal', 'test_readers')),
     'e2e': ('whole runs as processes: demo, grader, recorder, tutorial, soak, packaging',
-            ('test_closed_loop', 'test_demo', 'test_grade',
+            ('test_closed_loop', 'test_lab', 'test_grade',
              'test_record', 'test_restart', 'test_scenario_bench',
              'test_signals', 'test_sim_domain', 'test_soak', 'test_tutorial', 'test_grade_class',
              'test_grade_ray', 'test_refusals')),
@@ -54,7 +54,7 @@ def pytest_configure(config):
 # short ones fill in at the end.
 SLOWEST_FIRST = ('test_tutorial', 'test_grade_class', 'test_gui_browser', 'test_record',
                  'test_signals', 'test_grade_ray', 'test_clients', 'test_ros2_cli',
-                 'test_closed_loop', 'test_tf', 'test_demo', 'test_animal', 'test_robot_object',
+                 'test_closed_loop', 'test_tf', 'test_lab', 'test_animal', 'test_robot_object',
                  'test_sim_domain', 'test_grade', 'test_soak', 'test_restart')
 
 

@@ -63,7 +63,7 @@ def test_placements_are_reproducible_and_inside_the_arena():
 
 def test_two_processes_find_each_other_and_kick(tmp_path):
     """The README's main job: two nodes over DDS, headless, until the ball moves."""
-    cmd = [sys.executable, '-m', 'miro_ball.demo', '--no-video', '--limit', '40',
+    cmd = [sys.executable, '-m', 'miro_ball.lab', '--no-video', '--limit', '40',
            '--real-time-factor', '0', '--out', str(tmp_path)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             start_new_session=True)

@@ -79,7 +79,7 @@ def test_a_reset_simulator_runs_an_episode_as_a_fresh_one(make_sim):
 
 def test_the_grader_and_the_demo_judge_an_episode_alike(make_sim, ros_context, executor):
     """The host's judge fed in-process and a Monitor's fed the simulator's ground truth
-    topics (as the demo, the scenario bench and the closed-loop tests are) say the same."""
+    topics (as the lab run, the scenario bench and the closed-loop tests are) say the same."""
     node = make_sim()
     probe = Probe(ros_context, executor)
     monitor = Monitor(probe.node, [NAME], debug_frames=False)

@@ -590,7 +590,7 @@ def test_a_click_in_the_world_view_places_a_sound_and_a_click_on_it_stops_it(rig
 
 
 def test_demo_mode_is_started_watched_and_stopped_from_the_page(rig, tmp_path):
-    """The demo panel: its button runs miro_animal for the page's robot; the page shows the
+    """The demo mode panel: its button runs miro_animal for the page's robot; the page shows the
     selected action, every action's priority, the affect and sleep, and the attention map
     over the eyes; the other button stops it."""
     page = rig.open_page()

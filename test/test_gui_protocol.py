@@ -481,35 +481,35 @@ def test_demo_modes_topics_become_what_the_page_draws_and_garbage_is_refused():
     from std_msgs.msg import Float32MultiArray, String
 
     from miro_ball.animal.actions import ACTIONS
-    from miro_ball.gui import demo
+    from miro_ball.gui import demo_mode_panel
 
     state = AnimalState()
     state.emotion.valence, state.sleep.wakefulness = 0.5, 0.25
-    assert demo.animal_state(state) == {'emotion': [0.5, 0.0], 'mood': [0.0, 0.0],
+    assert demo_mode_panel.animal_state(state) == {'emotion': [0.5, 0.0], 'mood': [0.0, 0.0],
                                         'sleep': [0.25, 0.0]}
     state.mood.arousal = math.nan
     with pytest.raises(ValueError):
-        demo.animal_state(state)
-    assert demo.priorities(Float32MultiArray(data=[0.5] * len(ACTIONS))) == [0.5] * len(ACTIONS)
+        demo_mode_panel.animal_state(state)
+    assert demo_mode_panel.priorities(Float32MultiArray(data=[0.5] * len(ACTIONS))) == [0.5] * len(ACTIONS)
     for bad in ([0.5] * (len(ACTIONS) + 1), [math.inf] * len(ACTIONS)):
         with pytest.raises(ValueError):
-            demo.priorities(Float32MultiArray(data=bad))
-    assert demo.action(String(data='orient')) == 'orient'
+            demo_mode_panel.priorities(Float32MultiArray(data=bad))
+    assert demo_mode_panel.action(String(data='orient')) == 'orient'
     with pytest.raises(ValueError):
-        demo.action(String(data='<script>'))
+        demo_mode_panel.action(String(data='<script>'))
     found = Objects(balls=[ObjectBall(centre=[0.5, 0.25], radius=0.125)],
                     faces=[ObjectFace(corner=[0.25, 0.5], size=[0.125, 0.25])],
                     tags=[ObjectTag(id=3, centre=[0.75, 0.5])])
-    assert demo.objects(found) == [
+    assert demo_mode_panel.objects(found) == [
         {'kind': 'ball', 'x': 0.5, 'y': 0.25, 'r': 0.125},
         {'kind': 'face', 'x': 0.25, 'y': 0.5, 'w': 0.125, 'h': 0.25},
         {'kind': 'tag 3', 'x': 0.75, 'y': 0.5}]
-    assert len(demo.objects(Objects(tags=[ObjectTag()] * 100))) == 20  # bounded
-    view = demo.attention_view(Image(width=4, height=2, step=4, encoding='mono8',
+    assert len(demo_mode_panel.objects(Objects(tags=[ObjectTag()] * 100))) == 20  # bounded
+    view = demo_mode_panel.attention_view(Image(width=4, height=2, step=4, encoding='mono8',
                                      data=bytes(range(8))))
     assert base64.b64decode(view['data']) == bytes(range(8))
     for bad in (Image(width=4, height=2, step=4, encoding='rgb8', data=bytes(24)),
                 Image(width=4, height=2, step=4, encoding='mono8', data=bytes(3)),
                 Image(width=4000, height=2000, step=4000, encoding='mono8', data=bytes(10))):
         with pytest.raises(ValueError):
-            demo.attention_view(bad)
+            demo_mode_panel.attention_view(bad)

@@ -185,7 +185,7 @@ def test_a_node_that_left_while_it_was_looked_at_is_no_failure():
 def test_the_demo_summary_says_kicked_once_and_how_a_run_without_its_kick_ended():
     from types import SimpleNamespace
 
-    from miro_ball.demo import summary
+    from miro_ball.lab import summary
 
     def said(judge, outcome):
         monitor = SimpleNamespace(judge=judge, robots={}, frames=0)

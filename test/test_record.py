@@ -43,7 +43,7 @@ def test_records_every_topic_with_types_counts_and_simulated_stamps(
     bag = SplitBag(tmp_path / 'bag')
     recorder = Recorder(bag, Selection(exclude=[ROBOT.eye_raw('cam?')]), context=ros_context)
     executor.add_node(recorder)
-    # Subscribed before the clock runs (the demo waits for that to start it); a latched
+    # Subscribed before the clock runs (the lab run waits for that to start it); a latched
     # topic's message from before is held for the first /clock.
     latched = Probe(ros_context, executor, 'early').node.create_publisher(
         String, '/latched', QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL))
@@ -298,7 +298,7 @@ def test_the_main_job_records_every_node_of_the_run(tmp_path):
     bag = tmp_path / 'run'
     # In real time, as the main job runs: free-running, the whole run can be over before
     # the controller's publisher has matched the recorder's new subscription.
-    cmd = [sys.executable, '-m', 'miro_ball.demo', '--no-video', '--limit', '3',
+    cmd = [sys.executable, '-m', 'miro_ball.lab', '--no-video', '--limit', '3',
            '--real-time-factor', '1', '--out', str(tmp_path), '--record', str(bag)]
     _, output = run_command(cmd)
     assert f'recording:            {bag}' in output and 'FAILED' not in output, output

@@ -167,7 +167,7 @@ OWN_LIFECYCLE = {
     'miro_ball/bench/': 'benchmarks drive their nodes in-process',
     # Main jobs with no node of their own until Ctrl+C: they note it, say what they have,
     # and stop their children (run/processes.py).
-    'miro_ball/demo.py': 'the main job',
+    'miro_ball/lab.py': 'the main job',
     'miro_ball/grade.py': 'the grader',
 }
 

@@ -1,4 +1,4 @@
-"""A ROS domain of its own for a run, so tests, benchmarks and the demo never see
+"""A ROS domain of its own for a run, so tests, benchmarks and the lab run never see
 other ROS processes on the machine (or each other when they run side by side).
 
 A domain id chosen from the process id alone collides now and then (1 in 100 per

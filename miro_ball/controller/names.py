@@ -1,4 +1,4 @@
-"""The controller's own names, for those who watch it (the demo, the GUI, tests)."""
+"""The controller's own names, for those who watch it (the lab run, the GUI, tests)."""
 from miro_ball.miro.interface import check_name
 
 NODE_NAME = 'kick_blue_ball'

@@ -9,7 +9,7 @@ a fresh simulator (test_grade_host).
 The simulator is unprivileged (SimNode(privileged=False)): on the ROS graph it is MiRo's
 interface and /clock, nothing else. The host places robot and ball, runs and pauses the
 clock and has the episode judged in-process, after every physics step, from the world
-itself (by the one judge, run/judge.py, fed as the demo's is over ROS). The command under
+itself (by the one judge, run/judge.py, fed as the lab run's is over ROS). The command under
 test runs in its sandbox (sandbox.py) beside it and is watched on the graph (watch.py): a
 breach of MiRo's interface ends the episode as cheated.
 
@@ -72,7 +72,7 @@ def place(sim, name, robot, ball):
 
 def observe(judge, sim, name):
     """What the world says now, to the judge (run/judge.py), after each physics step: what
-    the simulator's ground truth topics say to the demo's, on the same instants (a touch
+    the simulator's ground truth topics say to the lab run's, on the same instants (a touch
     after any step, the ball and the robot on platform ticks)."""
     if sim.touching(name):
         judge.touch(name, sim.time, sim.ball_position())

@@ -34,7 +34,7 @@ from miro_ball.common.qos import profile
 from miro_ball.common.robots import robots_running
 from miro_ball.common.throttle import Throttled
 from miro_ball.gui import protocol as p
-from miro_ball.gui.demo import DemoRunner
+from miro_ball.gui.demo_mode_panel import DemoModeRunner
 from miro_ball.gui import readouts as r
 from miro_ball.gui.frames import FrameStore
 from miro_ball.gui.robot_part import NODE_NAME, PUBLISHED, RobotPart
@@ -91,7 +91,7 @@ class GuiBridge(Node):
         self.on_frame = on_frame if on_frame is not None else (lambda channel: None)
         self.on_event = on_event if on_event is not None else (lambda owners, text: None)
         self.images = FrameStore(self.warn, self.on_frame)
-        self.demo = DemoRunner()  # demo mode processes the pages started
+        self.demo = DemoModeRunner()  # demo mode processes the pages started
         self.sim = SimLink(self, self._report, self.warn)
         self._lock = threading.Lock()
         # Pages coming and going apart from their commands, so a flood of commands (whose

@@ -20,7 +20,7 @@ from miro_ball.common.qos import profile
 from miro_ball.common.stamps import seconds
 from miro_ball.controller.names import debug_topic
 from miro_ball.gui import protocol as p
-from miro_ball.gui import demo
+from miro_ball.gui import demo_mode_panel
 from miro_ball.gui import readouts as r
 from miro_ball.gui.hearing import MicMeter, speaker_message
 from miro_ball.miro.camera_model import CameraModel
@@ -166,9 +166,9 @@ class RobotPart(Node):
         if not on:
             return
         rows = [(key, {}, convert, partial(self._demo_readout, slot))
-                for key, convert, slot in demo.READ]
+                for key, convert, slot in demo_mode_panel.READ]
         rows += [(key, {'eye': eye}, convert, partial(self._overlay_part, eye, part))
-                 for key, convert, part in demo.OVERLAY for eye in EYES]
+                 for key, convert, part in demo_mode_panel.OVERLAY for eye in EYES]
         try:
             for key, fields, convert, take in rows:
                 row = CORE_TOPIC[key]

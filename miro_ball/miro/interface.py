@@ -185,7 +185,7 @@ CORE_INTERFACE = tuple(Topic(*row) for row in (
     ('attention_view', 'core/attention_{eye}', 'sensor_msgs/msg/Image', CORE_OUT, SENSOR_QOS,
      'the attention map as each eye sees it, mono8 64x36 (the MDK\'s core/pril, prir)'),
     ('config_state', 'core/config/state', 'std_msgs/msg/String', CORE_OUT, SENSOR_QOS,
-     "the demo's switches as the MDK's letters (those on)"),
+     "demo mode's switches as the MDK's letters (those on)"),
     ('animal_adjust', 'core/animal/adjust', 'miro2_msg/msg/AnimalAdjust', CORE_IN,
      CONTROL_QOS, 'nudge emotion, mood or sleep (the MDK\'s Adjust)'),
     ('config_command', 'core/config/command', 'std_msgs/msg/String', CORE_IN, COMMAND_QOS,

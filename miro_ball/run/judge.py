@@ -2,7 +2,7 @@
 how far the robots drove, and whether the episode is over. Plain Python, time passed in.
 
 Everyone asks it: the grading host feeds it from the world in its own process after each
-physics step (grading/host.py), the demo, the scenario bench and the closed-loop tests from
+physics step (grading/host.py), the lab run, the scenario bench and the closed-loop tests from
 the simulator's ground truth topics (run/monitor.py). Both feed it the same facts on the
 same instants, so both judge an episode alike:
 

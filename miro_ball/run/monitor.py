@@ -1,7 +1,7 @@
 """An observer of a run over ROS: simulated time, the ball, the robots, the controllers.
 
 It only subscribes (to /clock, the simulator's ground truth, its touches and the
-controllers' annotated frames), so it can watch any run: the demo's, a user's. What
+controllers' annotated frames), so it can watch any run: the lab run's, a user's. What
 happened is the one judge's to say (run/judge.py): Monitor.judge. Image callbacks are
 optional; they get each frame decoded to BGR.
 """

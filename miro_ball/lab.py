@@ -1,7 +1,7 @@
 """The main job: the simulator and one kick_blue_ball per robot as separate processes.
 
 It starts the nodes exactly as a user would in several shells (on a ROS domain
-of their own), the simulator paused. Once every controller and the demo's own
+of their own), the simulator paused. Once every controller and the lab run's own
 observer (and the recorder, if asked for) are there, it starts the clock, so the
 run is watched from its first instant. It shows progress, stops the nodes cleanly
 and prints a summary with a line per robot. It also writes a video: the overhead
@@ -96,10 +96,10 @@ def watch(args, robots, procs, domain_id, stop):
     from miro_ball.run.video import Video
 
     name = args.world if len(robots) > 1 else args.mode
-    video = Video(Path(args.out) / f'demo_{name}.mp4', robots) if args.video else None
+    video = Video(Path(args.out) / f'lab_{name}.mp4', robots) if args.video else None
     rtf = 0.0
     with ros_domain(domain_id) as context:
-        referee = Referee(context, robots, 'miro_demo', video=video, video_note=args.mode,
+        referee = Referee(context, robots, 'miro_lab', video=video, video_note=args.mode,
                           debug_frames=True)
         try:
             outcome = start(args, robots, procs, referee, stop)
@@ -164,7 +164,7 @@ def summary(outcome, monitor, rtf, video, killed, record=None):
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(
-        prog='python -m miro_ball.demo',
+        prog='python -m miro_ball.lab',
         description='Run the simulator and one controller per robot headless until the ball '
                     'is kicked; print a summary and write a video.')
     parser.add_argument('--mode', choices=('improved', 'tutorial'), default='improved')
@@ -200,7 +200,7 @@ def main(argv=None):
     robots = robot_names(args.world, parser)
     domain_id = private_domain(salt=50)
     out = Path(args.out)
-    print(f'miro_ball demo: mode {args.mode}, world {args.world}, robots {", ".join(robots)}, '
+    print(f'miro_ball lab: mode {args.mode}, world {args.world}, robots {", ".join(robots)}, '
           f'limit {args.limit:g} s simulated, ROS domain {domain_id}; logs in {out}/',
           flush=True)
     stop = StopRequest()  # Ctrl+C ends the run with a summary, and stops the nodes

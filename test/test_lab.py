@@ -1,6 +1,6 @@
-"""The demo as a user runs it: every node of the run has a name of its own, and the run is
-watched from its first instant (the simulator waits, paused, for the controllers and the
-demo's observer)."""
+"""The lab run as a user runs it: every node of the run has a name of its own, and the run is
+watched from its first instant (the simulator waits, paused, for the controllers and
+its own observer)."""
 import os
 import queue
 import re
@@ -26,11 +26,11 @@ PROGRESS = re.compile(r'^  t = +([0-9.]+) s simulated, ball moved [0-9.]+ m, (\d
                       re.M)
 
 
-class Demo:
-    """The demo as a process of its own; its output read line by line as it comes."""
+class LabRun:
+    """The lab run as a process of its own; its output read line by line as it comes."""
 
     def __init__(self, *args):
-        self.proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.demo', *args],
+        self.proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.lab', *args],
                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                      text=True, start_new_session=True)
         self.lines, self.output = queue.Queue(), []
@@ -49,7 +49,7 @@ class Demo:
                 line = self.lines.get(timeout=1.0)
             except queue.Empty:
                 continue
-            assert line is not None, 'the demo ended:\n' + ''.join(self.output)
+            assert line is not None, 'the lab run ended:\n' + ''.join(self.output)
             self.output.append(line)
             if re.search(pattern, line):
                 return line
@@ -72,7 +72,7 @@ def node_names(domain, wanted):
     """Fully qualified names of the nodes on ROS domain ``domain`` (ours left out), once
     those wanted have shown up."""
     with ros_domain(domain) as context:
-        node = rclpy.create_node('demo_names_probe', context=context)
+        node = rclpy.create_node('lab_names_probe', context=context)
         ours = node.get_fully_qualified_name()
         deadline = time.monotonic() + HANG_GUARD_S
         while not wanted <= set(node.get_fully_qualified_node_names()):
@@ -84,24 +84,24 @@ def node_names(domain, wanted):
     return names
 
 
-def test_every_node_of_the_football_demo_has_a_name_of_its_own(tmp_path):
+def test_every_node_of_the_football_lab_run_has_a_name_of_its_own(tmp_path):
     robots = [spec.name for spec in load_world(FOOTBALL).robots]
     # A quarter of real time: the Ctrl+C below comes at the first progress line after the
     # start (2 s of wall time), long before a kick ends the run (at real time, once, it came first).
-    demo = Demo('--world', FOOTBALL, '--no-video', '--limit', '60', '--real-time-factor',
+    run = LabRun('--world', FOOTBALL, '--no-video', '--limit', '60', '--real-time-factor',
                 '0.25', '--out', str(tmp_path))
     try:
-        domain = int(demo.line(r'ROS domain \d+').split('ROS domain ')[1].split(';')[0])
+        domain = int(run.line(r'ROS domain \d+').split('ROS domain ')[1].split(';')[0])
         controllers = {f'/{robot}/{CONTROLLER}' for robot in robots}
-        names = node_names(domain, controllers | {'/miro_sim', '/miro_demo'})
+        names = node_names(domain, controllers | {'/miro_sim', '/miro_lab'})
         assert len(names) == len(set(names)), sorted(names)
-        assert sorted(names) == sorted(controllers | {'/miro_sim', '/miro_demo'})
+        assert sorted(names) == sorted(controllers | {'/miro_sim', '/miro_lab'})
         # Ctrl+C once the simulated time runs.
-        while float(PROGRESS.search(demo.line(PROGRESS.pattern)).group(1)) == 0.0:
+        while float(PROGRESS.search(run.line(PROGRESS.pattern)).group(1)) == 0.0:
             pass
     finally:
-        demo.proc.send_signal(signal.SIGINT)
-        _, output = demo.finish()
+        run.proc.send_signal(signal.SIGINT)
+        _, output = run.finish()
     assert re.search(r'^  kicked: +(yes|no)\n  ended: +interrupted \(Ctrl\+C\)$', output,
                      re.M), output
     simulated = float(re.search(r'simulated time: +([0-9.]+) s', output).group(1))
@@ -109,11 +109,11 @@ def test_every_node_of_the_football_demo_has_a_name_of_its_own(tmp_path):
     assert 'FAILED' not in output, output
 
 
-def test_the_demo_is_watched_from_its_first_instant(tmp_path):
+def test_the_lab_run_is_watched_from_its_first_instant(tmp_path):
     """The video's first frame is the start, with the robots and the ball where the world
     puts them; no progress line counts more frames than the simulated time allows."""
     world = load_world(FOOTBALL)
-    _, output = run_command([sys.executable, '-m', 'miro_ball.demo', '--world', FOOTBALL,
+    _, output = run_command([sys.executable, '-m', 'miro_ball.lab', '--world', FOOTBALL,
                                 '--limit', '3', '--out', str(tmp_path)])
     assert 'FAILED' not in output, output
     start = re.search(r'^  started at t = ([0-9.]+) s: (.*); the ball at \((.*)\)$', output,

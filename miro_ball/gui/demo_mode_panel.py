@@ -72,7 +72,7 @@ READ = [('animal_state', animal_state, 'state'), ('selection_priority', prioriti
 OVERLAY = (('detect_objects', objects, 'objects'), ('attention_view', attention_view, 'view'))
 
 
-class DemoRunner:
+class DemoModeRunner:
     """Demo mode (python -m miro_ball.animal) run for robots, one process each, its last
     lines of output kept for the page's status."""
 
