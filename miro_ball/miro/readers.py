@@ -51,14 +51,13 @@ class Motion(NamedTuple):
 
 @dataclass(frozen=True)
 class Reader:
-    """One sensor stream's reading: ``read(msg)`` -> value or Refused; ``units`` of the
-    value; ``nothing``: what the value is when the sensor senses nothing (None: no such
-    value); ``show(value)``: the value in a few words for a person."""
+    """One sensor stream's reading: ``read(msg)`` -> value or Refused (its text says what
+    was wanted, in one line); ``units`` of the value; ``nothing``: what the value is when
+    the sensor senses nothing (None: no such value)."""
 
     key: str
     read: Callable[[Any], Any]
     units: str
-    show: Callable[[Any], str]
     nothing: Any = None
 
 
@@ -118,50 +117,28 @@ def _mics(msg):
         raise Refused(str(err)) from None
 
 
-def _pair(values, unit=''):
-    return f'L {values[0]:.2f}{unit}  R {values[1]:.2f}{unit}'
-
-
-def _show_sonar(distance):
-    return 'nothing in range' if distance == NOTHING_IN_RANGE else f'{distance:.3f} m'
-
-
 READERS = {reader.key: reader for reader in (
-    Reader('kinematic_joints', lambda m: _values(m.position, 4, JOINT_POSITIONS), 'rad',
-           lambda v: '  '.join(f'{math.degrees(a):+.1f}' for a in v) + ' deg'),
+    Reader('kinematic_joints', lambda m: _values(m.position, 4, JOINT_POSITIONS), 'rad'),
     Reader('body_pose', lambda m: Pose(*_values((m.x, m.y, m.theta), 3, 'x, y, theta')),
-           'm, m, rad', str),
-    Reader('odom', _odometry, 'm, rad; m/s, rad/s',
-           lambda v: f'{v.pose}  v {v.forward:+.3f} m/s  w {v.turn:+.3f} rad/s'),
+           'm, m, rad'),
+    Reader('odom', _odometry, 'm, rad; m/s, rad/s'),
     Reader('cliff', lambda m: _values(m.data, 2, 'values [left, right]', 0.0, 1.0),
-           '0..1 (1: floor, below 0.7: a drop)', _pair),
-    Reader('sonar', _sonar, 'm', _show_sonar, NOTHING_IN_RANGE),
-    Reader('light', lambda m: _values(m.data, 4, 'light values', 0.0, 1.0), '0..1',
-           lambda v: '  '.join(f'{x:.2f}' for x in v)),
-    Reader('touch', lambda m: _count(m.data, UINT16_MAX, 'touch'), 'a bit per pad',
-           lambda v: f'{v:016b}', 0),
-    Reader('battery', _battery, 'V', lambda v: f'{v:.2f} V'),
-    Reader('imu', _acceleration, 'm/s^2',
-           lambda v: f'acc x {v[0]:+.2f}  y {v[1]:+.2f}  z {v[2]:+.2f} m/s2'),
-    Reader('wheel_speed_cmd', lambda m: _values(m.data, 2, 'speeds [left, right]'), 'm/s',
-           lambda v: _pair(v, ' m/s')),
-    Reader('wheel_speed_opto', lambda m: _values(m.data, 2, 'speeds [left, right]'), 'm/s',
-           lambda v: _pair(v, ' m/s')),
-    Reader('sensor_flags', lambda m: _count(m.data, UINT32_MAX, 'flags'), 'bits',
-           lambda v: f'0x{v:08x}'),
-    Reader('mics', _mics, 'of full scale, (4, samples)',
-           lambda v: f'{v.shape[1]} samples x {v.shape[0]} microphones'),
+           '0..1 (1: floor, below 0.7: a drop)'),
+    Reader('sonar', _sonar, 'm', NOTHING_IN_RANGE),
+    Reader('light', lambda m: _values(m.data, 4, 'light values', 0.0, 1.0), '0..1'),
+    Reader('touch', lambda m: _count(m.data, UINT16_MAX, 'touch'), 'a bit per pad', 0),
+    Reader('battery', _battery, 'V'),
+    Reader('imu', _acceleration, 'm/s^2'),
+    Reader('wheel_speed_cmd', lambda m: _values(m.data, 2, 'speeds [left, right]'), 'm/s'),
+    Reader('wheel_speed_opto', lambda m: _values(m.data, 2, 'speeds [left, right]'), 'm/s'),
+    Reader('sensor_flags', lambda m: _count(m.data, UINT32_MAX, 'flags'), 'bits'),
+    Reader('mics', _mics, 'of full scale, (4, samples)'),
 )}
 
 
 def read(key, msg):
     """The value of a message of the stream ``key``, or Refused saying why in one line."""
     return READERS[key].read(msg)
-
-
-def row_type(key):
-    """The ROS type ('pkg/msg/Name') of a reader's stream."""
-    return TOPIC[key].type
 
 
 def topic_of(key, topics=RobotTopics(), **fields):
