@@ -50,8 +50,8 @@ class Rig:
     def __init__(self, context, executor, overrides=(), robot=None, **kwargs):
         robot = robot or default_robot_name()
         # No use_sim_time: the node follows /clock by default.
-        self.node = ControllerHost(KICK_BLUE_BALL, context=context, parameter_overrides=list(overrides),
-                                 robot=robot, **kwargs)
+        self.node = ControllerHost(KICK_BLUE_BALL, context=context,
+                                   parameter_overrides=list(overrides), robot=robot, **kwargs)
         self.probe = rclpy.create_node('fake_sim', context=context)
         self.executor = executor
         self.twists, self.joints = [], []
@@ -126,8 +126,9 @@ class Rig:
     def cliff(self, values):
         before = self.node.readings['cliff'].stamp, sum(self.node.rejected.values())
         self.pub_cliff.publish(Float32MultiArray(data=list(values)))
-        self.wait_until(lambda: (self.node.readings['cliff'].stamp, sum(self.node.rejected.values()))
-                        != before, 'the node to take a cliff reading')
+        self.wait_until(lambda: (self.node.readings['cliff'].stamp,
+                                 sum(self.node.rejected.values())) != before,
+                        'the node to take a cliff reading')
 
     def last_twist(self):
         self.spin()
@@ -533,6 +534,19 @@ def test_steers_by_the_camera_info_model(make_rig):
     assert rig.node.state == 'approach'
     assert rig.last_twist()[1] == pytest.approx(DEFAULTS.steer_gain * math.radians(10),
                                                 abs=0.03)
+
+
+def test_joining_a_running_simulator_no_input_is_called_silent_from_time_zero(make_rig):
+    """A reading that came before the node's first /clock (node time 0) is not 26.5 s old
+    when the clock then says 26.5 s: silence counts from the node's first tick."""
+    rig = make_rig(Parameter('head_hold_s', value=0.0))
+    rig.cliff([1.0, 1.0])  # at node time 0: no /clock yet
+    assert rig.node.readings['cliff'].stamp == 0.0
+    rig.set_clock(26.5)
+    rig.advance(0.1)
+    assert rig.node.last_tick > 26.5 and rig.node.silent == []
+    rig.advance(1.0)  # nothing new since: now it is silence
+    assert RobotTopics(rig.node.robot).cliff in rig.node.silent
 
 
 def test_bad_parameter_is_refused(ros_context):

@@ -143,6 +143,7 @@ class ControllerHost(Node):
     last_action       the controller's latest Action (contract.Action)
     last_tick         node time (s) of the latest control tick, None before the first
     robot             the robot it drives: the last part of its namespace
+    silent            the inputs it warned were silent at its latest tick (topic names)
     detectors ([{name: detect}] per eye), detection_params, parts, pub_twist
 
     robot (a name) picks the namespace, as --robot does; a remapped __ns wins.
@@ -170,6 +171,7 @@ class ControllerHost(Node):
         self.last_command = None
         self.last_action = None
         self.state = STARTUP
+        self.silent = []
         self._warn = Throttled(self.get_logger().warning, WARN_EVERY_S)
         self._clock_watch = guard_clock(self, self._warn)
         self.eyes = [Latest() for _ in EYES]  # (frame, {detector: result}, stamp) of each eye
@@ -444,10 +446,12 @@ class ControllerHost(Node):
         watched = [(names.eye_compressed(eye), latest)
                    for eye, latest in zip(EYES, self.eyes)] + [(names.cliff,
                                                                  self.readings['cliff'])]
+        self.silent = []
         for name, latest in watched:
             since = max(latest.stamp if latest.stamp is not None else self._started,
                         self._started)
             if now - since > stale:
+                self.silent.append(name)
                 self._warn('silent ' + name, 'nothing on %s for %.1f s' % (name, now - since))
 
     def _publish_head(self, joints=None):
