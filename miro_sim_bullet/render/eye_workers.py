@@ -18,6 +18,7 @@ workers, view k to worker k mod n; results come back in the order jobs were sent
 import multiprocessing
 import subprocess
 import sys
+import time
 from multiprocessing.connection import Connection
 
 import cv2
@@ -27,6 +28,10 @@ from miro_sim_bullet.render.cameras import Cameras, LensPlans, through_lens
 from miro_sim_bullet.render.eye_images import draw_and_encode
 from miro_sim_bullet.render.gl_renderer import GlBackend
 from miro_sim_bullet.render.renderer import draw_rows
+
+# A worker drawing its last frame (0.3 s here on a loaded machine at 'tiny') may finish it;
+# the simulator's whole stop is to take less than a second.
+CLOSE_WAIT_S = 0.5
 
 
 class WorkerLost(RuntimeError):
@@ -169,19 +174,23 @@ class EyeWorkers:
             raise WorkerLost(f'eye worker {k} is gone ({_reason(exc)})') from None
 
     def close(self):
+        """Tell every worker to stop, and let go of the pipes at once: a worker blocked
+        sending frames nobody will read now gets a broken pipe and ends (waited for with the
+        pipes open, it ran out a 5 s bound: the simulator took 4.7 s to stop). One still
+        drawing after CLOSE_WAIT_S is killed: what it draws is not wanted any more."""
         for connection in self.connections:
             try:
                 connection.send(None)
             except (BrokenPipeError, OSError):
                 pass
+            connection.close()
+        deadline = time.monotonic() + CLOSE_WAIT_S
         for process in self.processes:
             try:
-                process.wait(timeout=5)
+                process.wait(timeout=max(0.0, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
-        for connection in self.connections:
-            connection.close()
         self.connections, self.processes = [], []
 
 
