@@ -53,7 +53,7 @@ def test_controller_parameters_at_run_time(ros_context, executor):
     node = rig.node
     try:
         def current(name):
-            for values in (node.config, node.detection_params, node._behaviour_params):
+            for values in node.values.values():
                 if hasattr(values, name):
                     return getattr(values, name)
         exercise(node, GROUPS, CONTROLLER_FIXED, current)
