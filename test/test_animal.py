@@ -104,6 +104,28 @@ def test_a_face_on_the_wall_is_noticed_and_looked_at(rig):
     assert any(stimulus.kind == 'face' for stimulus in rig.animal.stimuli)
 
 
+@pytest.mark.parametrize('side', [+1, -1], ids=['left', 'right'])
+def test_a_face_60_degrees_to_the_side_is_the_target_at_once_and_faced(rig, side):
+    """The den's face board 60 deg to one side, 1 m away, lands near the edge of one eye,
+    where the lens leans and stretches it (issue 39). It is found there, at the first looks
+    (before the idle head's sweep could bring it nearer an eye's middle), becomes the
+    target, and MiRo faces it; the ball behind and the tag board do not win."""
+    rig = rig('den')
+    face = (1.0, 0.0)
+    rig.robot.place(0.0, 0.0, math.radians(-60 * side))
+
+    def attending():
+        target = rig.animal.target
+        return target is not None and target.kind == 'face'
+    rig.advance()
+    assert bearing_error(rig.robot, face) > 55
+    rig.run(0.5, until=attending)  # two looks of each eye (face_every 6 at 15 frames/s)
+    assert attending(), rig.animal.target
+    rig.run(15.0, until=lambda: attending() and bearing_error(rig.robot, face) < 15)
+    assert attending() and bearing_error(rig.robot, face) < 15, (rig.animal.target,
+                                                                 rig.robot.pose())
+
+
 def test_a_loud_sound_behind_turns_it_round_and_arouses_it(rig):
     rig = rig(camera_rate=5.0)
     rig.sim.place_ball(*FAR)

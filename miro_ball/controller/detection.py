@@ -66,15 +66,17 @@ class DetectionParams:
                                                   'range': (2, 1000)})
     # The other detectors (sights.py), for controllers that ask for them.
     face_every: int = field(default=6, metadata={
-        'help': 'faces: look in one frame of this many per eye (a look costs ~25 ms)',
+        'help': 'faces: look in one frame of this many per eye (a look costs ~35 ms)',
         'range': (1, 100)})
-    face_scale_step: float = field(default=1.25, metadata={
+    face_scale_step: float = field(default=1.15, metadata={
         'help': 'faces: each size looked for is this much larger than the last (smaller '
                 'finds more, costs more)', 'range': (1.05, 2.0)})
-    face_width: int = field(default=320, metadata={
-        'help': 'faces: frames scaled down to this width first, px', 'range': (64, 1280)})
+    face_width: int = field(default=400, metadata={
+        'help': "faces: how fine the eye's level view is, as a 120 deg frame this many px "
+                'wide is at its centre', 'range': (64, 1280)})
     face_min_px: int = field(default=20, metadata={
-        'help': 'faces: the smallest face looked for, px at face_width', 'range': (12, 200)})
+        'help': 'faces: the smallest face looked for, px in the level view',
+        'range': (12, 200)})
     tag_width: int = field(default=640, metadata={
         'help': 'AprilTags: frames scaled down to this width first, px', 'range': (64, 1280)})
     motion_width: int = field(default=160, metadata={

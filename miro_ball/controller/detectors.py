@@ -35,16 +35,18 @@ def _ball(params):
     return lambda image, camera: detector.detect(image)
 
 
-def _sight(name):
+def _sight(name, with_camera=False):
     def factory(params):
         from miro_ball.controller import sights  # scikit-image only for who asks for faces
 
         detector = getattr(sights, name)(params)
+        if with_camera:
+            return detector.detect
         return lambda image, camera: detector.detect(image)
     return factory
 
 
 register('ball', _ball)
-register('face', _sight('FaceDetector'))
+register('face', _sight('FaceDetector', with_camera=True))
 register('tag', _sight('TagDetector'))
 register('motion', _sight('MotionDetector'))
