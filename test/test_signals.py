@@ -148,7 +148,9 @@ LONG_RUNNING = {
                       '{tmp}/mics.wav'], 'client_audio'),
     'client_stream': (['miro_ball.examples.client_stream', '--ahead', '4'], 'client_stream'),
     'client_drive_voice': (['miro_ball.examples.client_drive_voice'], 'client_drive_voice'),
-    'client_demo_config': (['miro_ball.examples.client_demo_config'], 'client_demo_config'),
+    # For a robot whose demo mode never answers (the GUI's would, and it would be done).
+    'client_demo_config': (['miro_ball.examples.client_demo_config', '--robot', 'nobody'],
+                           'client_demo_config'),
     'client_demo_interact': (['miro_ball.examples.client_demo_interact', 'show', '--seconds',
                               '3600'], 'client_demo_interact'),
     # With a demo mode started from its page (a child process of its own): below.
@@ -198,6 +200,8 @@ class Program:
 
     def stop(self):
         """One SIGINT; (exit code, seconds to exit, output, the descendants left running)."""
+        if self.proc.poll() is not None:  # a stop that was not the Ctrl+C's
+            return f'ended before its Ctrl+C ({self.proc.returncode})', 0.0, self.output(), []
         children = proc_tree.descendants(self.proc.pid)
         sent = time.monotonic()
         self.proc.send_signal(signal.SIGINT)
