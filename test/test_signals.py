@@ -358,3 +358,16 @@ def test_run_node_says_a_bad_start_in_one_line(own_signal_handlers, capsys):
     assert done.value.code == 2
     assert capsys.readouterr().err == "probe: error: no world 'nowhere'\n"
     assert not rclpy.ok()
+
+
+def test_the_fast_heartbeat_is_ours_unless_the_user_has_a_dds_profile_of_their_own():
+    from miro_ball.common.fast_acks import ENV, ENV_NEW, use_fast_acks
+
+    for theirs in ({ENV: '/their/profile.xml'}, {ENV_NEW: '/their/profile.xml'}):
+        environ = dict(theirs)
+        use_fast_acks(environ)
+        assert environ == theirs
+    environ = {}
+    use_fast_acks(environ)
+    assert '<heartbeatPeriod><sec>0</sec><nanosec>50000000</nanosec>' in \
+        Path(environ[ENV]).read_text()
