@@ -3,16 +3,14 @@ the simulator through each lens, is found by the face detector in every eye that
 whole, where it is; an eye that sees no face finds none."""
 import math
 
-import cv2
 import numpy as np
 import pytest
 
-from face_board import face_board_world, face_centre
+from miro_ball.bench.face_board import eye_frames, face_board_world, face_centre
 from miro_ball.controller.detection import DetectionParams
 from miro_ball.controller.sights import FaceDetector
 from miro_ball.miro.camera_model import CameraModel, LENSES
 from miro_sim_bullet.physics.world import SimWorld
-from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.scene.world_file import load_world
 
 SIZE = (640, 360)  # demo mode's eyes (the simulator's default)
@@ -24,19 +22,6 @@ AZIMUTH_TOLERANCE, ELEVATION_TOLERANCE = 2.0, 4.0
 @pytest.fixture(scope='module')
 def detector():
     return FaceDetector(DetectionParams(face_every=1))
-
-
-def eye_frames(world, lens):
-    """[(side, BGR frame, eye position, eye rotation)] of both eyes, the head at rest."""
-    camera = CameraModel(*SIZE, lens=lens)
-    world.run(0.3)
-    cameras = Cameras(world, 'auto')
-    try:
-        frames = cameras.render_eyes([(world.robot, +1), (world.robot, -1)], camera)
-    finally:
-        cameras.close()
-    return camera, [(side, cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR), *world.robot.eye_pose(side))
-                    for side, rgb in zip((+1, -1), frames)]
 
 
 def direction(vector):
@@ -59,8 +44,9 @@ def seen_at(sight, camera, rotation):
 def test_a_face_board_is_found_where_it_is_in_every_eye_that_sees_it(
         detector, tmp_path, lens, azimuth, distance):
     world = SimWorld(load_world(face_board_world(tmp_path, azimuth, distance)))
+    camera = CameraModel(*SIZE, lens=lens)
     try:
-        camera, frames = eye_frames(world, lens)
+        frames = eye_frames(world, camera)
     finally:
         world.close()
     centre = np.array(face_centre(azimuth, distance))
@@ -84,9 +70,10 @@ def test_no_face_is_found_where_there_is_none(detector, world_name, yaw_deg):
     """The den turned from its face board (its tag board and the ball in view), and the
     arena turned from its face poster (its logo panels in view)."""
     world = SimWorld(load_world(world_name))
+    camera = CameraModel(*SIZE)
     try:
         world.robot.place(0.0, 0.0, math.radians(yaw_deg))
-        camera, frames = eye_frames(world, 'pinhole')
+        frames = eye_frames(world, camera)
     finally:
         world.close()
     for side, frame, _, _ in frames:
@@ -98,8 +85,9 @@ def test_a_face_is_said_in_the_frame_of_any_size_the_camera_model_is_scaled_to(d
     """A camera model of another size than the frame (a camera_info of another resolution)
     is scaled to the frame: the same face, the same normalised place."""
     world = SimWorld(load_world(face_board_world(tmp_path, 60, 1.0)))
+    camera = CameraModel(*SIZE)
     try:
-        camera, frames = eye_frames(world, 'pinhole')
+        frames = eye_frames(world, camera)
     finally:
         world.close()
     frame = frames[0][1]

@@ -1,6 +1,9 @@
 """The den world's face board (a 0.4 m photographed face) anywhere around MiRo, facing it,
-for the tests that look for faces (test_faces, test_animal)."""
+and what MiRo's eyes see of it: for the face benchmark (face_bench.py) and the face tests
+(test_faces)."""
 import math
+
+import cv2
 
 BOARD_HEIGHT = 0.3  # m, the centre of the board and of its photo
 
@@ -12,8 +15,9 @@ def face_centre(azimuth_deg, distance):
 
 
 def face_board_world(folder, azimuth_deg, distance=1.0):
-    """Path of a world file (written in folder): the board azimuth_deg to MiRo's left
-    (negative: right), distance m from it, its photo turned to MiRo; the ball far away."""
+    """Path of a world file (written in folder, a pathlib.Path): the board azimuth_deg to
+    MiRo's left (negative: right), distance m from it, its photo turned to MiRo; the ball
+    far away."""
     x, y, _ = face_centre(azimuth_deg, distance)
     path = folder / f'face_{azimuth_deg:+g}deg_{distance:g}m.toml'
     path.write_text(f'''description = "a face board {azimuth_deg:g} deg left of MiRo, {distance:g} m"
@@ -35,3 +39,18 @@ picture_face = "-x"
 picture_size = [0.4, 0.45]
 ''')
     return str(path)
+
+
+def eye_frames(world, camera):
+    """[(side, BGR frame, eye position, eye rotation)] of both eyes of the world's robot
+    (side +1 left, -1 right) through a CameraModel, once the world has settled 0.3 s."""
+    from miro_sim_bullet.render.cameras import Cameras
+
+    world.run(0.3)
+    cameras = Cameras(world, 'auto')
+    try:
+        frames = cameras.render_eyes([(world.robot, +1), (world.robot, -1)], camera)
+    finally:
+        cameras.close()
+    return [(side, cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR), *world.robot.eye_pose(side))
+            for side, rgb in zip((+1, -1), frames)]
