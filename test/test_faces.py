@@ -8,6 +8,7 @@ import pytest
 
 from miro_ball.bench.face_board import eye_frames, face_board_world, face_centre
 from miro_ball.controller.detection import DetectionParams
+from miro_ball.controller.level_view import level_view, px_per_rad
 from miro_ball.controller.sights import FaceDetector
 from miro_ball.miro.camera_model import CameraModel, LENSES
 from miro_sim_bullet.physics.world import SimWorld
@@ -94,3 +95,11 @@ def test_a_face_is_said_in_the_frame_of_any_size_the_camera_model_is_scaled_to(d
     face, = detector.detect(frame, camera)
     other, = detector.detect(frame, camera.scaled_to(1280, 720))
     assert other == face
+
+
+def test_the_level_view_is_made_once_per_camera_model_and_scale():
+    """Its maps are made once: every frame of an eye (a new but equal camera model each
+    time, as the controller host makes them) reuses them."""
+    first = level_view(CameraModel(*SIZE), px_per_rad(400))
+    assert level_view(CameraModel(*SIZE), px_per_rad(400)) is first
+    assert level_view(CameraModel(*SIZE, lens='miro'), px_per_rad(400)) is not first

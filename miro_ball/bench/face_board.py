@@ -2,6 +2,7 @@
 and what MiRo's eyes see of it: for the face benchmark (face_bench.py) and the face tests
 (test_faces)."""
 import math
+import sys
 
 import cv2
 
@@ -43,11 +44,12 @@ picture_size = [0.4, 0.45]
 
 def eye_frames(world, camera):
     """[(side, BGR frame, eye position, eye rotation)] of both eyes of the world's robot
-    (side +1 left, -1 right) through a CameraModel, once the world has settled 0.3 s."""
+    (side +1 left, -1 right) through a CameraModel, once the world has settled 0.3 s (the
+    renderer's name to stderr, off the benchmark's table)."""
     from miro_sim_bullet.render.cameras import Cameras
 
     world.run(0.3)
-    cameras = Cameras(world, 'auto')
+    cameras = Cameras(world, 'auto', log=lambda line: print(line, file=sys.stderr))
     try:
         frames = cameras.render_eyes([(world.robot, +1), (world.robot, -1)], camera)
     finally:

@@ -66,7 +66,7 @@ class DetectionParams:
                                                   'range': (2, 1000)})
     # The other detectors (sights.py), for controllers that ask for them.
     face_every: int = field(default=6, metadata={
-        'help': 'faces: look in one frame of this many per eye (a look costs ~35 ms)',
+        'help': 'faces: look in one frame of this many per eye (a look costs ~30 ms)',
         'range': (1, 100)})
     face_scale_step: float = field(default=1.15, metadata={
         'help': 'faces: each size looked for is this much larger than the last (smaller '
