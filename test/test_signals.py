@@ -148,8 +148,8 @@ LONG_RUNNING = {
                       '{tmp}/mics.wav'], 'client_audio'),
     'client_stream': (['miro_ball.examples.client_stream', '--ahead', '4'], 'client_stream'),
     'client_drive_voice': (['miro_ball.examples.client_drive_voice'], 'client_drive_voice'),
-    # For a robot whose demo mode never answers (the GUI's would, and it would be done).
-    'client_demo_config': (['miro_ball.examples.client_demo_config', '--robot', 'nobody'],
+    # For a robot with no demo mode to answer (the GUI's would, and it would be done).
+    'client_demo_config': (['miro_ball.examples.client_demo_config', '--robot', 'unanswered'],
                            'client_demo_config'),
     'client_demo_interact': (['miro_ball.examples.client_demo_interact', 'show', '--seconds',
                               '3600'], 'client_demo_interact'),
@@ -222,8 +222,9 @@ def installed_console_scripts():
             if ep.value.startswith(('miro_ball.', 'miro_sim_bullet.'))}
 
 
-def wait_for_nodes(ros_context, names):
-    """Until each node name is on the graph as often as names holds it (a hang guard only)."""
+def wait_for_nodes(ros_context, names, programs):
+    """Until each node name is on the graph as often as names holds it (a hang guard only),
+    every one of programs still running."""
     import rclpy
 
     watcher = rclpy.create_node('stop_test_watcher', context=ros_context)
@@ -231,6 +232,8 @@ def wait_for_nodes(ros_context, names):
         deadline = time.monotonic() + UP_GUARD_S
         while missing := names - collections.Counter(
                 name for name, _ in watcher.get_node_names_and_namespaces()):
+            ended = {p.name: p.output()[-500:] for p in programs if p.proc.poll() is not None}
+            assert not ended, f'ended before all were up: {ended}'
             assert time.monotonic() < deadline, f'never on the graph: {dict(missing)}'
             time.sleep(0.2)
     finally:
@@ -282,7 +285,7 @@ def test_every_program_ends_within_a_second_of_one_ctrl_c_taking_its_children(
         start_demo_mode(gui_url)
         # Each program's node, and demo mode's once more: the one the GUI started.
         wait_for_nodes(ros_context, collections.Counter(
-            [node for _, node in LONG_RUNNING.values()] + ['miro_animal']))
+            [node for _, node in LONG_RUNNING.values()] + ['miro_animal']), programs.values())
         gui_children = proc_tree.descendants(programs['miro_gui'].proc.pid)
         for name in [*programs][1:] + ['miro_sim']:
             results[name] = programs[name].stop()
