@@ -29,9 +29,10 @@ from miro_sim_bullet.render.eye_images import draw_and_encode
 from miro_sim_bullet.render.gl_renderer import GlBackend
 from miro_sim_bullet.render.renderer import draw_rows
 
-# A worker drawing its last frame (0.3 s here on a loaded machine at 'tiny') may finish it;
-# the simulator's whole stop is to take less than a second.
-CLOSE_WAIT_S = 0.5
+# A worker that is not done by then is killed: it holds nothing that outlives it (its GL
+# context and PyBullet copy go with the process), and finishing its frame and closing its
+# drawer took 0.2-0.5 s on a loaded machine, half of the simulator's second to stop.
+CLOSE_WAIT_S = 0.1
 
 
 class WorkerLost(RuntimeError):
