@@ -48,3 +48,12 @@ def test_interface_text_expands_nested_types_a_tab_in():
     assert 'std_msgs/Header header' in lines and '\t\tint32 sec' in lines
     with pytest.raises(ValueError, match='not a type name'):
         expanded('twist')
+
+
+def test_values_nested_deeper_than_any_message_are_refused_as_they_are_read():
+    from miro_ball.ros2.convert import MAX_DEPTH
+
+    assert parse_yaml('{a: ' + '[' * (MAX_DEPTH - 1) + ']' * (MAX_DEPTH - 1) + '}')
+    for depth in (MAX_DEPTH, 5000):
+        with pytest.raises(ValueError, match='nested too deeply'):
+            parse_yaml('{a: ' + '[' * depth + ']' * depth + '}')

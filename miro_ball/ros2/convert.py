@@ -16,6 +16,7 @@ import numpy as np
 import yaml
 
 TRUNCATE = 128  # ros2 topic echo's default --truncate-length
+MAX_DEPTH = 100  # nesting of a YAML value: a message nests a few levels, never this many
 
 
 def is_message(value):
@@ -57,14 +58,28 @@ def has_alias(text):
     return any(isinstance(event, yaml.AliasEvent) for event in yaml.parse(text))
 
 
+def _check_events(text):
+    """ValueError for aliases, or for nesting deeper than any message has, seen as the text
+    is read: 5000 brackets cost PyYAML 6 s of CPU before it ran out of recursion."""
+    depth = 0
+    for event in yaml.parse(text):
+        if isinstance(event, yaml.AliasEvent):
+            raise ValueError('the values use YAML aliases (*name): write the values out')
+        if isinstance(event, yaml.CollectionStartEvent):
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise ValueError('the values are nested too deeply')
+        elif isinstance(event, yaml.CollectionEndEvent):
+            depth -= 1
+
+
 def parse_yaml(text):
     """A dict from the YAML (or '') of ros2 topic pub / service call; ValueError if not.
 
     No anchors or aliases (& and *): 270 bytes of aliases nine deep expand to billions of
     values (a MemoryError after 40 s); a message's fields never need them."""
     try:
-        if has_alias(text):
-            raise ValueError('the values use YAML aliases (*name): write the values out')
+        _check_events(text)
         data = yaml.safe_load(text) if text.strip() else {}
     except yaml.YAMLError as err:
         mark = getattr(err, 'problem_mark', None)
