@@ -2,8 +2,8 @@
 # One entry point for a new user: sets up .venv (and, as root, the Debian
 # packages) on first use, then runs what was asked.
 #   ./dev.sh lab [args]    the lab, headless: simulator + controller, summary and video
-#   ./dev.sh test [args]   the test suite (pytest); no args: every tier once, two test files at
-#                          a time, as robot miro02; -m unit: the quick tier
+#   ./dev.sh test [args]   the test suite (pytest); no args: every tier once, three test files
+#                          at a time, as robot miro02; -m unit: the quick tier
 #   ./dev.sh bench         simulator, detection and scenario benchmarks
 #   ./dev.sh soak [args]   long free run: memory, open files, speed per minute (--minutes N)
 #   ./dev.sh setup         only the set-up
@@ -76,8 +76,9 @@ case "$cmd" in
     if [ $# -gt 0 ]; then exec "$PY" -m pytest "$@"; fi
     # Every tier once, under a robot name other than the default (the MDK's multi-robot
     # convention), so that no test or node leans on the name 'miro'; a test file's tests
-    # run in one process (each on a ROS domain of its own), TEST_JOBS files at a time.
-    MIRO_ROBOT_NAME=miro02 exec "$PY" -m pytest -n "${TEST_JOBS:-2}" --dist loadfile \
+    # run in one process (each on a ROS domain of its own), TEST_JOBS files at a time: three
+    # on two cores, as the tests wait on processes and discovery about as much as they compute.
+    MIRO_ROBOT_NAME=miro02 exec "$PY" -m pytest -n "${TEST_JOBS:-3}" --dist loadfile \
       --durations=15 ;;
   bench) setup; exec "$PY" -m miro_ball.bench.sim_bench "$@" ;;
   soak) setup; exec "$PY" -m miro_ball.bench.soak "$@" ;;

@@ -6,6 +6,11 @@ import subprocess
 import time
 
 import rclpy
+from rclpy.executors import ShutdownException, TimeoutException
+
+from miro_ball.miro.constants import PLATFORM_TICK_S
+
+IDLE_LOOKS = 3  # drain: looks in a row that find nothing before it stops looking
 
 
 def spin_until(executor, predicate, timeout_s=10.0, what=None):
@@ -34,12 +39,30 @@ def _source(predicate):
         return repr(predicate)
 
 
-def drain(executor, rounds=50):
-    """Deliver what is already queued (no waiting beyond a few empty spins), between the
-    ticks of a world a test steps. It says nothing of what arrived: a test that relies on a
-    message's arrival waits for it with spin_until."""
+def drain(executor, rounds=50, idle=IDLE_LOOKS):
+    """Deliver what is already queued (no waiting beyond a few empty looks), between the
+    ticks of a world a test steps: at most ``rounds`` callbacks, ending after ``idle`` looks
+    in a row that found nothing. It says nothing of what arrived: a test that relies on a
+    message's arrival waits for it with spin_until.
+
+    Each look builds a wait set of every entity of every node (the simulator has dozens):
+    30 empty spin_once() a tick were most of a stepped test's time, and kept a core busy
+    while a child process was still starting."""
+    empty = 0
     for _ in range(rounds):
-        executor.spin_once(timeout_sec=0)
+        try:
+            handler, _, _ = executor.wait_for_ready_callbacks(timeout_sec=0)
+        except TimeoutException:
+            empty += 1
+            if empty >= idle:
+                return
+            continue
+        except ShutdownException:
+            return
+        empty = 0
+        handler()
+        if handler.exception() is not None:
+            raise handler.exception()
 
 
 def advance_ticks(sim_node, executor, count=1, rounds=30):
@@ -50,13 +73,26 @@ def advance_ticks(sim_node, executor, count=1, rounds=30):
         drain(executor, rounds=rounds)
 
 
+PACE_RTF = 2.0  # advance_until's world runs at most this many times faster than the wall
+
+
 def advance_until(sim_node, executor, predicate, timeout_s=60.0):
     """Step an in-process simulator tick by tick until predicate() holds (e.g. a child
-    process has done its job); the wall-clock limit only guards against a hang."""
-    deadline = time.monotonic() + timeout_s
+    process has done its job); the wall-clock limit only guards against a hang.
+
+    At most PACE_RTF times real time, the rest of each tick's share spent handling what
+    arrives: a child that is still starting (seconds of discovery) needs no simulated
+    time, and a world raced meanwhile kept a core busy that the suite's other tests need."""
+    start = time.monotonic()
+    deadline = start + timeout_s
+    ticks = 0
     while not predicate():
         assert time.monotonic() < deadline, 'timed out'
         advance_ticks(sim_node, executor)
+        ticks += 1
+        due = start + ticks * PLATFORM_TICK_S / PACE_RTF
+        while (ahead := due - time.monotonic()) > 0:
+            executor.spin_once(timeout_sec=ahead)
 
 
 def run_command(cmd, timeout_s=300):
