@@ -11,7 +11,8 @@ client then prints the switches that are on (core/config/state) and exits.
     python -m miro_ball.examples.client_demo_config v T        # voice and tail toggled
     python -m miro_ball.examples.client_demo_config --set trnsFB   # only these on
 
-The same switches are demo mode's ROS parameters (voice, tail, ...): ros2 param set works.
+The same switches are demo mode's ROS parameters (flags.voice, flags.tail, ...): ros2 param
+set works.
 """
 import argparse
 import sys
