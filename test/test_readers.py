@@ -45,7 +45,7 @@ def test_every_reader_is_a_sensor_stream_with_units():
         assert TOPIC[key].direction == SENSOR and reader.units, key
 
 
-def test_the_robot_object_and_the_gui_read_through_the_readers():
+def test_the_robot_object_reads_through_the_readers_as_the_gui_does():
     """Fed +inf, neither complains and both say nothing is in range; fed NaN, both say so
     and keep the last good value."""
     from miro_ball.gui.robot_part import READOUTS
@@ -78,7 +78,8 @@ def test_the_gui_reads_inf_sonar_as_nothing_in_range(ros_context):
     from miro_ball.gui.robot_part import READOUTS, RobotPart
 
     warnings = []
-    part = RobotPart('miro02', context=ros_context, frames=FrameStore(warn=lambda *a: None, on_frame=lambda *a: None),
+    frames = FrameStore(warn=lambda *a: None, on_frame=lambda *a: None)
+    part = RobotPart('miro02', context=ros_context, frames=frames,
                      warn=lambda key, text: warnings.append(text),
                      tell_pages=lambda robot, text: None)
     try:

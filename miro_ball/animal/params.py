@@ -2,8 +2,8 @@
 
 Numbers are the MDK demo's where it has one (the MDK's ``miro2.core`` demo controller and its
 ``pars.py``; described publicly in Consequential Robotics' "Biomimetic core" page,
-https://consequential.bitbucket.io/Technical_Biomimetic_Core.html), restated in seconds and SI units: the MDK counts 50 Hz ticks, we count seconds so a
-change of tick keeps the behaviour. Where the MDK has no number (or its model is not
+https://consequential.bitbucket.io/Technical_Biomimetic_Core.html), restated in seconds and SI
+units: the MDK counts 50 Hz ticks, we count seconds so a change of tick keeps the behaviour. Where the MDK has no number (or its model is not
 ours) the value is our own and its help says what it does.
 """
 import math

@@ -2,8 +2,8 @@
 
 The basal ganglia (the MDK's model, ours in code): every action's priority, with a little
 noise (up to +- selection_noise), competes; the winner is disinhibited (its inhibition 0,
-every other's 1) and drives the body. The running action gets a bonus (hysteresis), so two actions of nearly
-equal priority do not take turns every tick, and it keeps running for min_duration_s
+every other's 1) and drives the body. The running action gets a bonus (hysteresis), so two
+actions of nearly equal priority do not take turns every tick, and it keeps running for min_duration_s
 unless a challenger reaches the uninterruptable priority 1.
 
 A selector is any class built as ``Class(params, rng)`` (params: ActionParams, rng: a

@@ -9,8 +9,9 @@ TwistStamped). Each eye's pinhole model comes from its camera_info (MiRo's simul
 deg eye until one arrives), so bearings stay right whatever field of view the camera has.
 
 What it hosts is described by a ``Hosted`` (hosted.py): kick_blue_ball's family
-(controller/kick_blue_ball.py) and demo mode (animal/demo_mode.py). Their parameters are declared as
-their groups say, change live, and a value that does not fit is refused in one line.
+(controller/kick_blue_ball.py) and demo mode (animal/demo_mode.py). Their parameters are
+declared as their groups say, change live, and a value that does not fit is refused in one
+line.
 
 The node lives in its robot's namespace and uses relative names, so
 ``--ros-args -r __ns:=/miro02`` (or ``--robot miro02``, or $MIRO_ROBOT_NAME) makes it
@@ -70,15 +71,11 @@ ACTED = {'wheels': 'cmd_vel', 'head': 'kinematic_targets', 'cosmetic': 'cosmetic
          'illum': 'illum', 'tone': 'tone', 'stream': 'stream'}
 
 
-def _row_topic(key, **fields):
-    return RobotTopics().topic(TOPIC[key].name.format(**fields))
-
-
 def _uses(key, purpose, **fields):
     """One row of the interface table as the host uses it."""
     row = TOPIC[key]
-    return _row_topic(key, **fields), row.type, 'in' if row.direction == SENSOR else 'out', \
-        purpose
+    way = 'in' if row.direction == SENSOR else 'out'
+    return RobotTopics().row(key, **fields), row.type, way, purpose
 
 
 def topics(hosted=None):
@@ -186,17 +183,18 @@ class ControllerHost(Node):
 
         eyes = profile(EYE_QOS)
         for eye, cam in enumerate(EYES):
-            self.create_subscription(CompressedImage, _row_topic('eye_compressed', eye=cam),
+            self.create_subscription(CompressedImage, RobotTopics().row('eye_compressed', eye=cam),
                                      partial(self._on_image, eye), eyes)
-            self.create_subscription(CameraInfo, _row_topic('camera_info', eye=cam),
+            self.create_subscription(CameraInfo, RobotTopics().row('camera_info', eye=cam),
                                      partial(self._on_camera_info, eye), eyes)
         for field, (key, fields) in SENSED.items():
-            self.create_subscription(message_class(TOPIC[key].type), _row_topic(key, **fields),
-                                     partial(self._on_reading, field, key),
+            topic = RobotTopics().row(key, **fields)
+            self.create_subscription(message_class(TOPIC[key].type), topic,
+                                     partial(self._on_reading, field, key, topic),
                                      profile(TOPIC[key].qos))
         self.pub_twist, self.pub_joints, self.pub_cosmetic, self.pub_illum, self.pub_tone, \
             self.pub_stream = (
-                self.create_publisher(message_class(TOPIC[key].type), _row_topic(key),
+                self.create_publisher(message_class(TOPIC[key].type), RobotTopics().row(key),
                                       profile(TOPIC[key].qos)) for key in ACTED.values())
         self._listen()
         self.pub_debug = [self.create_publisher(CompressedImage, DEBUG_TOPIC.format(eye=cam),
@@ -257,7 +255,7 @@ class ControllerHost(Node):
         hears = getattr(self.controller, 'hears', False)
         if hears and self._mics is None:
             self._mics = self.create_subscription(
-                Int16MultiArray, _row_topic('mics'), self._on_mics, profile(TOPIC['mics'].qos))
+                Int16MultiArray, RobotTopics().mics, self._on_mics, profile(TOPIC['mics'].qos))
         elif not hears and self._mics is not None:
             self.destroy_subscription(self._mics)
             self._mics = None
@@ -344,11 +342,11 @@ class ControllerHost(Node):
                                       camera.distortion_model, 2 * math.degrees(edge)))
         self.cameras[eye] = camera
 
-    def _on_reading(self, field, key, msg):
+    def _on_reading(self, field, key, topic, msg):
         try:
             value = read(key, msg)
         except Refused as err:
-            return self.reject(key, '%s: %s' % (_row_topic(key, **SENSED[field][1]), err))
+            return self.reject(key, '%s: %s' % (topic, err))
         self.readings[field].set(self._seconds(), value)
 
     def _on_mics(self, msg):
@@ -356,7 +354,7 @@ class ControllerHost(Node):
         try:
             window = read('mics', msg)
         except Refused as err:
-            return self.reject('mics', '%s: %s' % (_row_topic('mics'), err))
+            return self.reject('mics', '%s: %s' % (RobotTopics().row('mics'), err))
         joints = self.readings['joints'].value or KIN_CALIB_RAD
         heard = locate(window, joints)
         if heard is not None:

@@ -15,8 +15,9 @@ and publishes its Action. A kind of controller tells the host, through a ``Hoste
                              the same one reconfigured, or a new one
     describe(values)         a few words for the start-up log line
 
-kick_blue_ball's family (controller/kick_blue_ball.py) and demo mode (animal/demo_mode.py) are both kinds
-hosted this way; the learning environments build the same controllers without a host.
+kick_blue_ball's family (controller/kick_blue_ball.py) and demo mode (animal/demo_mode.py)
+are both kinds hosted this way; the learning environments build the same controllers without
+a host.
 """
 from dataclasses import dataclass, fields
 from typing import Any, Callable, Tuple
@@ -24,7 +25,7 @@ from typing import Any, Callable, Tuple
 from miro_ball.common.ros_params import group_of
 
 # What the host itself reads from a kind's first group.
-HOST_FIELDS = ('tick', 'stale_s', 'head_hold_s', 'head_lift_deg')
+HOST_FIELDS = ('tick', 'stale_s', 'head_hold_s', 'head_lift_deg', 'save_debug_keep')
 
 
 @dataclass(frozen=True)

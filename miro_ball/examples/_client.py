@@ -30,7 +30,7 @@ from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import (CLOCK, CONTROL_QOS, DEFAULT_ROBOT_NAME, EYE_QOS, EYES,
                                       MIC_QOS, robot_name, robot_namespace, robot_of_namespace,
                                       RobotTopics, SENSOR_QOS)
-from miro_ball.miro.readers import read, Refused, topic_of
+from miro_ball.miro.readers import read, Refused
 from miro_ball.miro.rotations import yaw_of
 
 SILENCE_NOTICE_S = 5.0  # wall seconds without the robot before a client says so
@@ -171,7 +171,7 @@ class Client(Node):
         try:
             return read(key, msg)
         except Refused as err:
-            self.warn(key, f'{topic_of(key, self.topics, **fields)} ignored: {err}')
+            self.warn(key, f'{self.topics.row(key, **fields)} ignored: {err}')
             return None
 
     def advertise(self, msg_type, topic, qos=CONTROL_QOS):

@@ -27,7 +27,7 @@ from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import JOINT_NAMES
 from miro_ball.miro.interface import CONTROL_QOS, CORE_TOPIC, EYE_QOS, EYES, MIC_QOS, \
     RobotTopics, SENSOR_QOS, TOPIC
-from miro_ball.miro.readers import read, Refused, topic_of
+from miro_ball.miro.readers import read, Refused
 
 NODE_NAME = 'miro_gui'
 DEADMAN_S = 0.3  # a drive command not refreshed for this long becomes a stop
@@ -71,7 +71,7 @@ READOUTS = (
 def _package_field(key, fields):
     """The field of a sensors/package that holds a readout's message: its topic's name
     (sensors/battery -> battery, sensors/imu_body -> imu_body)."""
-    return topic_of(key, **fields).split('/', 1)[1]
+    return RobotTopics().row(key, **fields).split('/', 1)[1]
 
 
 # The page's commands that become one message on one of MiRo's control topics:
@@ -127,7 +127,7 @@ class RobotPart(Node):
         except ValueError:  # miro2_msg is not built: the separate topics
             self._sensor_subs = [
                 self.create_subscription(message_class(TOPIC[key].type),
-                                         topic_of(key, **fields),
+                                         self.topics.row(key, **fields),
                                          partial(self._take_readouts, [row]),
                                          profile(TOPIC[key].qos))
                 for row in READOUTS for key, fields, _ in [row]]
@@ -270,7 +270,8 @@ class RobotPart(Node):
             try:
                 self.values.update(readout(read(key, part)))
             except (Refused, AttributeError) as err:  # garbage from the graph
-                self.warn('sensor', f'{self.robot}: {topic_of(key, **fields)} ignored: {err}')
+                self.warn('sensor',
+                          f'{self.robot}: {self.topics.row(key, **fields)} ignored: {err}')
                 continue
             took = True
         if took:

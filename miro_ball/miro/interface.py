@@ -273,7 +273,8 @@ class RobotTopics:
     def topic(self, relative):
         return relative if self.name is None else f'/{self.name}/{relative}'
 
-    def _row(self, key, **fields):
+    def row(self, key, **fields):
+        """The topic of the interface row ``key``, its placeholders filled from fields."""
         return self.topic(TOPIC[key].name.format(**fields))
 
     def core(self, key, **fields):
@@ -282,21 +283,21 @@ class RobotTopics:
 
     # Sensors: what the robot (or the simulator standing in for it) publishes.
     def eye_compressed(self, eye):
-        return self._row('eye_compressed', eye=eye)
+        return self.row('eye_compressed', eye=eye)
 
     def eye_raw(self, eye):
-        return self._row('eye_raw', eye=eye)
+        return self.row('eye_raw', eye=eye)
 
     def camera_info(self, eye):
-        return self._row('camera_info', eye=eye)
+        return self.row('camera_info', eye=eye)
 
     def imu(self, part):
         """part: 'body' or 'head'."""
-        return self._row('imu', part=part)
+        return self.row('imu', part=part)
 
     def touch(self, part):
         """part: 'head' or 'body'."""
-        return self._row('touch', part=part)
+        return self.row('touch', part=part)
 
     def all(self, direction=None):
         """Every topic name of the interface (only SENSOR's or CONTROL's if direction is

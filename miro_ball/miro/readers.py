@@ -19,7 +19,7 @@ from typing import Any, Callable, NamedTuple
 from miro_ball.common.checks import finite_values
 from miro_ball.miro.constants import JOINT_POSITIONS
 from miro_ball.miro.hearing import mic_window
-from miro_ball.miro.interface import RobotTopics, SENSOR, TOPIC
+from miro_ball.miro.interface import SENSOR, TOPIC
 from miro_ball.miro.rotations import yaw_of
 
 NOTHING_IN_RANGE = math.inf  # the sonar's reading when no echo comes back (REP 117)
@@ -139,11 +139,6 @@ READERS = {reader.key: reader for reader in (
 def read(key, msg):
     """The value of a message of the stream ``key``, or Refused saying why in one line."""
     return READERS[key].read(msg)
-
-
-def topic_of(key, topics=RobotTopics(), **fields):
-    """A reader's topic name (relative by default; {part} filled from fields)."""
-    return topics.topic(TOPIC[key].name.format(**fields))
 
 
 def _check_table():

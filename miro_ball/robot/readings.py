@@ -1,8 +1,8 @@
 """What a Robot hears: the latest of each sensor, checked, and the eyes' latest frames.
 
-Each topic's message is turned into plain Python values as it arrives (miro.readers); a message that
-does not make sense (wrong length, NaN, a JPEG that does not decode) is dropped with a
-rate-limited warning and the last good value stays.
+Each topic's message is turned into plain Python values as it arrives (miro.readers); a
+message that does not make sense (wrong length, NaN, a JPEG that does not decode) is dropped
+with a rate-limited warning and the last good value stays.
 """
 from dataclasses import dataclass
 from typing import Optional, Tuple
@@ -14,7 +14,7 @@ from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.messages import message_class
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import EYE_QOS, EYES, RobotTopics, TOPIC
-from miro_ball.miro.readers import Pose, read, Refused, topic_of
+from miro_ball.miro.readers import Pose, read, Refused
 
 __all__ = ['Eyes', 'Pose', 'READINGS', 'Readings', 'Sensors']
 
@@ -58,9 +58,9 @@ class Readings:
         self.count = dict.fromkeys(READINGS, 0)
         for name, (key, fields) in READINGS.items():
             row = TOPIC[key]
-            connection.subscribe(message_class(row.type), topic_of(key, **fields), row.qos,
-                                 self._taker(name, key, topic_of(key, **fields),
-                                             connection.warn))
+            topic = RobotTopics().row(key, **fields)
+            connection.subscribe(message_class(row.type), topic, row.qos,
+                                 self._taker(name, key, topic, connection.warn))
 
     def _taker(self, name, key, topic, warn):
         def take(msg):
