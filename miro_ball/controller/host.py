@@ -48,7 +48,7 @@ from miro_ball.miro.hearing import locate
 from miro_ball.miro.interface import (CLOCK, EYE_QOS, EYES, robot_namespace,
                                       robot_of_namespace, RobotTopics, SENSOR, TOPIC)
 from miro_ball.miro.kinematics import clamp_wheel_speeds, wheel_speed2cmd_vel
-from miro_ball.miro.readers import read, Refused
+from miro_ball.miro.readers import PERCEPT_READINGS, read, Refused
 
 SIDES = ('left', 'right')  # of EYES, in order
 STARTUP = 'startup'
@@ -57,15 +57,6 @@ NO_CLOCK_NOTICE_S = 5.0  # wall seconds
 MAX_FRAME_SIDE = max(max(size) for size in FRAME_SIZES)
 FRAMES_KEPT = 500  # frame lags kept (a benchmark's window)
 
-# The Percepts' readings: field -> (reader and interface row, fields of its topic name).
-SENSED = {
-    'cliff': ('cliff', {}),
-    'sonar': ('sonar', {}),
-    'light': ('light', {}),
-    'joints': ('kinematic_joints', {}),
-    'touch_head': ('touch', {'part': 'head'}),
-    'touch_body': ('touch', {'part': 'body'}),
-}
 # The Action's fields: the control topic each goes out on.
 ACTED = {'wheels': 'cmd_vel', 'head': 'kinematic_targets', 'cosmetic': 'cosmetic_joints',
          'illum': 'illum', 'tone': 'tone', 'stream': 'stream'}
@@ -86,7 +77,8 @@ def topics(hosted=None):
         used += [_uses('eye_compressed', side + ' eye, JPEG', eye=eye),
                  _uses('camera_info', '%s eye camera model, lens included (until one '
                        'arrives: %g deg pinhole)' % (side, CAM_HFOV_DEG_SIM), eye=eye)]
-    used += [_uses(key, 'percepts.' + field, **fields) for field, (key, fields) in SENSED.items()]
+    used += [_uses(key, 'percepts.' + field, **fields)
+             for field, (key, fields) in PERCEPT_READINGS.items()]
     used.append(_uses('mics', 'percepts.sound (for a controller that hears)'))
     used += [_uses(key, 'action.' + field) for field, key in ACTED.items()]
     used += [(DEBUG_TOPIC.format(eye=eye), TOPIC['eye_compressed'].type, 'out',
@@ -172,7 +164,7 @@ class ControllerHost(Node):
         self._warn = Throttled(self.get_logger().warning, WARN_EVERY_S)
         self._clock_watch = guard_clock(self, self._warn)
         self.eyes = [Latest() for _ in EYES]  # (frame, {detector: result}, stamp) of each eye
-        self.readings = {field: Latest() for field in list(SENSED) + ['sound']}
+        self.readings = {field: Latest() for field in list(PERCEPT_READINGS) + ['sound']}
         self._mics = None  # the microphones' subscription, while the controller hears
         self.mic_blocks = 0  # microphone blocks taken in
         self.frame_lags = deque(maxlen=FRAMES_KEPT)  # node time - stamp of the latest frames
@@ -187,7 +179,7 @@ class ControllerHost(Node):
                                      partial(self._on_image, eye), eyes)
             self.create_subscription(CameraInfo, RobotTopics().row('camera_info', eye=cam),
                                      partial(self._on_camera_info, eye), eyes)
-        for field, (key, fields) in SENSED.items():
+        for field, (key, fields) in PERCEPT_READINGS.items():
             topic = RobotTopics().row(key, **fields)
             self.create_subscription(message_class(TOPIC[key].type), topic,
                                      partial(self._on_reading, field, key, topic),

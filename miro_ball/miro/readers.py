@@ -136,6 +136,18 @@ READERS = {reader.key: reader for reader in (
 )}
 
 
+# The body readings a controller's Percepts hold: field -> (reader and interface row, fields
+# of its topic name). The controller host and the Robot object read these.
+PERCEPT_READINGS = {
+    'cliff': ('cliff', {}),
+    'sonar': ('sonar', {}),
+    'light': ('light', {}),
+    'joints': ('kinematic_joints', {}),
+    'touch_head': ('touch', {'part': 'head'}),
+    'touch_body': ('touch', {'part': 'body'}),
+}
+
+
 def read(key, msg):
     """The value of a message of the stream ``key``, or Refused saying why in one line."""
     return READERS[key].read(msg)

@@ -14,7 +14,7 @@ from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.messages import message_class
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import EYE_QOS, EYES, RobotTopics, TOPIC
-from miro_ball.miro.readers import Pose, read, Refused
+from miro_ball.miro.readers import PERCEPT_READINGS, Pose, read, Refused
 
 __all__ = ['Eyes', 'Pose', 'READINGS', 'Readings', 'Sensors']
 
@@ -37,17 +37,9 @@ class Sensors:
     battery: Optional[float] = None
 
 
-# What the robot reads: name -> (the reader and interface row, fields of its topic name).
-READINGS = {
-    'pose': ('body_pose', {}),
-    'joints': ('kinematic_joints', {}),
-    'cliff': ('cliff', {}),
-    'sonar': ('sonar', {}),
-    'light': ('light', {}),
-    'touch_head': ('touch', {'part': 'head'}),
-    'touch_body': ('touch', {'part': 'body'}),
-    'battery': ('battery', {}),
-}
+# What the robot reads: name -> (the reader and interface row, fields of its topic name): the
+# controller's percepts and where it is and its battery.
+READINGS = {'pose': ('body_pose', {}), **PERCEPT_READINGS, 'battery': ('battery', {})}
 
 
 class Readings:
