@@ -246,14 +246,19 @@ def wait_for_nodes(ros_context, names, programs):
 
 
 def start_demo_mode(gui_url):
-    """What the GUI page's "demo mode" switch sends."""
+    """What the GUI page's "demo mode" switch sends; the page stays until the GUI's state
+    says demo mode runs (a page that closed at once could go before its command was read)."""
     import json
 
     from websockets.sync.client import connect
 
     with connect(gui_url.replace('http://', 'ws://') + 'ws', open_timeout=30) as page:
         page.send(json.dumps({'t': 'demo_run', 'run': True}))
-        time.sleep(0.5)  # a page that closes at once may go before its command is read
+        deadline = time.monotonic() + UP_GUARD_S  # a hang guard only
+        while True:
+            message = page.recv(timeout=max(0.0, deadline - time.monotonic()))
+            if isinstance(message, str) and json.loads(message).get('demo_running'):
+                return
 
 
 def test_every_long_running_console_script_is_tested_for_its_stop():
