@@ -31,9 +31,11 @@ setup(
         'setuptools',
         'aiohttp',  # miro_gui's web server
         'foxglove-sdk',  # python -m miro_ball.foxglove: the live graph for the Foxglove app
+        'gymnasium>=1.0',  # miro_ball.learn: the learning environments
         'moderngl',  # the eye renderer (OpenGL on a headless EGL context)
         'numpy',
         'opencv-python-headless',
+        'pettingzoo>=1.24',  # miro_ball.learn's several-robot environments
         'psutil',  # process trees: the grader's commands, the soak, memory figures
         'pybullet',
         'rosbags',  # rosbag2 (MCAP) recording without a ROS install
@@ -68,8 +70,11 @@ setup(
         # our robot_description.
         'test': ['pytest', 'pytest-xdist', 'playwright', 'hypothesis', 'mcap', 'websockets',
                  'yourdfpy'],
-        # Grading on a Ray cluster: python -m miro_ball.grade --ray.
+        # Grading on a Ray cluster: python -m miro_ball.grade --ray; training: --ray.
         'scale': ['ray>=2.40'],
+        # Stable-Baselines3 on the learning environments (docs/learning.md). It pulls in
+        # PyTorch (a large download), so it is not part of a student's install.
+        'learn': ['stable-baselines3>=2.3'],
     },
     zip_safe=False,
     maintainer='miro_ball developers',

@@ -1,0 +1,146 @@
+"""The simulator's own world in this process, seen and driven as the controller contract
+says: Percepts out, Action in, one 20 ms platform tick at a time. No ROS, no DDS, no child
+processes.
+
+The same SimWorld (robot model, worlds, physics, microphones) and the same Cameras
+(renderer, MiRo's lens) as the ROS simulator. What the simulator's topics would carry is
+taken here from the robot's own tick (its ``sensors``), and an Action reaches the robot as
+the simulator's control topics hand it over, so that what is learnt here behaves the same
+there. A snapshot of the built world makes a reset cheap: restored, never rebuilt.
+"""
+import math
+
+import numpy as np
+
+from miro_ball.controller.contract import Eye, Percepts
+from miro_ball.controller.detection import DetectionParams
+from miro_ball.controller.detectors import make_detectors
+from miro_ball.miro.camera_model import CameraModel, PINHOLE
+from miro_ball.miro.constants import CAM_HFOV_DEG_SIM
+from miro_ball.miro.hearing import locate
+from miro_ball.miro.kinematics import clamp_wheel_speeds, wheel_speed2cmd_vel
+from miro_sim_bullet.physics.world import SimWorld
+from miro_sim_bullet.render.cameras import Cameras
+from miro_sim_bullet.render.eye_images import to_bgr
+
+SIDES = (1, -1)  # left eye, right eye: EYES order
+
+
+def to_argb(rgb):
+    """0xFFRRGGBB of an (R, G, B) triple of 0..255."""
+    r, g, b = (int(min(max(v, 0), 255)) for v in rgb)
+    return 0xFF000000 | r << 16 | g << 8 | b
+
+
+class WorldRig:
+    """A world (SimWorld or what SimWorld takes: a bundled name, a path, a World) with eyes
+    of ``eyes`` = (width, height) pixels through ``lens`` (None: no image is ever drawn)
+    and, for each robot, the detectors named in ``detectors`` run on its eyes' images.
+    ``hears``: the microphones are worked out and each robot's latest block kept."""
+
+    def __init__(self, world='miro', eyes=None, lens=PINHOLE, detectors=(), hears=False,
+                 renderer='auto', robot_name=None):
+        self.sim = world if isinstance(world, SimWorld) else SimWorld(world,
+                                                                     robot_name=robot_name)
+        self.eye_size = eyes
+        self.camera = None if eyes is None else CameraModel(*eyes, lens, CAM_HFOV_DEG_SIM)
+        self.renderer = renderer
+        self.cameras = None
+        if eyes is not None:
+            self._cameras()
+        self.detector_names = tuple(detectors)
+        self.hears = hears
+        self.images = {}  # robot -> (left, right) BGR images of the latest tick
+        self.heard = {}  # robot -> the latest MicBlock
+        self._detectors = {}
+
+    # -- time ---------------------------------------------------------------------------------
+    @property
+    def t(self):
+        return self.sim.time
+
+    def restore(self):
+        """The world as it was built: bodies, robots' platforms, time; no rebuild."""
+        self.sim.rewind()
+        self.images.clear()
+        self.heard.clear()
+        self._detectors = {name: [make_detectors(self.detector_names, DetectionParams())
+                                  for _ in SIDES] for name in self.sim.robots}
+
+    def tick(self, observe=None):
+        """One platform tick (its physics steps); ``observe(sim)`` after each physics step
+        (a judge sees every contact, however brief)."""
+        sim = self.sim
+        listening = sim.robots if self.hears else ()
+        for _ in range(sim.ticks_per_platform_tick):
+            sim.step(listening=listening)
+            if observe is not None:
+                observe(sim)
+        if self.hears:
+            for name, robot in sim.robots.items():
+                if robot.heard is not None:
+                    self.heard[name] = robot.heard
+
+    def look(self):
+        """Draw every robot's eyes now (one pass for all) and run their detectors."""
+        if self.camera is None:
+            return
+        requests = [(robot, side) for robot in self.sim.robots.values() for side in SIDES]
+        drawn = self.cameras.render_views(self.cameras.eye_views(requests), self.camera,
+                                          rgba=True)
+        for index, name in enumerate(self.sim.robots):
+            self.images[name] = tuple(to_bgr(image) for image in drawn[2 * index:2 * index + 2])
+
+    def _cameras(self):
+        if self.cameras is None:
+            self.cameras = Cameras(self.sim, self.renderer, log=lambda _: None)
+        return self.cameras
+
+    def view(self, position, rotation, intrinsics):
+        """An RGB picture from any camera pose (x forward, y left, z up)."""
+        return self._cameras().render_view(position, rotation, intrinsics)
+
+    # -- the contract -------------------------------------------------------------------------
+    def percepts(self, name):
+        """Robot ``name``'s Percepts now: its latest tick's readings, its eyes' images (as
+        look() drew them) and the detectors' results in them."""
+        robot = self.sim.robots[name]
+        sensors = robot.sensors
+        images = self.images.get(name, (None, None))
+        eyes = []
+        for side, image in enumerate(images):
+            found = {}
+            if image is not None:
+                found = {key: detect(image, self.camera)
+                         for key, detect in self._detectors[name][side].items()}
+            eyes.append(Eye(self.camera, image, found, self.t if image is not None else None))
+        heard = self.heard.get(name)
+        sound = None if heard is None else locate(heard.samples, sensors.kinematic_positions)
+        return Percepts(
+            t=self.t, eyes=tuple(eyes), cliff=tuple(sensors.cliff), sonar=sensors.sonar,
+            touch_head=sensors.touch_head, touch_body=sensors.touch_body,
+            light=tuple(sensors.light), joints=tuple(sensors.kinematic_positions), sound=sound)
+
+    def act(self, name, action):
+        """Hand robot ``name`` each part of ``action`` that is set, as its control topics do
+        (wheels through the MDK's cmd_vel formula, as the controller host sends them)."""
+        robot = self.sim.robots[name]
+        if action.wheels is not None:
+            left, right = (float(v) if math.isfinite(v) else 0.0 for v in action.wheels)
+            robot.set_cmd_vel(*wheel_speed2cmd_vel(clamp_wheel_speeds(left, right)))
+        if action.head is not None:
+            robot.set_kinematic_targets([float(v) for v in action.head])
+        if action.cosmetic is not None:
+            robot.set_cosmetic([float(v) for v in action.cosmetic])
+        if action.illum is not None and list(action.illum) != robot.illum:
+            robot.set_illum([int(v) for v in action.illum])
+        if action.tone is not None:
+            robot.play_tone(*action.tone)
+        if action.stream is not None:
+            robot.stream(np.asarray(action.stream, np.int16))
+
+    def close(self):
+        if self.cameras is not None:
+            self.cameras.close()
+        self.sim.close()
+

@@ -1,0 +1,128 @@
+"""The controller contract as Gymnasium spaces: Percepts as an observation ``Dict``, an
+``Action`` as an action ``Dict``, and the conversions both ways.
+
+Observation (every array float32 unless said):
+
+- ``eyes``: (2, height, width, 3) uint8, left then right, BGR as the contract's frames
+  (only when the environment draws eyes);
+- ``joints``: the neck's tilt, lift, yaw, pitch (rad); ``sonar``: (1,) metres, the sonar's
+  far end (1 m) when nothing is in range (the contract's inf, made finite for learners);
+  ``cliff``: [left, right], 1 = floor; ``light``: four values 0..1;
+- ``touch_head``, ``touch_body``: MultiBinary(14), one per pad;
+- ``mics`` (when asked): the latest block, (4, 500) samples scaled to -1..1;
+- one entry per detector asked (e.g. ``ball``): (2, 4) rows [seen, x, y, r] per eye in the
+  detector's normalised units, zeros where nothing was found.
+
+Action: ``wheels`` (2,) m/s within +-0.4; ``head`` (4,) tilt, lift, yaw, pitch targets
+within MiRo's ranges; ``cosmetic`` (6,) 0..1; ``illum`` (6, 3) uint8 RGB of the six LEDs;
+``tone`` (2,) frequency Hz and volume 0..255 (volume 0: no tone), sounding for the step.
+"""
+import math
+
+import numpy as np
+from gymnasium import spaces
+
+from miro_ball.controller.contract import Action
+from miro_ball.miro.constants import (JOINT_LIMITS_RAD, MIC_BLOCK_SAMPLES,
+                                      TONE_FREQUENCY_RANGE_HZ, TONE_VOLUME_MAX,
+                                      WHEEL_MAX_SPEED_M_PER_S)
+from miro_ball.miro.touch import TOUCH_PADS
+from miro_sim_bullet.physics.model import SONAR_RANGE
+
+MICS = 4
+F32 = np.float32
+SONAR_FAR_M = SONAR_RANGE[1]
+INT16_FULL_SCALE = 32768.0
+
+
+def _box(low, high, shape=None, dtype=F32):
+    return spaces.Box(low=low, high=high, shape=shape, dtype=dtype)
+
+
+def observation_space(eyes=None, detectors=(), hears=False):
+    """The Dict observation space; ``eyes`` (width, height) or None."""
+    parts = {
+        'joints': _box(-math.pi, math.pi, (4,)),
+        'sonar': _box(0.0, SONAR_FAR_M, (1,)),
+        'cliff': _box(0.0, 1.0, (2,)),
+        'light': _box(0.0, 1.0, (4,)),
+        'touch_head': spaces.MultiBinary(TOUCH_PADS),
+        'touch_body': spaces.MultiBinary(TOUCH_PADS),
+    }
+    if eyes is not None:
+        width, height = eyes
+        parts['eyes'] = _box(0, 255, (2, height, width, 3), np.uint8)
+    if hears:
+        parts['mics'] = _box(-1.0, 1.0, (MICS, MIC_BLOCK_SAMPLES))
+    for name in detectors:
+        parts[name] = _box(-1.0, 1.0, (2, 4))
+    return spaces.Dict(parts)
+
+
+def action_space():
+    """The Dict action space: every part of the contract's Action a policy may set."""
+    head_low, head_high = zip(*JOINT_LIMITS_RAD)
+    return spaces.Dict({
+        'wheels': _box(-WHEEL_MAX_SPEED_M_PER_S, WHEEL_MAX_SPEED_M_PER_S, (2,)),
+        'head': _box(np.array(head_low, F32), np.array(head_high, F32)),
+        'cosmetic': _box(0.0, 1.0, (6,)),
+        'illum': _box(0, 255, (6, 3), np.uint8),
+        'tone': _box(np.array([0.0, 0.0], F32),
+                     np.array([TONE_FREQUENCY_RANGE_HZ[1], TONE_VOLUME_MAX], F32)),
+    })
+
+
+def _bits(mask):
+    return np.array([(int(mask or 0) >> pad) & 1 for pad in range(TOUCH_PADS)], np.int8)
+
+
+def _sighting(result):
+    """[seen, x, y, r] of one eye's detection (a Ball, or anything with x and y)."""
+    if result is None:
+        return (0.0, 0.0, 0.0, 0.0)
+    return (1.0, float(result.x), float(result.y), float(getattr(result, 'r', 0.0)))
+
+
+def observation(percepts, space, mics=None):
+    """The observation of ``space`` made from ``percepts`` (contract.Percepts); ``mics``
+    the latest microphone block (int16, (4, 500)) or None."""
+    sonar = percepts.sonar if percepts.sonar is not None else math.inf
+    obs = {
+        'joints': np.asarray(percepts.joints, F32),
+        'sonar': np.array([min(max(sonar, 0.0), SONAR_FAR_M)], F32),
+        'cliff': np.clip(np.asarray(percepts.cliff, F32), 0.0, 1.0),
+        'light': np.clip(np.asarray(percepts.light, F32), 0.0, 1.0),
+        'touch_head': _bits(percepts.touch_head),
+        'touch_body': _bits(percepts.touch_body),
+    }
+    if 'eyes' in space.spaces:
+        obs['eyes'] = np.stack([eye.image for eye in percepts.eyes])
+    if 'mics' in space.spaces:
+        block = np.zeros((MICS, MIC_BLOCK_SAMPLES), F32) if mics is None else \
+            np.asarray(mics, F32) / INT16_FULL_SCALE
+        obs['mics'] = block
+    for name in space.spaces:
+        if name not in obs:
+            obs[name] = np.clip(np.array([_sighting(found) for found in
+                                          percepts.found(name)], F32), -1.0, 1.0)
+    return obs
+
+
+def to_action(act, ticks=1):
+    """The contract's Action of a (partial) action Dict: a part that is missing is left
+    None, so the robot keeps what it was told. A tone sounds for ``ticks`` platform ticks."""
+    def part(key):
+        value = act.get(key)
+        return None if value is None else np.asarray(value)
+
+    wheels, head, cosmetic, illum, tone = (part(key) for key in
+                                           ('wheels', 'head', 'cosmetic', 'illum', 'tone'))
+    return Action(
+        wheels=None if wheels is None else tuple(float(v) for v in wheels),
+        head=None if head is None else tuple(float(v) for v in head),
+        cosmetic=None if cosmetic is None else tuple(float(v) for v in cosmetic),
+        illum=None if illum is None else tuple(
+            0xFF000000 | int(r) << 16 | int(g) << 8 | int(b)
+            for r, g, b in np.clip(illum, 0, 255).astype(int)),
+        tone=None if tone is None or float(tone[1]) <= 0 else (
+            int(tone[0]), int(tone[1]), int(ticks)))
