@@ -36,7 +36,7 @@ class MiroEnv(gym.Env):
     def __init__(self, task=None, world=None, eyes=(64, 48), frame_skip=None, lens=PINHOLE,
                  hears=False, detectors=None, render_mode=None, renderer='auto'):
         self.task = Task() if task is None else task
-        self.frame_skip = int(frame_skip or self.task.frame_skip)
+        self.frame_skip = self.task.frame_skip if frame_skip is None else int(frame_skip)
         if self.frame_skip < 1:
             raise ValueError(f'frame_skip must be at least 1, got {frame_skip}')
         if eyes is not None and (len(eyes) != 2 or min(eyes) < 8 or max(eyes) > 1280):
