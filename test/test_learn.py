@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import miro_ball.learn  # noqa: F401  (registers the ids)
+import miro_ball.learn
 from miro_ball.controller.behaviour import BehaviourParams, make_behaviour
 from miro_ball.controller.contract import Action
 from miro_ball.learn.controllers import run_controller
@@ -17,6 +17,8 @@ from miro_ball.run.placements import placements
 
 # Gymnasium's advice for Box actions (symmetric, normalised): MiRo's are in its own units,
 # m/s and rad, as the contract says; and check_env's note on checking a wrapped environment.
+gymnasium.register_envs(miro_ball.learn)  # registered on import: says why it is imported
+
 pytestmark = [pytest.mark.filterwarnings('ignore:.*symmetric and normalized space'),
               pytest.mark.filterwarnings('ignore:.*different from the unwrapped version')]
 

@@ -13,8 +13,8 @@ Observation (every array float32 unless said):
 - one entry per detector asked (e.g. ``ball``): (2, 4) rows [seen, x, y, r] per eye in the
   detector's normalised units, zeros where nothing was found.
 
-Action: ``wheels`` (2,) m/s within +-0.4; ``head`` (4,) tilt, lift, yaw, pitch targets
-within MiRo's ranges; ``cosmetic`` (6,) 0..1; ``illum`` (6, 3) uint8 RGB of the six LEDs;
+Action: ``wheels`` (2,) m/s within +-0.4; ``head`` (3,) lift, yaw, pitch targets within
+MiRo's ranges (the tilt is fixed: the contract's fourth value is always MiRo's); ``cosmetic`` (6,) 0..1; ``illum`` (6, 3) uint8 RGB of the six LEDs;
 ``tone`` (2,) frequency Hz and volume 0..255 (volume 0: no tone), sounding for the step.
 """
 import math
@@ -23,7 +23,7 @@ import numpy as np
 from gymnasium import spaces
 
 from miro_ball.controller.contract import Action
-from miro_ball.miro.constants import (JOINT_LIMITS_RAD, MIC_BLOCK_SAMPLES,
+from miro_ball.miro.constants import (JOINT_LIMITS_RAD, MIC_BLOCK_SAMPLES, TILT_RAD,
                                       TONE_FREQUENCY_RANGE_HZ, TONE_VOLUME_MAX,
                                       WHEEL_MAX_SPEED_M_PER_S)
 from miro_ball.miro.touch import TOUCH_PADS
@@ -61,7 +61,7 @@ def observation_space(eyes=None, detectors=(), hears=False):
 
 def action_space():
     """The Dict action space: every part of the contract's Action a policy may set."""
-    head_low, head_high = zip(*JOINT_LIMITS_RAD)
+    head_low, head_high = zip(*JOINT_LIMITS_RAD[1:])
     return spaces.Dict({
         'wheels': _box(-WHEEL_MAX_SPEED_M_PER_S, WHEEL_MAX_SPEED_M_PER_S, (2,)),
         'head': _box(np.array(head_low, F32), np.array(head_high, F32)),
@@ -119,7 +119,7 @@ def to_action(act, ticks=1):
                                            ('wheels', 'head', 'cosmetic', 'illum', 'tone'))
     return Action(
         wheels=None if wheels is None else tuple(float(v) for v in wheels),
-        head=None if head is None else tuple(float(v) for v in head),
+        head=None if head is None else (TILT_RAD, *(float(v) for v in head)),
         cosmetic=None if cosmetic is None else tuple(float(v) for v in cosmetic),
         illum=None if illum is None else tuple(
             0xFF000000 | int(r) << 16 | int(g) << 8 | int(b)
