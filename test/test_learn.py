@@ -1,5 +1,9 @@
 """The learning environments: Gymnasium's checks, seeded determinism, the contract's spaces,
-and a controller of the contract running in an environment unchanged."""
+a controller of the contract running in an environment unchanged, and docs/learning.md's
+examples, run as written."""
+import re
+from pathlib import Path
+
 import gymnasium
 import numpy as np
 import pytest
@@ -18,6 +22,8 @@ from miro_ball.run.placements import placements
 # Gymnasium's advice for Box actions (symmetric, normalised): MiRo's are in its own units,
 # m/s and rad, as the contract says; and check_env's note on checking a wrapped environment.
 gymnasium.register_envs(miro_ball.learn)  # registered on import: says why it is imported
+
+LEARNING_MD = Path(__file__).resolve().parent.parent / 'docs' / 'learning.md'
 
 pytestmark = [pytest.mark.filterwarnings('ignore:.*symmetric and normalized space'),
               pytest.mark.filterwarnings('ignore:.*different from the unwrapped version')]
@@ -149,3 +155,11 @@ def test_an_action_of_the_contract_is_a_step_too():
     env.step(Action(head=(0.0, 0.3, 0.5, 0.0)))
     assert env.rig.sim.robot.kin_targets[2] == pytest.approx(0.5)
     env.close()
+
+
+EXAMPLES = re.findall(r'^```python\n(.*?)^```$', LEARNING_MD.read_text(), re.M | re.S)
+
+
+@pytest.mark.parametrize('example', EXAMPLES, ids=[f'example{i}' for i in range(len(EXAMPLES))])
+def test_the_examples_of_docs_learning_md_run_as_written(example):
+    exec(compile(example, str(LEARNING_MD), 'exec'), {})
