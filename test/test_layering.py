@@ -107,6 +107,17 @@ def test_demo_modes_parts_need_neither_ros_nor_pybullet():
     assert not {m.split('.')[0] for m in loaded} & {'rclpy', 'pybullet'}
 
 
+def test_the_learning_environments_need_no_ros_and_nothing_else_needs_gymnasium():
+    # In-process learning: no rclpy, no DDS. And the nodes, which never learn, do not pay
+    # Gymnasium's import (0.13 s a start).
+    learning = sorted(m for m in our_modules() if m.startswith('miro_ball.learn.'))
+    assert 'miro_ball.learn.env' in learning
+    assert 'rclpy' not in {m.split('.')[0] for m in loaded_by(', '.join(learning))}
+    nodes = ('miro_sim_bullet.ros.node, miro_ball.controller.host, miro_ball.gui.server, '
+             'miro_ball.lab, miro_ball.grade')
+    assert 'gymnasium' not in {m.split('.')[0] for m in loaded_by(nodes)}
+
+
 def _private_methods(cls_node):
     return {item.name for item in cls_node.body
             if isinstance(item, (ast.FunctionDef, ast.AsyncFunctionDef))
