@@ -50,23 +50,30 @@ def _answers(address, timeout_s=CONNECT_S):
     return True
 
 
+def connect(address):
+    """The ray module, joined to the cluster at ``address`` ('auto': the one this machine
+    is in); RayUnavailable if Ray is not installed or nothing answers there."""
+    try:
+        import ray
+    except ImportError:
+        raise RayUnavailable("--ray needs Ray: pip install -e '.[scale]'") from None
+    if address != 'auto' and not _answers(address):
+        raise RayUnavailable(f'--ray: no Ray cluster answers at {address} (start one with '
+                             '`ray start --head`, or check the address and port)')
+    try:
+        ray.init(address=address, logging_level='ERROR', log_to_driver=False)
+    except (ConnectionError, RuntimeError, ValueError) as err:
+        raise RayUnavailable(f'--ray: no Ray cluster at {address}: '
+                             f'{str(err).splitlines()[0]}') from None
+    return ray
+
+
 class RayPool:
     """run(specs, done) as LocalPool does, on the Ray cluster at ``address`` ('auto': the
     one this machine is in)."""
 
     def __init__(self, settings, address, stop=None):
-        try:
-            import ray
-        except ImportError:
-            raise RayUnavailable("--ray needs Ray: pip install -e '.[scale]'") from None
-        if address != 'auto' and not _answers(address):
-            raise RayUnavailable(f'--ray: no Ray cluster answers at {address} (start one with '
-                                 '`ray start --head`, or check the address and port)')
-        try:
-            ray.init(address=address, logging_level='ERROR', log_to_driver=False)
-        except (ConnectionError, RuntimeError, ValueError) as err:
-            raise RayUnavailable(f'--ray: no Ray cluster at {address}: '
-                                 f'{str(err).splitlines()[0]}') from None
+        ray = connect(address)
         self.ray, self.settings, self.stop = ray, settings, stop
         self.remote = ray.remote(num_cpus=1, max_retries=RETRIES)(episode_task)
 
