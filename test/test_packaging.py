@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-BUNDLED = ['cube', 'den', 'empty', 'football', 'football_pitch', 'miro', 'petshop', 'tables']
+BUNDLED = ['cube', 'den', 'empty', 'football', 'football_pitch', 'miro', 'petshop', 't_maze',
+           'tables']
 
 
 @pytest.fixture(scope='module')

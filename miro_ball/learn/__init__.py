@@ -13,6 +13,7 @@ from gymnasium.envs.registration import register
 ENVIRONMENTS = {
     'KickBall-v0': 'miro_ball.learn.registry:kick_ball',
     'KBandit-v0': 'miro_ball.learn.registry:k_bandit',
+    'TMaze-v0': 'miro_ball.learn.registry:t_maze',
 }
 
 for _id, _entry in ENVIRONMENTS.items():

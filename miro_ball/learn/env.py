@@ -12,7 +12,6 @@ and ``step_action(Action)`` takes its output (learn.controllers.run_controller).
 import random
 
 import gymnasium as gym
-import numpy as np
 
 from miro_ball.controller.contract import Action
 from miro_ball.learn import spaces
@@ -39,8 +38,7 @@ class MiroEnv(gym.Env):
         self.frame_skip = self.task.frame_skip if frame_skip is None else int(frame_skip)
         if self.frame_skip < 1:
             raise ValueError(f'frame_skip must be at least 1, got {frame_skip}')
-        if eyes is not None and (len(eyes) != 2 or min(eyes) < 8 or max(eyes) > 1280):
-            raise ValueError(f'eyes must be (width, height) of 8 to 1280 px, got {eyes}')
+        spaces.check_eyes(eyes)
         if render_mode not in (None, *self.metadata['render_modes']):
             raise ValueError(f'render_mode {render_mode!r}: only rgb_array or None')
         self.render_mode = render_mode
@@ -91,13 +89,7 @@ class MiroEnv(gym.Env):
                 self.task.info())
 
     def render(self):
-        if self.render_mode != 'rgb_array':
-            return None
-        from miro_sim_bullet.render.overhead import overhead_camera
-
-        position, rotation, intrinsics = overhead_camera(self.rig.sim.description)
-        image = self.rig.view(position, rotation, intrinsics)
-        return np.ascontiguousarray(image[..., :3])
+        return self.rig.overhead() if self.render_mode == 'rgb_array' else None
 
     def close(self):
         self.rig.close()

@@ -100,6 +100,13 @@ class WorldRig:
         """An RGB picture from any camera pose (x forward, y left, z up)."""
         return self._cameras().render_view(position, rotation, intrinsics)
 
+    def overhead(self):
+        """An RGB picture of the whole world from straight above."""
+        from miro_sim_bullet.render.overhead import overhead_camera
+
+        image = self.view(*overhead_camera(self.sim.description))
+        return np.ascontiguousarray(image[..., :3])
+
     # -- the contract -------------------------------------------------------------------------
     def percepts(self, name):
         """Robot ``name``'s Percepts now: its latest tick's readings, its eyes' images (as

@@ -39,6 +39,20 @@ def _box(low, high, shape=None, dtype=F32):
     return spaces.Box(low=low, high=high, shape=shape, dtype=dtype)
 
 
+def check_eyes(eyes):
+    """Refuse an eye size that is no (width, height) of 8 to 1280 px (ValueError, one line);
+    None (no eyes) is fine."""
+    if eyes is None:
+        return
+    try:
+        fine = len(eyes) == 2 and all(isinstance(v, (int, np.integer)) and 8 <= v <= 1280
+                                     for v in eyes)
+    except TypeError:
+        fine = False
+    if not fine:
+        raise ValueError(f'eyes must be (width, height) of 8 to 1280 px, got {eyes!r}')
+
+
 def observation_space(eyes=None, detectors=(), hears=False):
     """The Dict observation space; ``eyes`` (width, height) or None."""
     parts = {
