@@ -1,0 +1,197 @@
+"""Football with several MiRos (PettingZoo's checks, seeded placements, the same seed giving
+the same trajectories) and the T-maze (Gymnasium's checks, and solved by a robot that looks
+for the cue)."""
+import math
+import random
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env, data_equivalence
+from pettingzoo.test import api_test, parallel_api_test
+
+import miro_ball.learn
+from miro_ball.controller.contract import Action
+from miro_ball.learn import football
+from miro_ball.learn.t_maze import TMaze, reached
+
+gymnasium.register_envs(miro_ball.learn)  # registered on import: says why it is imported
+
+# MiRo's action Boxes are in its own units (m/s, rad), not normalised, as the contract says;
+# PettingZoo's advice (Box or Discrete actions, array observations, agents named player_0)
+# does not fit the contract's Dicts and MiRo's names.
+pytestmark = [pytest.mark.filterwarnings('ignore:.*symmetric and normalized space'),
+              pytest.mark.filterwarnings('ignore:.*different from the unwrapped version'),
+              pytest.mark.filterwarnings('ignore:.*probably should be gymnasium'),
+              pytest.mark.filterwarnings('ignore:.*agents to be named'),
+              pytest.mark.filterwarnings('ignore:Observation is not a NumPy array')]
+
+
+@pytest.mark.parametrize('eyes', [None, (32, 24)], ids=['state-only', 'eyes'])
+def test_football_passes_pettingzoos_parallel_api_test(eyes):
+    env = football.parallel_env(robots=3, eyes=eyes, limit_s=0.6)
+    parallel_api_test(env, num_cycles=40)
+    assert env.possible_agents == ['miro01', 'miro02', 'miro03']
+    observations, _ = env.reset(seed=1)
+    assert ('ball' in observations['miro02']) == (eyes is not None)
+    if eyes is not None:
+        assert observations['miro03']['eyes'].shape == (2, 24, 32, 3)
+    env.close()
+
+
+def test_football_as_an_aec_environment_passes_pettingzoos_api_test():
+    env = football.env(robots=2, eyes=None, limit_s=0.3)
+    api_test(env, num_cycles=20)
+    env.close()
+
+
+def play(env, seed, steps=30):
+    observations, _ = env.reset(seed=seed)
+    for index, agent in enumerate(env.possible_agents):
+        env.action_space(agent).seed(seed + index)
+    rows = [observations]
+    for _ in range(steps):
+        actions = {agent: env.action_space(agent).sample() for agent in env.agents}
+        rows.append(env.step(actions))
+        if not env.agents:
+            break
+    return rows
+
+
+def test_football_the_same_seed_gives_the_same_trajectories_bit_for_bit():
+    env = football.parallel_env(robots=3, eyes=(32, 24))
+    first = play(env, 5)
+    play(env, 6)  # another episode between: nothing of it may carry over
+    again = play(env, 5)
+    other = play(env, 6)
+    assert len(first) == len(again) and data_equivalence(first, again, exact=True)
+    assert not data_equivalence(first[0], other[0])
+    env.close()
+
+
+def test_football_placements_are_seeded_apart_and_on_the_pitch():
+    half = (1.65, 1.0)
+    for seed in range(200):
+        ball, poses = football.pitch_placement(random.Random(seed), 4, half)
+        assert (ball, poses) == football.pitch_placement(random.Random(seed), 4, half)
+        spots = [pose[:2] for pose in poses]
+        assert all(abs(x) <= half[0] and abs(y) <= half[1] for x, y in spots + [ball])
+        assert all(math.dist(ball, spot) >= football.BALL_GAP_M for spot in spots)
+        assert all(math.dist(a, b) >= football.ROBOT_GAP_M
+                   for i, a in enumerate(spots) for b in spots[i + 1:])
+
+
+def test_football_rewards_the_robot_that_drives_to_the_ball_and_the_kicker():
+    env = football.parallel_env(robots=2, eyes=None)
+    env.reset(seed=3)
+    sim = env.rig.sim
+    chaser, idle = env.possible_agents
+    ball = sim.ball_position()[:2]
+    x, y, _ = sim.robots[chaser].pose()
+    sim.robots[chaser].place(x, y, math.atan2(ball[1] - y, ball[0] - x))  # facing the ball
+    stop = Action(wheels=(0.0, 0.0))
+
+    def idle_gap():
+        return math.dist(sim.robots[idle].pose()[:2], sim.ball_position()[:2])
+
+    totals, start = dict.fromkeys(env.possible_agents, 0.0), idle_gap()
+    while env.agents:
+        _, rewards, _, _, infos = env.step({chaser: Action(wheels=(0.4, 0.4)), idle: stop})
+        for agent, reward in rewards.items():
+            totals[agent] += reward
+    assert infos[idle]['kicked'] and infos[idle]['kicker'] == chaser
+    assert totals[chaser] > football.KICK_REWARD
+    # The one standing still: only what the kick took the ball nearer it or away.
+    assert totals[idle] == pytest.approx(start - idle_gap())
+    env.close()
+
+
+@pytest.mark.parametrize('kwargs', [dict(robots=0), dict(robots='3'), dict(robots=13),
+                                    dict(eyes=(3, 3)), dict(eyes='big'), dict(frame_skip=0),
+                                    dict(limit_s=-1), dict(eyes=None, detectors=('ball',))])
+def test_football_refuses_garbage_in_one_line(kwargs):
+    with pytest.raises(ValueError) as refused:
+        football.parallel_env(**kwargs)
+    assert '\n' not in str(refused.value)
+
+
+def test_the_t_maze_passes_gymnasiums_checks():
+    env = gymnasium.make('miro_ball/TMaze-v0', limit_s=1.0)
+    check_env(env)
+    check_env(env.unwrapped)
+    env.close()
+
+
+def drive_to(robot, goal):
+    """Wheel speeds towards ``goal``, turning on the spot first when it is far off course."""
+    x, y, yaw = robot.pose()
+    off = math.atan2(goal[1] - y, goal[0] - x) - yaw
+    off = math.atan2(math.sin(off), math.cos(off))
+    turn = 0.15 * max(-1.0, min(1.0, 2.5 * off))
+    ahead = 0.3 * max(0.0, math.cos(off)) ** 4
+    return Action(wheels=(ahead - turn, ahead + turn))
+
+
+def run_maze(env, seed, choose):
+    """Up the stem to the junction, then into the arm ``choose(robot, env)`` names; the
+    episode's total reward and its last info. The way is driven from MiRo's pose (ground
+    truth): the test is whether the task can be solved, not how to steer."""
+    _, info = env.reset(seed=seed)
+    robot = env.unwrapped.rig.sim.robot
+    total = 0.0
+    junction = (0.9, 0.0)
+    while math.dist(robot.pose()[:2], junction) > 0.1:
+        _, reward, terminated, truncated, info = env.unwrapped.step_action(
+            drive_to(robot, junction))
+        total += reward
+        assert not (terminated or truncated)
+    side = 1.0 if choose(robot, env) == 'left' else -1.0
+    while True:
+        _, reward, terminated, truncated, info = env.unwrapped.step_action(
+            drive_to(robot, (0.9, side * 1.2)))
+        total += reward
+        if terminated or truncated:
+            return total, info
+
+
+def looks_left_for_the_ball(robot, env):
+    """Turns to face the left arm and goes there if the ball detector sees the ball."""
+    while True:
+        x, y, _ = robot.pose()
+        obs, *_ = env.unwrapped.step_action(drive_to(robot, (x, y + 1.0)))
+        if abs(robot.pose()[2] - math.pi / 2) < 0.1:
+            obs, *_ = env.unwrapped.step_action(Action(wheels=(0.0, 0.0)))
+            return 'left' if obs['ball'][:, 0].any() else 'right'
+
+
+def test_the_t_maze_is_solved_by_following_the_cue():
+    env = gymnasium.make('miro_ball/TMaze-v0', frame_skip=5)
+    arms = set()
+    for seed in (0, 1):  # the ball at the right arm's end, then the left's
+        total, info = run_maze(env, seed, looks_left_for_the_ball)
+        assert total == 1.0 and info['reached'] == info['arm']
+        arms.add(info['arm'])
+    assert arms == {'left', 'right'}
+    env.close()
+
+
+def test_the_t_maze_punishes_the_wrong_arm_and_can_hide_the_cue():
+    env = gymnasium.make('miro_ball/TMaze-v0', eyes=None, detectors=(), frame_skip=5,
+                         cue=False, arm='right')
+    total, info = run_maze(env, 2, lambda robot, env: 'left')
+    assert total == -1.0 and info == {'arm': 'right', 'reached': 'left'}
+    ball = env.unwrapped.rig.sim.ball_position()
+    assert reached(ball) is None and ball[0] < -1.2  # parked behind the stem's foot
+    env.close()
+    with pytest.raises(ValueError):
+        TMaze(arm='up')
+
+
+def test_the_t_maze_times_out_when_miro_stays_in_the_stem():
+    env = gymnasium.make('miro_ball/TMaze-v0', eyes=None, detectors=(), limit_s=0.5)
+    env.reset(seed=0)
+    still = {'wheels': np.zeros(2, np.float32)}
+    outcomes = [env.step(still)[1:4] for _ in range(25)]
+    assert outcomes[-1] == (0.0, False, True)
+    assert all(outcome == (0.0, False, False) for outcome in outcomes[:-1])
+    env.close()
