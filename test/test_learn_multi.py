@@ -108,7 +108,8 @@ def test_football_rewards_the_robot_that_drives_to_the_ball_and_the_kicker():
 
 @pytest.mark.parametrize('kwargs', [dict(robots=0), dict(robots='3'), dict(robots=13),
                                     dict(eyes=(3, 3)), dict(eyes='big'), dict(frame_skip=0),
-                                    dict(limit_s=-1), dict(eyes=None, detectors=('ball',))])
+                                    dict(limit_s=-1), dict(eyes=None, detectors=('ball',)),
+                                    dict(world='miro'), dict(world='nowhere')])
 def test_football_refuses_garbage_in_one_line(kwargs):
     with pytest.raises(ValueError) as refused:
         football.parallel_env(**kwargs)

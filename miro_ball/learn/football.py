@@ -83,6 +83,9 @@ def pitch_world(world, robots):
     """``world`` (a World, bundled name or path) with ``robots`` MiRos named miro01, ... in
     it, standing apart (a reset places them anew)."""
     world = world if isinstance(world, World) else load_world(world)
+    if world.ball is None or world.ground_height != 0.0:
+        raise ValueError(f'world {world.name}: football needs a [ball] and a [ground] at '
+                         'height 0, whose size is the pitch')
     _, poses = pitch_placement(random.Random(0), robots, free_half_size(world))
     specs = tuple(RobotSpec(name, pose) for name, pose in zip(player_names(robots), poses))
     return dataclasses.replace(world, robots=specs)
@@ -130,7 +133,8 @@ class Football(KickBall):
 
 class FootballEnv(ParallelEnv):
     """``robots``: how many MiRos play (1 to MAX_PLAYERS), named miro01, ... ``world``: the
-    pitch (any world file; its robots are replaced by the players, placed on its ground).
+    pitch (any world file with a ball and a [ground] at height 0 whose size is the pitch;
+    its robots are replaced by the players).
     ``eyes``: (width, height) of each eye's image, or None for none (state only).
     ``detectors``: their results in each observation (default: the ball's, with eyes).
     ``frame_skip``: platform ticks per step. ``limit_s``: simulated seconds an episode
@@ -142,7 +146,8 @@ class FootballEnv(ParallelEnv):
     def __init__(self, robots=3, eyes=(64, 48), frame_skip=1, limit_s=20.0, world=PITCH,
                  lens=PINHOLE, hears=False, detectors=None, render_mode=None,
                  renderer='auto'):
-        if not isinstance(robots, int) or not 1 <= robots <= MAX_PLAYERS:
+        if isinstance(robots, bool) or not isinstance(robots, int) or \
+                not 1 <= robots <= MAX_PLAYERS:
             raise ValueError(f'robots must be a whole number 1 to {MAX_PLAYERS}, '
                              f'got {robots!r}')
         if not isinstance(frame_skip, int) or frame_skip < 1:
