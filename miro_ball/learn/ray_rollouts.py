@@ -1,0 +1,44 @@
+"""Episodes on a Ray cluster (pip install -e '.[scale]'): training past one machine.
+
+``RayRollouts(address)`` is a pool as rollouts.evaluate_population takes one: its
+``imap(function, jobs)`` runs each job as a Ray task of one CPU, anywhere in the cluster, and
+gives the results back in the jobs' order. A node runs as many episodes at a time as it has
+CPUs. Ray keeps a worker process from one task to the next, and each process keeps its
+environment (rollouts builds it on the process's first episode): an episode on Ray costs a
+reset, as in a local pool, not a world build. Ray runs a task again elsewhere when its node
+is lost (max_retries). Every node needs this package installed, as the grader's do.
+"""
+from miro_ball.grading.ray_pool import RETRIES, connect
+
+
+def _in_worker(function, job):
+    import cv2
+
+    cv2.setNumThreads(1)  # a task has one CPU: OpenCV's own threads would only contend
+    return function(job)
+
+
+class RayRollouts:
+    """A pool of the Ray cluster at ``address`` ('auto': the one this machine is in);
+    RayUnavailable (one line) if Ray is not installed or nothing answers there."""
+
+    def __init__(self, address):
+        self.ray = connect(address)
+        self.remote = self.ray.remote(num_cpus=1, max_retries=RETRIES)(_in_worker)
+        self.pending = []
+
+    def imap(self, function, jobs, chunksize=1):
+        """function(job) of each job, in order, as each is ready (chunksize: as a
+        multiprocessing Pool's, not used: a task is one episode)."""
+        ray = self.ray
+        self.pending = [self.remote.remote(function, job) for job in jobs]
+        while self.pending:
+            yield ray.get(self.pending[0])
+            self.pending.pop(0)
+
+    def terminate(self):
+        """Cancel what is still to run and leave the cluster (it keeps running)."""
+        for ref in self.pending:
+            self.ray.cancel(ref, force=True)
+        self.pending = []
+        self.ray.shutdown()
