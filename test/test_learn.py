@@ -16,7 +16,7 @@ from miro_ball.learn.controllers import run_controller
 from miro_ball.learn.env import MiroEnv
 from miro_ball.learn.kbandit import EXPRESSION_NAMES
 from miro_ball.learn.tasks import KickBall
-from miro_ball.learn.wrappers import PickActions, PickObservations
+from miro_ball.learn.wrappers import FlattenActions, PickActions, PickObservations
 from miro_ball.run.placements import placements
 
 # Gymnasium's advice for Box actions (symmetric, normalised): MiRo's are in its own units,
@@ -110,6 +110,23 @@ def test_a_picked_wheels_action_drives_and_leaves_the_rest_as_it_was():
         env.step(np.array([0.3, 0.3], np.float32))
     assert np.hypot(robot.pose()[0] - start[0], robot.pose()[1] - start[1]) > 0.1
     assert robot.cosmetic == cosmetic
+    env.close()
+
+
+def test_the_whole_action_flattened_is_one_box_that_reaches_every_part():
+    env = FlattenActions(MiroEnv(KickBall(), eyes=None, detectors=()))
+    full = env.unwrapped.action_space
+    assert env.action_space.shape == (gymnasium.spaces.flatdim(full),)
+    env.reset(seed=1)
+    action = gymnasium.spaces.flatten(full, {
+        'wheels': np.zeros(2, np.float32), 'head': np.array([0.3, 0.5, 0.0], np.float32),
+        'cosmetic': np.full(6, 0.9, np.float32), 'illum': np.full((6, 3), 200, np.uint8),
+        'tone': np.zeros(2, np.float32)})
+    env.step(action)
+    robot = env.unwrapped.rig.sim.robot
+    assert robot.kin_targets[1:3] == pytest.approx([0.3, 0.5])
+    assert robot.cosmetic == pytest.approx([0.9] * 6)
+    assert robot.illum == [0xFFC8C8C8] * 6
     env.close()
 
 

@@ -3,7 +3,8 @@
 ``PickActions(env, 'wheels')`` lets a policy set the wheels only (a Box of the two wheel
 speeds); the parts it leaves out are never sent, so the robot keeps what it was last told.
 ``PickObservations(env, ('ball', 'cliff'))`` keeps those entries of the observation.
-Gymnasium's own ``FlattenObservation`` makes the Dict one flat Box.
+Gymnasium's own ``FlattenObservation`` makes the Dict one flat Box; ``FlattenActions`` does
+the same for the action, for learners that take a Box only (Stable-Baselines3).
 """
 import gymnasium as gym
 from gymnasium import spaces
@@ -42,3 +43,14 @@ class PickObservations(gym.ObservationWrapper):
 
     def observation(self, observation):
         return {key: observation[key] for key in self.keys}
+
+
+class FlattenActions(gym.ActionWrapper):
+    """The (Dict) action as one flat Box, in Gymnasium's flatten order (parts by name)."""
+
+    def __init__(self, env):
+        super().__init__(env)
+        self.action_space = spaces.flatten_space(env.action_space)
+
+    def action(self, action):
+        return spaces.unflatten(self.env.action_space, action)
