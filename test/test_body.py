@@ -9,7 +9,8 @@ from hypothesis import given, settings, strategies as st
 from rclpy.serialization import deserialize_message, serialize_message
 
 from miro_ball.common.messages import message_class
-from miro_ball.miro.body import COSMETIC_JOINTS, COSMETIC_SPANS, LINK, LINKS, MOVABLE, PHYSICAL
+from miro_ball.miro.body import (COSMETIC_JOINTS, COSMETIC_SPANS, ILLUM_NAMES, LINK, LINKS,
+                                 MOVABLE, PHYSICAL)
 from miro_ball.miro.constants import JOINT_LIMITS_RAD, JOINT_NAMES, KIN_CALIB_RAD
 from miro_ball.miro.kc import CAML, CAMR, FOOT, HEAD, KinematicChain, SONAR
 from miro_ball.miro.link_poses import (fixed_transforms, FIXED_LINKS, JOINTED, jointed_poses,
@@ -17,7 +18,8 @@ from miro_ball.miro.link_poses import (fixed_transforms, FIXED_LINKS, JOINTED, j
 from miro_ball.miro.rotations import quaternion_matrix, rpy_quaternion
 from miro_ball.miro.tf_tree import TfError, TfTree
 from miro_ball.miro.urdf import urdf
-from miro_sim_bullet.physics.model import COSMETIC_LINKS, ILLUM_LINKS
+from miro_sim_bullet.physics.drawn import carrier, COSMETIC, DRAWN, SOLVED
+from miro_sim_bullet.physics.model import CARRIED
 from miro_sim_bullet.ros import convert
 
 angles = st.floats(-math.pi, math.pi)
@@ -57,10 +59,39 @@ def test_the_urdf_puts_the_eyes_and_sonar_where_the_kinematic_chain_does(model, 
         assert urdf_pose == pytest.approx(chain.frame_in(frame, FOOT), abs=1e-6), link
 
 
-def test_the_physics_body_has_the_descriptions_links_in_order():
-    assert [PHYSICAL[i] for i in ILLUM_LINKS] == ['led_lf', 'led_lm', 'led_lr', 'led_rf',
-                                                  'led_rm', 'led_rr']
-    assert [LINK[PHYSICAL[i]].joint for i in COSMETIC_LINKS] == list(COSMETIC_JOINTS)
+def test_the_physics_body_solves_the_descriptions_links_in_its_order():
+    """joint_states' joints after the tilt are the solved links' then the cosmetic ones;
+    PyBullet keeps the solved links in their order (it numbers links depth first) and every
+    link the description draws is solved or drawn on its own."""
+    from miro_sim_bullet.bullet import pybullet as pb
+    from miro_sim_bullet.physics.model import MiroModel
+    assert [LINK[name].joint for name in SOLVED + COSMETIC] == list(MOVABLE[1:])
+    assert [LINK[name].joint for name in COSMETIC] == list(COSMETIC_JOINTS)
+    assert sorted(SOLVED + DRAWN) == sorted(PHYSICAL)
+    assert set(ILLUM_NAMES) <= set(DRAWN)
+    client = pb.connect(pb.DIRECT)
+    try:
+        model = MiroModel(client)
+        parents = [pb.getJointInfo(model.body_id, k, physicsClientId=client)[16]
+                   for k in range(len(SOLVED))]
+        assert parents == [SOLVED.index(LINK[name].parent) if LINK[name].parent in SOLVED
+                           else -1 for name in SOLVED]
+    finally:
+        pb.disconnect(client)
+
+
+def test_the_solved_body_weighs_what_the_description_does(model):
+    """The drawn parts' masses ride in their carriers, at the same centre of mass (each
+    part's at its joint's origin, where the URDF puts it whatever the joints' angles)."""
+    total = sum(mass for mass, _, _ in CARRIED.values())
+    assert total == pytest.approx(sum(LINK[name].mass for name in ('body',) + PHYSICAL))
+    for name in ('body', 'head'):
+        mass, com, _ = CARRIED[name]
+        parts = [part for part in DRAWN if carrier(part) == name]
+        assert parts and mass > LINK[name].mass
+        moments = LINK[name].mass * np.array(LINK[name].com) + sum(
+            LINK[part].mass * model.get_transform(part, name)[:3, 3] for part in parts)
+        assert np.array(com) * mass == pytest.approx(moments, abs=1e-9)
 
 
 def test_fixed_and_moving_links_cover_every_link_once():

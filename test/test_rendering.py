@@ -225,6 +225,31 @@ def test_led_colour_changes_are_drawn(sims):
 
 
 @pytest.mark.parametrize('kind', KINDS)
+def test_the_tail_wag_is_drawn_and_a_snapshot_draws_it_alike(sims, kind):
+    """The tail, eyelids and ears are drawn-only parts, posed for each picture: a wag moves
+    the tail in the image, and a copy restored from a snapshot (as the tiny helper processes
+    draw) shows the same picture."""
+    sim, cameras = sims('empty', kind)
+    robot = sim.robot
+    x, y, yaw = robot.pose()
+    behind = np.array([x - 0.5 * math.cos(yaw), y - 0.5 * math.sin(yaw), 0.12])
+    rotation = np.array([[math.cos(yaw), -math.sin(yaw), 0.0],
+                         [math.sin(yaw), math.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+    intrinsics = Intrinsics.from_hfov(160, 120, 60.0)
+    robot.set_cosmetic([0.0, 0.0, 0.0, 0.0, 0.5, 0.5])
+    sim.run(0.2)
+    left = cameras.render_view(behind, rotation, intrinsics)
+    robot.set_cosmetic([0.0, 1.0, 0.0, 0.0, 0.5, 0.5])
+    sim.run(0.2)
+    right = cameras.render_view(behind, rotation, intrinsics)
+    assert (left != right).any(axis=2).sum() > 30
+    copy, copy_cameras = sims('empty', kind)
+    copy.restore(sim.snapshot())
+    again = copy_cameras.render_view(behind, rotation, intrinsics)
+    assert (again != right).any(axis=2).mean() < 0.001
+
+
+@pytest.mark.parametrize('kind', KINDS)
 def test_overhead_view_shows_ball_and_robots_where_they_are(sims, kind):
     """The football pitch from above: the ball where the pinhole model puts it, and the
     white and grey robots, not the green pitch, at the three robots' poses."""

@@ -150,15 +150,15 @@ def test_reset_restores_the_initial_state():
 
 
 def test_illum_colours_the_body_patches(empty):
+    from miro_ball.miro.body import ILLUM_NAMES
     from miro_sim_bullet.bullet import pybullet as pb
-    from miro_sim_bullet.physics.model import ILLUM_LINKS
     empty.robot.set_illum([0xFFFF0000, 0x8000FF00, 0, 0, 0, 0xFF0000FF])
-    colours = {row[1]: row[7] for row in pb.getVisualShapeData(empty.robot.body_id,
-                                                               physicsClientId=empty.client)}
-    assert colours[ILLUM_LINKS[0]][:3] == pytest.approx((1.0, 0.0, 0.0))
-    assert colours[ILLUM_LINKS[1]][1] > 0.95 and colours[ILLUM_LINKS[1]][0] < 0.5  # half-lit green
-    assert colours[ILLUM_LINKS[2]][:3] == pytest.approx((0.92, 0.92, 0.90))
-    assert colours[ILLUM_LINKS[5]][:3] == pytest.approx((0.0, 0.0, 1.0))
+    colours = [pb.getVisualShapeData(empty.robot.model.drawn.bodies[led],
+                                     physicsClientId=empty.client)[0][7] for led in ILLUM_NAMES]
+    assert colours[0][:3] == pytest.approx((1.0, 0.0, 0.0))
+    assert colours[1][1] > 0.95 and colours[1][0] < 0.5  # half-lit green
+    assert colours[2][:3] == pytest.approx((0.92, 0.92, 0.90))
+    assert colours[5][:3] == pytest.approx((0.0, 0.0, 1.0))
 
 
 def test_sonar_sees_the_ball_ahead_and_nothing_beyond_range(empty):
@@ -174,21 +174,67 @@ def test_sonar_sees_the_ball_ahead_and_nothing_beyond_range(empty):
     assert sonar == pytest.approx(0.6 - 0.1 - nose_x, abs=0.06)
 
 
-def test_cosmetic_joints_move_the_model(empty):
+def _drawn_poses(world):
+    """{part: (position, quaternion)} of the robot's drawn-only parts as a picture shows."""
     from miro_sim_bullet.bullet import pybullet as pb
-    from miro_sim_bullet.physics.model import COSMETIC_LINKS
+    world.robot.pose_drawn()
+    return {name: pb.getBasePositionAndOrientation(body, physicsClientId=world.client)
+            for name, body in world.robot.model.drawn.bodies.items()}
 
-    def angles():
-        return [s[0] for s in pb.getJointStates(empty.robot.body_id, COSMETIC_LINKS,
-                                                physicsClientId=empty.client)]
+
+def test_cosmetic_joints_move_the_drawn_model_as_servos(empty):
+    """The tail, eyelids and ears are drawn, not solved: a command moves them as a servo
+    would (most of the way within 0.1 s), joint_states says where they are, the parts drawn
+    are posed there, and a copy restored from a snapshot draws them the same."""
+    from miro_ball.miro.body import COSMETIC_SPANS
+    from miro_sim_bullet.physics.drawn import COSMETIC
     empty.run(0.5)
-    rest = angles()
-    empty.robot.set_cosmetic([1.0, 0.0, 1.0, 1.0, 0.0, 1.0])  # droop, wag right, eyes shut
-    empty.run(1.0)
-    moved = angles()
-    assert all(abs(a - b) > 0.2 for a, b in zip(moved, rest)), (rest, moved)
-    # The eyes and the world view draw the model's joints (joint_angles is their snapshot).
-    assert [empty.robot.joint_angles()[link] for link in COSMETIC_LINKS] == moved
+    rest = _drawn_poses(empty)
+    commanded = [1.0, 0.0, 1.0, 1.0, 0.0, 1.0]  # droop, wag right, eyes shut, ears
+    empty.robot.set_cosmetic(commanded)
+    empty.run(0.02)
+    first = empty.robot.sensors.joint_positions[-6:]
+    empty.run(0.08)
+    angles = empty.robot.sensors.joint_positions[-6:]
+    targets = [lo + v * (hi - lo) for v, (lo, hi) in zip(commanded, COSMETIC_SPANS)]
+    assert angles == pytest.approx(targets, abs=0.02)
+    assert all(0.5 < (a - b) / (t - b) < 0.8 for a, b, t in
+               zip(first, [0.0, 0.0, 0.0, 0.0, -1 / 6, 1 / 6], targets))  # a tick: two thirds
+    moved = _drawn_poses(empty)
+    for name in COSMETIC:
+        assert moved[name][1] != pytest.approx(rest[name][1], abs=0.05), name
+    copy = SimWorld('empty')
+    try:
+        copy.restore(empty.snapshot())
+        for name, (position, orientation) in _drawn_poses(copy).items():
+            assert position == pytest.approx(moved[name][0], abs=1e-6), name
+            assert orientation == pytest.approx(moved[name][1], abs=1e-6), name
+    finally:
+        copy.close()
+
+
+def test_drawn_parts_are_where_the_urdf_puts_them(empty):
+    """The tail (two joints deep, on the body) and an ear (on the head), as /tf places them
+    from joint_states."""
+    from miro_ball.miro.body import MOVABLE
+    from miro_ball.miro.link_poses import JOINTED, jointed_poses
+    from miro_sim_bullet.bullet import pybullet as pb
+    from miro_sim_bullet.physics.model import HEAD
+    empty.robot.set_kinematic_targets([0.0, 0.6, 0.5, -0.1])
+    empty.robot.set_cosmetic([0.7, 0.1, 0.5, 0.2, 0.9, 0.3])
+    empty.run(0.5)
+    positions = empty.robot.sensors.joint_positions
+    in_parent = dict(zip((link.name for link in JOINTED), jointed_poses(
+        [positions[MOVABLE.index(link.joint)] for link in JOINTED])))
+    drawn = _drawn_poses(empty)
+    kw = {'physicsClientId': empty.client}
+    head = pb.getLinkState(empty.robot.body_id, HEAD, computeForwardKinematics=1, **kw)[4:6]
+    for frame, chain in ((empty.robot.model.body_pose(), ('tail_droop', 'tail')),
+                         (head, ('ear_r',))):
+        for link in chain:
+            frame = pb.multiplyTransforms(*frame, in_parent[link][:3], in_parent[link][3:])
+        assert drawn[chain[-1]][0] == pytest.approx(frame[0], abs=1e-6)
+        assert drawn[chain[-1]][1] == pytest.approx(frame[1], abs=1e-6)
 
 
 def test_illum_is_kept(empty):

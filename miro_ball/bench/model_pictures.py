@@ -12,6 +12,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from miro_ball.miro.body import COSMETIC_JOINTS
 from miro_ball.miro.camera_model import Intrinsics
 from miro_ball.miro.constants import KIN_CALIB_RAD
 from miro_sim_bullet.bullet import pybullet as pb
@@ -51,9 +52,8 @@ def draw():
         joints = dict(zip(('lift', 'yaw', 'pitch'), KIN_CALIB_RAD[1:]))
         for name, link in zip(('lift', 'yaw', 'pitch'), (rb.NECK, rb.GIMBAL, rb.HEAD)):
             pb.resetJointState(robot.body_id, link, joints[name], **kw)
-        for name, link, (lo, hi) in zip(('droop', 'wag', 'eyelid_l', 'eyelid_r', 'ear_l',
-                                         'ear_r'), rb.COSMETIC_LINKS, rb.COSMETIC_RANGES):
-            pb.resetJointState(robot.body_id, link, lo + POSE.get(name, 1 / 3) * (hi - lo), **kw)
+        robot.pose_drawn([lo + POSE.get(name, 1 / 3) * (hi - lo)
+                          for name, (lo, hi) in zip(COSMETIC_JOINTS, rb.COSMETIC_RANGES)])
         renderer = Renderer(client, log=lambda line: None)
         intrinsics = Intrinsics.from_hfov(*SIZE_PX, HFOV_DEG)
         images = []

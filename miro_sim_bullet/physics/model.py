@@ -2,8 +2,9 @@
 
 PyBullet's base link is ``body`` (its origin the wheel-axle midpoint, 0.045 m up);
 nothing holds it tilted: it rests back on its slider by about 6 degrees because of where
-the slider is. Every other drawn or movable link of the description follows, in its
-order, so the link indices below are the description's. The other robots' eyes draw
+the slider is. The links the physics solves follow (drawn.SOLVED: the wheels, the neck, the
+gimbal, the head); the tail, eyelids, ears and LED patches are drawn-only parts
+(physics.drawn) whose masses ride in the body and the head. The other robots' eyes draw
 these shapes, so they see the MiRo the URDF describes.
 """
 import math
@@ -14,28 +15,37 @@ from miro_ball.miro import body as desc
 from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT, PITCH, TILT_RAD, YAW
 from miro_ball.miro.kc import AXLE_HEIGHT_M as AXLE_HEIGHT
 from miro_sim_bullet.bullet import pybullet as pb
+from miro_sim_bullet.physics.drawn import carried_mass, COSMETIC, DrawnParts, SOLVED
 
-CLIFF_IN_BODY, CLIFF_PITCH_DOWN, BODY_COM = desc.CLIFF_IN_BODY, desc.CLIFF_PITCH_DOWN, desc.BODY_COM
+CLIFF_IN_BODY, CLIFF_PITCH_DOWN = desc.CLIFF_IN_BODY, desc.CLIFF_PITCH_DOWN
 CLIFF_RANGE = 0.5
 SONAR_RANGE = (0.03, 1.0)
 SONAR_HALF_CONE = math.atan(0.309)  # cone radius 0.309 m at 1 m
 WHITE = desc.COLOURS['shell']  # an unlit LED
 
-# Link (= joint) indices: the description's physical links in order.
-(WHEEL_L, WHEEL_R, NECK, GIMBAL, HEAD, TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L,
- EAR_R) = (desc.PHYSICAL.index(name) for name in (
-    'wheel_l', 'wheel_r', 'neck', 'gimbal', 'head', 'tail_droop', 'tail', 'eyelid_l',
-    'eyelid_r', 'ear_l', 'ear_r'))
-# The six LEDs of control/illum in MiRo's order LF, LM, LR, RF, RM, RR.
-ILLUM_LINKS = tuple(desc.PHYSICAL.index(name) for name in desc.ILLUM_NAMES)
+# Link (= joint) indices of the physics body: drawn.SOLVED in order.
+WHEEL_L, WHEEL_R, NECK, GIMBAL, HEAD = (SOLVED.index(name) for name in (
+    'wheel_l', 'wheel_r', 'neck', 'gimbal', 'head'))
 KIN_LINKS = {LIFT: NECK, YAW: GIMBAL, PITCH: HEAD}
-# The movable joints after the tilt (which is the base's own pitch), as PyBullet's joints.
-JOINT_LINKS = tuple(desc.PHYSICAL.index(desc.LINK_OF_JOINT[joint].name)
-                    for joint in desc.MOVABLE[1:])
 # Cosmetic order: droop, wag, eyelid l/r, ear l/r; value 0..1 -> angle span.
-COSMETIC_LINKS = (TAIL_DROOP, TAIL_WAG, EYELID_L, EYELID_R, EAR_L, EAR_R)
-COSMETIC_RADIUS_M = 0.02  # about the size of a tail piece, an ear or an eyelid
 COSMETIC_RANGES = desc.COSMETIC_SPANS
+COSMETIC_RADIUS_M = 0.02  # about the size of a tail piece, an ear or an eyelid
+
+
+def _part_inertia(link):
+    """A drawn part's own inertia: a cosmetic piece as a ball of its mass and
+    COSMETIC_RADIUS_M, an LED patch (a gram) none, as when each was a link of its own."""
+    if link.name not in COSMETIC:
+        return np.zeros(3)
+    return np.full(3, 0.4 * link.mass * COSMETIC_RADIUS_M ** 2)
+
+
+# name -> (mass, centre of mass, inertia to add) of the body and each solved link, with
+# the drawn parts they carry.
+CARRIED = {link.name: carried_mass(link.name, link.mass, link.com, _part_inertia)
+           for link in (desc.LINK[name] for name in ('body',) + SOLVED)}
+# The base's centre of mass in the BODY frame: PyBullet reports and sets the base by it.
+BODY_COM = CARRIED['body'][1]
 _GEOM = {desc.BOX: pb.GEOM_BOX, desc.SPHERE: pb.GEOM_SPHERE, desc.CYLINDER: pb.GEOM_CYLINDER}
 _JOINT = {desc.REVOLUTE: pb.JOINT_REVOLUTE, desc.CONTINUOUS: pb.JOINT_REVOLUTE,
           desc.FIXED: pb.JOINT_FIXED}
@@ -72,6 +82,7 @@ class MiroModel:
     def __init__(self, client):
         self.client = client
         self.body_id = self._build()
+        self.drawn = DrawnParts(client, self._visual)
 
     def _visual(self, shapes):
         kw = {'physicsClientId': self.client}
@@ -105,23 +116,34 @@ class MiroModel:
     def _build(self):
         kw = dict(physicsClientId=self.client)
         base = desc.LINK['body']
-        links = [desc.LINK[name] for name in desc.PHYSICAL]
-        index = {name: i + 1 for i, name in enumerate(desc.PHYSICAL)}  # pybullet's parents
+        links = [desc.LINK[name] for name in SOLVED]
+        index = {name: i + 1 for i, name in enumerate(SOLVED)}  # pybullet's parents
         body = pb.createMultiBody(
-            baseMass=base.mass, baseCollisionShapeIndex=self._collision(base.collisions),
+            baseMass=CARRIED['body'][0],
+            baseCollisionShapeIndex=self._collision(base.collisions),
             baseVisualShapeIndex=self._visual(base.visuals), basePosition=(0, 0, 1.0),
-            baseInertialFramePosition=base.com,
-            linkMasses=[lk.mass for lk in links],
+            baseInertialFramePosition=BODY_COM,
+            linkMasses=[CARRIED[lk.name][0] for lk in links],
             linkCollisionShapeIndices=[self._collision(lk.collisions) for lk in links],
             linkVisualShapeIndices=[self._visual(lk.visuals) for lk in links],
             linkPositions=[lk.xyz for lk in links],
             linkOrientations=[pb.getQuaternionFromEuler(lk.rpy) for lk in links],
-            linkInertialFramePositions=[lk.com for lk in links],
+            linkInertialFramePositions=[CARRIED[lk.name][1] for lk in links],
             linkInertialFrameOrientations=[(0, 0, 0, 1)] * len(links),
             linkParentIndices=[index.get(lk.parent, 0) for lk in links],
             linkJointTypes=[_JOINT[lk.kind] for lk in links],
             linkJointAxis=[lk.axis for lk in links],
             **kw)
+        # PyBullet gives a link the inertia of its collision shapes' bounding box for the
+        # mass it has, in proportion to it: a carrier keeps its own share and gains its
+        # parts' (the inertia about the new centre; the products of inertia the parts add,
+        # under 4 % of the body's and the head's diagonal, are left out).
+        for link, name in enumerate(('body',) + SOLVED, start=-1):
+            mass, _, added = CARRIED[name]
+            if added.any():
+                computed = np.array(pb.getDynamicsInfo(body, link, **kw)[2])
+                pb.changeDynamics(body, link, localInertiaDiagonal=tuple(
+                    computed * desc.LINK[name].mass / mass + added), **kw)
         # The slider is the part of the base that touches the floor: its friction.
         pb.changeDynamics(body, -1, lateralFriction=0.01, **kw)
         for wheel_link in (WHEEL_L, WHEEL_R):
@@ -130,12 +152,6 @@ class MiroModel:
         for joint, link in KIN_LINKS.items():
             lo, hi = JOINT_LIMITS_RAD[joint]
             pb.changeDynamics(body, link, jointLowerLimit=lo, jointUpperLimit=hi, **kw)
-        # PyBullet takes a link's inertia from its collision shape; the cosmetic links have
-        # none (they touch nothing), and a link of zero inertia stays where its motor is
-        # told to move it. Each gets the inertia of a sphere of its mass.
-        for link in COSMETIC_LINKS:
-            inertia = 0.4 * links[link].mass * COSMETIC_RADIUS_M ** 2
-            pb.changeDynamics(body, link, localInertiaDiagonal=(inertia,) * 3, **kw)
         return body
 
     def set_collision_filter(self, group, mask):
@@ -146,12 +162,18 @@ class MiroModel:
 
     def show_illum(self, argb_values):
         """Colour the LED patches: 0xAARRGGBB, AA the brightness; dark LEDs look white."""
-        for link, argb in zip(ILLUM_LINKS, argb_values):
+        for name, argb in zip(desc.ILLUM_NAMES, argb_values):
             level = ((argb >> 24) & 0xFF) / 255.0
             rgb = [((argb >> shift) & 0xFF) / 255.0 for shift in (16, 8, 0)]
             colour = [w + level * (c - w) for c, w in zip(rgb, WHITE[:3])]
-            pb.changeVisualShape(self.body_id, link, rgbaColor=(*colour, 1.0),
-                                 physicsClientId=self.client)
+            self.drawn.colour(name, (*colour, 1.0))
+
+    def pose_drawn(self, cosmetic_angles):
+        """Pose the drawn-only parts on the body and the head as they are now, the
+        cosmetic joints at ``cosmetic_angles`` (rad, COSMETIC's order)."""
+        head = pb.getLinkState(self.body_id, HEAD, computeForwardKinematics=1,
+                               physicsClientId=self.client)
+        self.drawn.pose({'body': self.body_pose(), 'head': head[4:6]}, cosmetic_angles)
 
     def body_frame(self):
         """World (position, rotation matrix) of the BODY frame (the axle midpoint).
@@ -159,16 +181,13 @@ class MiroModel:
         PyBullet reports and sets a base by its centre of mass, which for MiRo
         sits 6 cm behind the axle.
         """
-        com, orn = pb.getBasePositionAndOrientation(self.body_id, physicsClientId=self.client)
-        rot = np.array(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
-        return np.array(com) - rot @ np.array(BODY_COM), rot
+        return body_frame_of(*pb.getBasePositionAndOrientation(self.body_id,
+                                                               physicsClientId=self.client))
 
     def body_pose(self):
-        """World (position, quaternion) of the BODY frame, as tuples (PyBullet's own
-        arithmetic: this runs for every robot every tick)."""
-        com, orn = pb.getBasePositionAndOrientation(self.body_id, physicsClientId=self.client)
-        return pb.multiplyTransforms(com, orn, [-v for v in BODY_COM], (0.0, 0.0, 0.0, 1.0),
-                                     physicsClientId=self.client)
+        """World (position, quaternion) of the BODY frame, as tuples."""
+        return body_pose_of(*pb.getBasePositionAndOrientation(self.body_id,
+                                                              physicsClientId=self.client))
 
     def place(self, x, y, yaw, floor=0.0):
         """Put the robot at rest on flat floor at height floor (FOOT pose x, y, yaw)."""
@@ -178,3 +197,15 @@ class MiroModel:
         pb.resetBasePositionAndOrientation(self.body_id, com, orientation,
                                            physicsClientId=self.client)
         pb.resetBaseVelocity(self.body_id, (0, 0, 0), (0, 0, 0), physicsClientId=self.client)
+
+
+def body_frame_of(com, orientation):
+    """MiroModel.body_frame() from the base's pose as PyBullet reports it."""
+    rot = np.array(pb.getMatrixFromQuaternion(orientation)).reshape(3, 3)
+    return np.array(com) - rot @ np.array(BODY_COM), rot
+
+
+def body_pose_of(com, orientation):
+    """MiroModel.body_pose() from the base's pose as PyBullet reports it (PyBullet's own
+    arithmetic: this runs for every robot every tick)."""
+    return pb.multiplyTransforms(com, orientation, [-v for v in BODY_COM], (0.0, 0.0, 0.0, 1.0))

@@ -11,7 +11,8 @@ import numpy as np
 
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
-                                      KIN_CALIB_RAD, TILT_RAD, WHEEL_RADIUS_M)
+                                      KIN_CALIB_RAD, PLATFORM_TICK_S, TILT_RAD,
+                                      WHEEL_RADIUS_M)
 from miro_ball.miro.body import LINK, MICS
 from miro_ball.miro.kc import camera_in_head, SONAR_IN_HEAD
 from miro_ball.miro.interface import TOUCH_PARTS
@@ -20,6 +21,7 @@ from miro_ball.miro.link_poses import pose_on_base, y_axis
 from miro_ball.miro.touch import pads_touched, TOUCH_PADS
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics import model as rb
+from miro_sim_bullet.physics.drawn import SOLVED
 from miro_sim_bullet.physics.sensors import (SONAR_DIRECTIONS, Accelerometer, Sensors,
                                              cliff_value)
 from miro_sim_bullet.physics.speaker import Speaker
@@ -28,7 +30,11 @@ CMD_TIMEOUT_S = 0.5
 WHEEL_TORQUE_NM = 0.5  # enough to reach 0.4 m/s in a few cm, weak enough to stall on a wall
 HEAD_SPEED_RAD_S = 2.0  # servo-like slew rate of the neck joints
 HEAD_TORQUE_NM = 2.0
-COSMETIC_TORQUE_NM = 0.2
+# The cosmetic joints close the gap to their target as a servo of this time constant (what
+# PyBullet's position motors did when they drove them as links: a tenth of the gap closed
+# each 2 ms step); they are drawn-only parts, moved here each platform tick (physics.drawn).
+COSMETIC_TIME_CONSTANT_S = 0.019
+COSMETIC_STEP = 1.0 - math.exp(-PLATFORM_TICK_S / COSMETIC_TIME_CONSTANT_S)
 # A touched pad reads touched this long after the last message that named it: a stroke is a
 # stream of touch messages (the GUI sends 20 a second), and letting go is their end.
 TOUCH_HOLD_S = 0.25
@@ -38,6 +44,13 @@ _SPEAKER_IN_HEAD = np.array(LINK['speaker'].xyz)
 # The ear microphones face out of the head's sides (+y left, -y right); the others, on its
 # top and on the body, are not shadowed by it.
 _EAR_SIDES = np.array([1.0, -1.0, 0.0, 0.0])
+# The physics body's joints: its links (physics.drawn.SOLVED), joint_states' order after the
+# tilt and before the cosmetic joints.
+_SOLVED_JOINTS = tuple(range(len(SOLVED)))
+
+
+def _matrix(quaternion):
+    return np.array(pb.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
 
 
 class HearingFrame(NamedTuple):
@@ -78,6 +91,10 @@ class MiroRobot:
         self.last_cmd_time = -math.inf
         self.kin_targets = list(KIN_CALIB_RAD)
         self.cosmetic = list(COSMETIC_CALIB)
+        # Where the cosmetic joints are (rad) and how fast they move: they are drawn, not
+        # solved, and follow self.cosmetic a tick at a time (settle_cosmetic).
+        self.cosmetic_angles = self._cosmetic_targets()
+        self.cosmetic_rates = [0.0] * len(self.cosmetic)
         self.flags = 0
         self.illum = [0] * 6
         self.speaker = Speaker()
@@ -116,7 +133,6 @@ class MiroRobot:
 
     def set_cosmetic(self, values):
         self.cosmetic = [min(max(v, 0.0), 1.0) for v in values]
-        self._apply_joint_motors()
 
     def set_illum(self, argb):
         """Six 0xAARRGGBB LEDs, shown as the colour of the body patches."""
@@ -147,15 +163,13 @@ class MiroRobot:
     def cliff_reflex_enabled(self):
         return not self.flags & DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
 
-    def _cosmetic_angles(self):
+    def _cosmetic_targets(self):
         return [lo + v * (hi - lo) for v, (lo, hi) in zip(self.cosmetic, rb.COSMETIC_RANGES)]
 
     def _set_joints_to_targets(self):
         kw = self._kw()
         for joint, link in rb.KIN_LINKS.items():
             pb.resetJointState(self.body_id, link, self.kin_targets[joint], **kw)
-        for link, angle in zip(rb.COSMETIC_LINKS, self._cosmetic_angles()):
-            pb.resetJointState(self.body_id, link, angle, **kw)
 
     def _apply_joint_motors(self):
         kw = self._kw()
@@ -163,14 +177,20 @@ class MiroRobot:
             pb.setJointMotorControl2(self.body_id, link, pb.POSITION_CONTROL,
                                      targetPosition=self.kin_targets[joint],
                                      maxVelocity=HEAD_SPEED_RAD_S, force=HEAD_TORQUE_NM, **kw)
-        pb.setJointMotorControlArray(self.body_id, list(rb.COSMETIC_LINKS), pb.POSITION_CONTROL,
-                                     targetPositions=self._cosmetic_angles(),
-                                     forces=[COSMETIC_TORQUE_NM] * 6, **kw)
+
+    def _settle_cosmetic(self):
+        """Move the cosmetic joints a platform tick on towards their targets."""
+        moves = [COSMETIC_STEP * (target - angle)
+                 for target, angle in zip(self._cosmetic_targets(), self.cosmetic_angles)]
+        self.cosmetic_angles = [angle + move for angle, move in zip(self.cosmetic_angles, moves)]
+        self.cosmetic_rates = [move / PLATFORM_TICK_S for move in moves]
 
     # -- the 50 Hz platform tick ------------------------------------------------------------
     def tick(self):
         """What MiRo's platform does at 50 Hz: sense, then timeout, cliff reflex, motors."""
-        cliff = self._sense_frames()
+        self._settle_cosmetic()
+        ranges = self._sense_frames()
+        cliff = ranges[0]
         left, right = self.wheel_cmd
         if self.clock() - self.last_cmd_time > CMD_TIMEOUT_S:
             left = right = 0.0
@@ -183,13 +203,27 @@ class MiroRobot:
             targetVelocities=[left / WHEEL_RADIUS_M, right / WHEEL_RADIUS_M],
             forces=[WHEEL_TORQUE_NM] * 2, **self._kw())
         self.sound = self.speaker.tick(self.clock())
-        self.sensors = self._read_sensors(cliff)
+        self.sensors = self._read_sensors(ranges)
 
     def _sense_frames(self):
-        """The head's and the body's frames now (the tick's: for the sonar, the cliff
-        sensors and the microphones), and the cliff readings."""
-        self.frames = {'head': self.link_frame(rb.HEAD), 'body': self.link_frame(-1)}
-        return self._read_cliff()
+        """Read the tick's state of the body and the head once (their frames and motion: for
+        the range sensors, odometry, joint_states and the IMUs) and cast every range ray
+        in one batch; (cliff readings, sonar reading)."""
+        kw = self._kw()
+        self.base = pb.getBasePositionAndOrientation(self.body_id, **kw)
+        self.base_velocity = pb.getBaseVelocity(self.body_id, **kw)
+        self.head = pb.getLinkState(self.body_id, rb.HEAD, computeLinkVelocity=1,
+                                    computeForwardKinematics=1, **kw)
+        self.frames = {'head': (np.array(self.head[4]), _matrix(self.head[5])),
+                       'body': rb.body_frame_of(*self.base)}
+        cliff_starts, cliff_ends = self._cliff_rays()
+        sonar_starts, sonar_ends = self._sonar_rays()
+        hits = self._rays(cliff_starts + sonar_starts, cliff_ends + sonar_ends)
+        cliff = tuple(cliff_value(h[2] * rb.CLIFF_RANGE if h[0] >= 0 else math.inf)
+                      for h in hits[:len(cliff_starts)])
+        lo, hi = rb.SONAR_RANGE
+        found = [h[2] * hi for h in hits[len(cliff_starts):] if h[0] >= 0]
+        return cliff, max(lo, min(found)) if found else math.inf
 
     def _sense(self):
         self.sensors = self._read_sensors(self._sense_frames())
@@ -215,69 +249,63 @@ class MiroRobot:
         if link < 0:
             return self.model.body_frame()
         state = pb.getLinkState(self.body_id, link, computeForwardKinematics=1, **self._kw())
-        return np.array(state[4]), np.array(pb.getMatrixFromQuaternion(state[5])).reshape(3, 3)
+        return np.array(state[4]), _matrix(state[5])
 
     def _rays(self, starts, ends):
         return pb.rayTestBatch(starts, ends, collisionFilterMask=self.ray_mask, **self._kw())
 
-    def _read_cliff(self):
+    def _cliff_rays(self):
+        """(starts, ends) of the two cliff sensors' rays."""
         pos, rot = self.frames['body']
         down = rb.CLIFF_PITCH_DOWN
         ray_dir = rot @ np.array([math.cos(down), 0.0, -math.sin(down)])
         x, y, z = rb.CLIFF_IN_BODY
         starts = [pos + rot @ np.array([x, side * y, z]) for side in (1, -1)]
-        hits = self._rays(starts, [s + rb.CLIFF_RANGE * ray_dir for s in starts])
-        return tuple(cliff_value(h[2] * rb.CLIFF_RANGE if h[0] >= 0 else math.inf)
-                     for h in hits)
+        return [s.tolist() for s in starts], [(s + rb.CLIFF_RANGE * ray_dir).tolist()
+                                              for s in starts]
 
-    def _read_sonar(self):
+    def _sonar_rays(self):
+        """(starts, ends) of the sonar cone's rays (lists: PyBullet reads them faster than
+        arrays)."""
         pos, rot = self.frames['head']
         start = pos + rot @ np.array(SONAR_IN_HEAD)
-        lo, hi = rb.SONAR_RANGE
-        ends = start + hi * SONAR_DIRECTIONS @ rot.T
-        found = [h[2] * hi for h in self._rays([start] * len(ends), ends) if h[0] >= 0]
-        return max(lo, min(found)) if found else math.inf
+        ends = start + rb.SONAR_RANGE[1] * SONAR_DIRECTIONS @ rot.T
+        return [start.tolist()] * len(ends), ends.tolist()
 
-    def _imu(self, link, part):
-        """Orientation, angular velocity and specific force of a link, in its own frame."""
-        kw = self._kw()
-        if link < 0:
-            orn = pb.getBasePositionAndOrientation(self.body_id, **kw)[1]
-            lin, ang = pb.getBaseVelocity(self.body_id, **kw)
-        else:
-            state = pb.getLinkState(self.body_id, link, computeLinkVelocity=1,
-                                    computeForwardKinematics=1, **kw)
-            orn, lin, ang = state[5], state[6], state[7]
-        rot = np.array(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
+    def _imu(self, orn, lin, ang, part):
+        """Orientation, angular velocity and specific force of a link moving so, in its own
+        frame."""
+        rot = _matrix(orn)
         force = self.imu[part].specific_force(self.clock(), rot, np.array(lin))
         return tuple(orn), tuple(rot.T @ np.array(ang)), force
 
-    def _read_sensors(self, cliff):
+    def _read_sensors(self, ranges):
         kw = self._kw()
-        states = dict(zip(rb.JOINT_LINKS, pb.getJointStates(self.body_id, rb.JOINT_LINKS, **kw)))
+        states = pb.getJointStates(self.body_id, _SOLVED_JOINTS, **kw)
         neck = [states[link] for link in (rb.NECK, rb.GIMBAL, rb.HEAD)]
         wheels = [states[link] for link in (rb.WHEEL_L, rb.WHEEL_R)]
-        lin, ang = pb.getBaseVelocity(self.body_id, **kw)
-        x, y, yaw = self.pose()
+        lin, ang = self.base_velocity
+        pos, rot = self.frames['body']
+        x, y, yaw = pos[0], pos[1], math.atan2(rot[1, 0], rot[0, 0])
         forward = lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw)
-        position, orientation = self.model.body_pose()
+        position, orientation = rb.body_pose_of(*self.base)
         body_xyz, body_quaternion, tilt = pose_on_base(position, orientation, x, y, yaw)
         tilt_rate = sum(a * b for a, b in zip(ang, y_axis(orientation)))
         return Sensors(
             time=self.clock(),
             kinematic_positions=(TILT_RAD, *(s[0] for s in neck)),
             kinematic_velocities=(0.0, *(s[1] for s in neck)),
-            joint_positions=(tilt, *(states[link][0] for link in rb.JOINT_LINKS)),
-            joint_velocities=(tilt_rate, *(states[link][1] for link in rb.JOINT_LINKS)),
+            joint_positions=(tilt, *(s[0] for s in states), *self.cosmetic_angles),
+            joint_velocities=(tilt_rate, *(s[1] for s in states), *self.cosmetic_rates),
             body_in_base=(body_xyz, body_quaternion),
             pose=(x, y, yaw),
             velocity=(forward, ang[2]),
             wheel_speed_cmd=self.wheel_out,
             wheel_speed_opto=tuple(s[1] * WHEEL_RADIUS_M for s in wheels),
-            cliff=cliff,
-            sonar=self._read_sonar(),
-            imu_body=self._imu(-1, 'body'),
-            imu_head=self._imu(rb.HEAD, 'head'),
+            cliff=ranges[0],
+            sonar=ranges[1],
+            imu_body=self._imu(self.base[1], lin, ang, 'body'),
+            imu_head=self._imu(*self.head[5:8], 'head'),
             touch_head=self._touch_reading('head'),
             touch_body=self._touch_reading('body'),
         )
@@ -300,11 +328,17 @@ class MiroRobot:
         eye_pos, eye_rot = camera_in_head(side)
         return head_pos + head_rot @ eye_pos, head_rot @ eye_rot
 
-    # -- snapshots for the eye workers --------------------------------------------------------
+    # -- drawing, and snapshots for the eye workers --------------------------------------------
+    def pose_drawn(self):
+        """Pose the drawn-only parts (tail, eyelids, ears, LEDs) for a picture of now."""
+        self.model.pose_drawn(self.cosmetic_angles)
+
     def joint_angles(self):
-        joints = range(pb.getNumJoints(self.body_id, **self._kw()))
-        return [s[0] for s in pb.getJointStates(self.body_id, joints, **self._kw())]
+        """Every joint after the tilt, as joint_states orders them (solved, then cosmetic)."""
+        states = pb.getJointStates(self.body_id, _SOLVED_JOINTS, **self._kw())
+        return [s[0] for s in states] + list(self.cosmetic_angles)
 
     def set_joint_angles(self, angles):
-        for joint, angle in enumerate(angles):
+        for joint, angle in zip(_SOLVED_JOINTS, angles):
             pb.resetJointState(self.body_id, joint, angle, **self._kw())
+        self.cosmetic_angles = list(angles[len(_SOLVED_JOINTS):])

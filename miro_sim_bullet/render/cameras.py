@@ -37,7 +37,10 @@ class Cameras:
         self._plans = LensPlans()
 
     def _current(self):
-        """The renderer, after it has read the bodies of a rebuilt (reset) world."""
+        """The renderer, after it has read the bodies of a rebuilt (reset) world, with the
+        robots' drawn-only parts (tail, eyelids, ears, LEDs) posed as they are now."""
+        for robot in self.world.robots.values():
+            robot.pose_drawn()
         if self._generation != self.world.generation:
             self.renderer.scene_changed()
             self._generation = self.world.generation

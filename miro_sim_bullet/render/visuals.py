@@ -10,6 +10,7 @@ shapes for both, so the view on ROS is the view the eyes have.
 import numpy as np
 
 from miro_sim_bullet.bullet import pybullet as p
+from miro_sim_bullet.physics.drawn import POSED_KEY
 
 MESHES = ('box', 'sphere', 'cylinder')  # unit cube, unit-radius sphere, unit cylinder along z
 MIN_SCALE = 1e-6  # flat shapes still get finite normals
@@ -38,7 +39,10 @@ class BodyVisuals:
         kw = {'physicsClientId': client}
         self.links = p.getNumJoints(body, **kw)
         info = p.getDynamicsInfo(body, -1, **kw)
-        self.static = info[0] == 0 and self.links == 0
+        # A body without mass or links stays where it is, but for a drawn-only part of a
+        # robot, which the simulator poses (physics.drawn).
+        self.static = (info[0] == 0 and self.links == 0
+                       and p.getUserDataId(body, POSED_KEY, **kw) < 0)
         # PyBullet reports a base by its centre of mass; visuals hang off the link frame.
         inertial_rot = matrices([info[4]])[0]
         self.base_to_link = (inertial_rot.T, -inertial_rot.T @ np.asarray(info[3]))

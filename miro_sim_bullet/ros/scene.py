@@ -22,19 +22,16 @@ import hashlib
 import math
 from pathlib import Path
 
-import numpy as np
-
 from builtin_interfaces.msg import Duration
 from geometry_msgs.msg import Point
 from sensor_msgs.msg import CompressedImage
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray, UVCoordinate
 
-from miro_ball.miro.body import PHYSICAL
+from miro_ball.miro.body import ILLUM_NAMES
 from miro_ball.miro.interface import frame_id, WORLD_FRAME
 from miro_ball.miro.rotations import matrix_quaternions
 from miro_sim_bullet.bullet import pybullet as pb
-from miro_sim_bullet.physics.model import ILLUM_LINKS
 from miro_sim_bullet.render.visuals import BodyVisuals, MESHES
 
 SCENE_RATE_HZ = 30.0
@@ -113,6 +110,9 @@ class SceneMarkers:
         self.labels = world.body_labels  # body id -> (namespace, kind of body)
         self.visuals = {body: BodyVisuals(world.client, body) for body in self.labels}
         self.robot_bodies = {robot.body_id: name for name, robot in world.robots.items()}
+        # Each robot's LED patches: drawn-only parts, a body each (physics.drawn).
+        self.leds = {name: [(led, BodyVisuals(world.client, robot.model.drawn.bodies[led]))
+                            for led in ILLUM_NAMES] for name, robot in world.robots.items()}
         self.movers = {body: ns for body, (ns, kind) in self.labels.items() if kind == 'mover'}
         self._sent = {}  # mover body -> its base's (position, quaternion) last sent
         self._shown = None
@@ -132,7 +132,7 @@ class SceneMarkers:
                                                         colours[k], WORLD_FRAME, ns, index),
                                           rotations[k], positions[k]))
             elif kind == 'robot':
-                markers += self._robot_markers(ns, visuals)
+                markers += self._robot_markers(ns)
         for index, picture in enumerate(getattr(self.world.description, 'pictures', ())):
             markers.append(picture_marker(picture, index))
         for index, (name, position) in enumerate(self.sounds()):
@@ -145,17 +145,15 @@ class SceneMarkers:
         return [(name, tuple(source.position)) for name, (_, source)
                 in self.world.acoustics.sounds.items()]
 
-    def _robot_markers(self, robot, visuals):
+    def _robot_markers(self, robot):
         """A robot's LEDs in their link frames, frame-locked: /tf moves them. A shade larger
         than the URDF's patches, so a viewer that draws both shows the lit colour."""
-        colours = visuals.colours()
         markers = []
-        for k in np.flatnonzero(np.isin(visuals.link, ILLUM_LINKS)):
-            link = PHYSICAL[visuals.link[k]]
-            marker = _shape_marker(visuals.mesh[k], visuals.scale[k] * LED_MARKER_SCALE,
-                                   colours[k], frame_id(robot, link), robot, int(k))
+        for index, (link, visuals) in enumerate(self.leds[robot]):
+            marker = _shape_marker(visuals.mesh[0], visuals.scale[0] * LED_MARKER_SCALE,
+                                   visuals.colours()[0], frame_id(robot, link), robot, index)
             marker.frame_locked, marker.text = True, link
-            markers.append(_place(marker, visuals.rot[k], visuals.offset[k]))
+            markers.append(_place(marker, visuals.rot[0], visuals.offset[0]))
         return markers
 
     def layout_state(self):
