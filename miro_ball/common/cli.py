@@ -1,5 +1,14 @@
-"""The command line of a node: the user's own arguments, without the ROS ones."""
+"""The command line of a node: the user's own arguments, without the ROS ones; a parser
+that refuses a bad command line in one line."""
+import argparse
 import sys
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse that ends a bad command line with one line and a pointer to --help."""
+
+    def error(self, message):
+        self.exit(2, '%s: error: %s (try --help)\n' % (self.prog, message))
 
 
 def user_args(argv, prog, params=(), node=None):

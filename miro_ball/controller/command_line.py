@@ -7,17 +7,10 @@ import sys
 import cv2
 
 from miro_ball.common import ros_params
-from miro_ball.common.cli import user_args
+from miro_ball.common.cli import Parser, user_args
 from miro_ball.common.lifecycle import run_node
 from miro_ball.controller.host import all_groups, ControllerHost, topics
 from miro_ball.miro.interface import CLOCK, DEFAULT_ROBOT_NAME
-
-
-class Parser(argparse.ArgumentParser):
-    """argparse that ends a bad command line with one line and a pointer to --help."""
-
-    def error(self, message):
-        self.exit(2, '%s: error: %s (try --help)\n' % (self.prog, message))
 
 
 def _topic_lines(hosted):
