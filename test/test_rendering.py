@@ -9,7 +9,9 @@ import threading
 import numpy as np
 import pytest
 
+from miro_ball.miro.body import LINK
 from miro_ball.miro.camera_model import CameraModel, Intrinsics
+from miro_ball.miro.rotations import quaternion_matrix
 from miro_sim_bullet.bullet import pybullet as p
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render import gl_renderer
@@ -236,12 +238,19 @@ def test_the_tail_wag_is_drawn_and_a_snapshot_draws_it_alike(sims, kind):
     rotation = np.array([[math.cos(yaw), -math.sin(yaw), 0.0],
                          [math.sin(yaw), math.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
     intrinsics = Intrinsics.from_hfov(160, 120, 60.0)
-    robot.set_cosmetic([0.0, 0.0, 0.0, 0.0, 0.5, 0.5])
-    sim.run(0.2)
-    left = cameras.render_view(behind, rotation, intrinsics)
-    robot.set_cosmetic([0.0, 1.0, 0.0, 0.0, 0.5, 0.5])
-    sim.run(0.2)
-    right = cameras.render_view(behind, rotation, intrinsics)
+    camera = CameraModel.from_intrinsics(intrinsics)
+    tip = np.array(LINK['tail'].visuals[-1].xyz)  # the dark ball at the tail's end
+    images = []
+    for wag in (0.0, 1.0):
+        robot.set_cosmetic([0.0, wag, 0.0, 0.0, 0.5, 0.5])
+        sim.run(0.2)
+        images.append(cameras.render_view(behind, rotation, intrinsics))
+        position, orientation = p.getBasePositionAndOrientation(
+            robot.model.drawn.bodies['tail'], physicsClientId=sim.client)
+        u, v = (round(c) for c in camera.project_from(
+            behind, rotation, np.array(position) + quaternion_matrix(orientation) @ tip))
+        assert (images[-1][v - 1:v + 2, u - 1:u + 2] < 70).all(), (kind, wag)
+    left, right = images
     assert (left != right).any(axis=2).sum() > 30
     copy, copy_cameras = sims('empty', kind)
     copy.restore(sim.snapshot())

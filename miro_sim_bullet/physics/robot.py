@@ -44,6 +44,11 @@ _SPEAKER_IN_HEAD = np.array(LINK['speaker'].xyz)
 # The ear microphones face out of the head's sides (+y left, -y right); the others, on its
 # top and on the body, are not shadowed by it.
 _EAR_SIDES = np.array([1.0, -1.0, 0.0, 0.0])
+# The cliff sensors (left, right) and where they look, in the BODY frame.
+_CLIFF_POINTS = tuple(np.array([rb.CLIFF_IN_BODY[0], side * rb.CLIFF_IN_BODY[1],
+                                rb.CLIFF_IN_BODY[2]]) for side in (1, -1))
+_CLIFF_DIRECTION = np.array([math.cos(rb.CLIFF_PITCH_DOWN), 0.0, -math.sin(rb.CLIFF_PITCH_DOWN)])
+_SONAR_POINT = np.array(SONAR_IN_HEAD)
 # The physics body's joints: its links (physics.drawn.SOLVED), joint_states' order after the
 # tilt and before the cosmetic joints.
 _SOLVED_JOINTS = tuple(range(len(SOLVED)))
@@ -257,10 +262,8 @@ class MiroRobot:
     def _cliff_rays(self):
         """(starts, ends) of the two cliff sensors' rays."""
         pos, rot = self.frames['body']
-        down = rb.CLIFF_PITCH_DOWN
-        ray_dir = rot @ np.array([math.cos(down), 0.0, -math.sin(down)])
-        x, y, z = rb.CLIFF_IN_BODY
-        starts = [pos + rot @ np.array([x, side * y, z]) for side in (1, -1)]
+        ray_dir = rot @ _CLIFF_DIRECTION
+        starts = [pos + rot @ where for where in _CLIFF_POINTS]
         return [s.tolist() for s in starts], [(s + rb.CLIFF_RANGE * ray_dir).tolist()
                                               for s in starts]
 
@@ -268,7 +271,7 @@ class MiroRobot:
         """(starts, ends) of the sonar cone's rays (lists: PyBullet reads them faster than
         arrays)."""
         pos, rot = self.frames['head']
-        start = pos + rot @ np.array(SONAR_IN_HEAD)
+        start = pos + rot @ _SONAR_POINT
         ends = start + rb.SONAR_RANGE[1] * SONAR_DIRECTIONS @ rot.T
         return [start.tolist()] * len(ends), ends.tolist()
 
