@@ -44,11 +44,10 @@ class DrawnParts:
         kw = {'physicsClientId': client}
         self.bodies = {}
         for name in DRAWN:
-            # A static rigid body (maximal coordinates) costs the physics step a fifth of
-            # what a multibody without links does: 0.05 us a step against 0.2.
-            body = pb.createMultiBody(0, -1, visual(desc.LINK[name].visuals),
-                                      useMaximalCoordinates=True, **kw)
-            pb.setCollisionFilterGroupMask(body, -1, 0, 0, **kw)  # no pairs with anything
+            # A multibody: PyBullet's saveState and restoreState (SimWorld.rewind) know no
+            # other kind, though a static rigid body would cost the step less (0.05 us
+            # against 0.2).
+            body = pb.createMultiBody(0, -1, visual(desc.LINK[name].visuals), **kw)
             pb.addUserData(body, POSED_KEY, '1', **kw)
             self.bodies[name] = body
         # name -> (parent, joint origin xyz, its turn, joint axis, index in COSMETIC or None)

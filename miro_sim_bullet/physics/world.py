@@ -143,11 +143,8 @@ class SimWorld:
         geom = {'box': pb.GEOM_BOX, 'cylinder': pb.GEOM_CYLINDER, 'sphere': pb.GEOM_SPHERE}
         col = pb.createCollisionShape(geom[shape.kind], **cdims, **kw)
         vis = pb.createVisualShape(geom[shape.kind], rgbaColor=(*shape.colour, 1), **dims, **kw)
-        # What does not move is a static rigid body (maximal coordinates): a fixed multibody
-        # costs every physics step 0.2 us, a tenth of MiRo's step in the arena's 25 shapes.
         body = pb.createMultiBody(shape.mass, col, vis, shape.position,
-                                  pb.getQuaternionFromEuler((0, 0, shape.yaw)),
-                                  useMaximalCoordinates=shape.mass == 0, **kw)
+                                  pb.getQuaternionFromEuler((0, 0, shape.yaw)), **kw)
         pb.changeDynamics(body, -1, lateralFriction=shape.friction,
                           restitution=shape.restitution, **kw)
         return body
@@ -172,7 +169,7 @@ class SimWorld:
                 # TinyRenderer's texture v runs up from the image's bottom row (OBJ's way).
                 uvs=[(u, 1.0 - v) for u, v in PICTURE_UV],
                 normals=[[n / length for n in normal]] * 4, **kw)
-            body = pb.createMultiBody(0, -1, visual, (0, 0, 0), useMaximalCoordinates=True, **kw)
+            body = pb.createMultiBody(0, -1, visual, (0, 0, 0), **kw)
             pb.changeVisualShape(body, -1, textureUniqueId=textures[picture.image],
                                  rgbaColor=(1, 1, 1, 1), **kw)
 

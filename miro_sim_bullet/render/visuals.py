@@ -39,16 +39,13 @@ class BodyVisuals:
         kw = {'physicsClientId': client}
         self.links = p.getNumJoints(body, **kw)
         info = p.getDynamicsInfo(body, -1, **kw)
-        massless = info[0] == 0 and self.links == 0
         # A body without mass or links stays where it is, but for a drawn-only part of a
         # robot, which the simulator poses (physics.drawn).
-        self.static = massless and p.getUserDataId(body, POSED_KEY, **kw) < 0
+        self.static = (info[0] == 0 and self.links == 0
+                       and p.getUserDataId(body, POSED_KEY, **kw) < 0)
         # PyBullet reports a base by its centre of mass; visuals hang off the link frame.
-        # A massless body is a static rigid body here, whose frames coincide (PyBullet
-        # fills in no inertial frame for those: what it reports is left from a call before).
-        inertial_rot = np.eye(3) if massless else matrices([info[4]])[0]
-        inertial_pos = np.zeros(3) if massless else np.asarray(info[3])
-        self.base_to_link = (inertial_rot.T, -inertial_rot.T @ inertial_pos)
+        inertial_rot = matrices([info[4]])[0]
+        self.base_to_link = (inertial_rot.T, -inertial_rot.T @ np.asarray(info[3]))
         mesh, link, entry, rot, offset, scale = [], [], [], [], [], []
         for index, shape in enumerate(p.getVisualShapeData(body, **kw)):
             geometry, dims, position, orientation = shape[2], shape[3], shape[5], shape[6]
