@@ -3,10 +3,11 @@
 They touch nothing and their joints' centres of mass sit on their axes, so all they do to
 the physics is weigh. The physics body (model.MiroModel) therefore solves only the body, the
 wheels, the neck and the head, with these parts' masses merged into the link that carries
-them; solving them as links of their own, moved by motors, cost a third of each physics
-step (BENCHMARKS.md, "Physics step, learning round"). What is drawn of each is a body of its
-own, without mass or collision shape, which the simulator poses from its carrier's frame and
-its joints' angles when something is about to draw (pose()), not every step.
+them; solving them as links of their own, moved by motors, cost over a third of each
+physics step (BENCHMARKS.md, "Physics step, learning round"). What is drawn of each is a
+body of its own, without mass or collision shape, which the simulator poses from its
+carrier's frame and its joints' angles when something is about to draw (pose()), not every
+step.
 """
 import numpy as np
 
