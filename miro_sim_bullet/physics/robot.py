@@ -97,7 +97,7 @@ class MiroRobot:
         self.kin_targets = list(KIN_CALIB_RAD)
         self.cosmetic = list(COSMETIC_CALIB)
         # Where the cosmetic joints are (rad) and how fast they move: they are drawn, not
-        # solved, and follow self.cosmetic a tick at a time (settle_cosmetic).
+        # solved, and follow self.cosmetic a tick at a time (_settle_cosmetic).
         self.cosmetic_angles = self._cosmetic_targets()
         self.cosmetic_rates = [0.0] * len(self.cosmetic)
         self.flags = 0
