@@ -257,7 +257,9 @@ def test_help_lists_the_parameters_and_worlds():
     out = subprocess.run([sys.executable, '-m', 'miro_sim_bullet', '--help'],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0
-    assert 'real_time_factor' in out.stdout and 'bundled worlds: cube, den, empty, football, football_pitch, miro, petshop, tables' in out.stdout
+    assert 'real_time_factor' in out.stdout
+    assert ('bundled worlds: cube, den, empty, football, football_pitch, miro, petshop, t_maze, '
+            'tables') in out.stdout
 
 
 def test_importing_the_simulator_prints_nothing():

@@ -8,7 +8,6 @@ taken here from the robot's own tick (its ``sensors``), and an Action reaches th
 the simulator's control topics hand it over, so that what is learnt here behaves the same
 there. A snapshot of the built world makes a reset cheap: restored, never rebuilt.
 """
-import importlib.util
 import math
 
 import numpy as np
@@ -31,16 +30,6 @@ def to_argb(rgb):
     """0xFFRRGGBB of an (R, G, B) triple of 0..255."""
     r, g, b = (int(min(max(v, 0), 255)) for v in rgb)
     return 0xFF000000 | r << 16 | g << 8 | b
-
-
-def _triton_before_mesa():
-    """PyTorch's compiler, triton, carries an LLVM of its own, and Mesa's software renderer
-    (llvmpipe, which draws the eyes where there is no GPU) puts another among the process's
-    global symbols: triton imported after the first eye image is drawn crashes the process
-    (Stable-Baselines3 imports it as it starts to train). Imported first, both work. Nothing
-    happens where PyTorch is not installed; 0.1 s once where it is."""
-    if importlib.util.find_spec('triton') is not None:
-        importlib.import_module('triton')
 
 
 class WorldRig:
@@ -104,7 +93,6 @@ class WorldRig:
 
     def _cameras(self):
         if self.cameras is None:
-            _triton_before_mesa()
             self.cameras = Cameras(self.sim, self.renderer, log=lambda _: None)
         return self.cameras
 

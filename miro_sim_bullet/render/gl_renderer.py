@@ -13,6 +13,7 @@ flipped vertically so that the first row read back is the top row of the image: 
 """
 import collections
 import functools
+import importlib.util
 import math
 import os
 import time
@@ -221,7 +222,19 @@ def _probe():
     return True, f'EGL works: {name}', name
 
 
+@functools.lru_cache(maxsize=1)
+def _triton_before_mesa():
+    """PyTorch's compiler, triton, carries an LLVM of its own, and Mesa's software renderer
+    (llvmpipe, where there is no GPU) puts another among the process's global symbols:
+    triton imported after the first EGL context crashes the process (Stable-Baselines3
+    imports it as it starts to train on a learning environment). Imported first, both work.
+    Nothing happens where PyTorch is not installed; 0.1 s once where it is."""
+    if importlib.util.find_spec('triton') is not None:
+        importlib.import_module('triton')
+
+
 def _create_context():
+    _triton_before_mesa()
     try:
         import moderngl
     except ImportError as exc:
