@@ -12,7 +12,8 @@ setup(
     # code finds the bundled worlds with importlib.resources, whatever the prefix.
     package_dir={'miro_sim_bullet.worlds': 'worlds'},
     package_data={'miro_sim_bullet.worlds': ['*.toml', 'pictures/*.png', 'sounds/*.ogg'],
-                  'miro_ball.gui': ['static/*', 'static/vendor/three/*']},
+                  'miro_ball.gui': ['static/*', 'static/vendor/three/*'],
+                  'miro_ball.learn': ['policies/*/*']},  # the trained policies bundled
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),
@@ -43,6 +44,7 @@ setup(
         'scikit-image',  # faces: its LBP frontal-face cascade (demo mode's face detector)
         'scipy',  # rotations (scipy.spatial.transform), the microphones' filters
         'soundfile',  # sound files: a world's sounds, the recorder's WAV, the audio clients
+        'tqdm',  # miro_ball.learn.train's and evaluate's progress bars
     ],
     extras_require={
         # Left out for users whose ROS 2 Jazzy is installed and sourced.

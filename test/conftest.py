@@ -25,7 +25,8 @@ TIERS = {
               'test_grade_report', 'test_soak_verdict', 'test_packaging', 'test_record_parts',
               'test_ros2_convert', 'test_build_interfaces', 'test_body', 'test_hearing',
               'test_animal_parts', 'test_throttle', 'test_sound_files', 'test_docs',
-              'test_gui_pairing', 'test_faces', 'test_learn', 'test_learn_multi')),
+              'test_gui_pairing', 'test_faces', 'test_learn', 'test_learn_multi',
+              'test_learn_train')),
     'ros': ('nodes in-process on executors of their own, a process or two beside them',
             ('test_clients', 'test_controller_node', 'test_fuzz_params', 'test_fuzz_topics',
              'test_gui_bridge', 'test_multi_robot', 'test_sim_executor', 'test_sim_node',
@@ -36,7 +37,7 @@ TIERS = {
             ('test_closed_loop', 'test_lab', 'test_grade',
              'test_record', 'test_restart', 'test_scenario_bench',
              'test_signals', 'test_sim_domain', 'test_soak', 'test_tutorial', 'test_grade_class',
-             'test_grade_ray', 'test_refusals', 'test_learn_ros')),
+             'test_grade_ray', 'test_refusals', 'test_learn_ros', 'test_learn_ray')),
     'browser': ('the GUI in Debian\'s chromium through Playwright', ('test_gui_browser',)),
     'netns': ('hosts in network namespaces (root)', ('test_two_hosts',)),
 }
