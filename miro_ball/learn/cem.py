@@ -4,11 +4,11 @@ import numpy as np
 
 
 class CrossEntropy:
-    """``size`` parameters from N(``mean`` (default 0), ``sigma``²). Each generation ``ask()`` gives
-    ``population`` vectors, the first of them the current mean (so the curve can follow the
-    mean itself at no extra cost), and ``tell(scores)`` refits the Gaussian to the
-    ``elite`` best. ``extra`` noise, halving every ``extra_half_life`` generations, keeps
-    the search from collapsing before it has found anything."""
+    """``size`` parameters from N(``mean`` (default 0), ``sigma``²). Each generation
+    ``ask()`` gives ``population`` vectors, the first of them the current mean (so the curve
+    can follow the mean itself at no extra cost), and ``tell(scores)`` refits the Gaussian
+    to the ``elite`` best. ``extra`` noise, halving every ``extra_half_life`` generations,
+    keeps the search from collapsing before it has found anything."""
 
     def __init__(self, size, rng, population=16, elite=4, sigma=1.0, extra=0.3,
                  extra_half_life=5.0, mean=None):
