@@ -3,8 +3,9 @@
 ``evaluate_population(settings, params_list, seeds, pool)`` runs every parameter vector of
 a population on every seed (the same seeds for all: their scores differ by the parameters,
 not the placements) and gives back an Outcome per pair. ``pool`` is anything with
-``map(function, jobs)`` (a multiprocessing Pool from ``make_pool(workers)``, one process per
-core; or None: in this process). Each process builds its environment once, on its first
+``imap(function, jobs, chunksize)`` giving results in the jobs' order (a multiprocessing
+Pool from ``make_pool(workers)``, one process per core; learn.ray_rollouts' RayRollouts, a
+Ray cluster; or None: in this process). Each process builds its environment once, on its first
 episode, and keeps it: an episode starts with a reset (a snapshot restored), not a build.
 
 ``settings`` (a JSON-able dict) says the task and how its environment is made: for
