@@ -129,9 +129,10 @@ class KickBallTraining:
                 break
         curve.write_csv(os.path.join(out, CURVE_CSV), columns, rows)
         table = np.array(rows, np.float64)
+        start_with = f'{count} episodes imitated, then ' if count else ''
         curve.write_png(os.path.join(out, CURVE_PNG), curve.draw(
-            f'kick_ball: cross-entropy method, {population} a generation, '
-            f'{per_generation} seeds each', 'minutes of training', table[:, 1],
+            f'kick_ball: {start_with}cross-entropy ({population} policies x {per_generation} '
+            'seeds a generation)', 'minutes of training', table[:, 1],
             {'kick rate of the mean policy': _smooth(table[:, 3]),
              'kick rate of the population': table[:, 4]}))
         return (f'kick_ball: {cem.generation} generations, {episodes} episodes in '
