@@ -42,3 +42,14 @@ class RayRollouts:
             self.ray.cancel(ref, force=True)
         self.pending = []
         self.ray.shutdown()
+
+
+def ray_pool(address, refuse):
+    """RayRollouts(address), or ``refuse(one line)`` (a parser's error) if Ray is not
+    installed or no cluster answers there."""
+    from miro_ball.grading.ray_pool import RayUnavailable
+
+    try:
+        return RayRollouts(address)
+    except RayUnavailable as err:
+        refuse(str(err))

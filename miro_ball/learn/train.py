@@ -28,6 +28,10 @@ def build_parser():
                         help='folder for the policy and the curve (made if missing)')
     parser.add_argument('--workers', type=int, default=os.cpu_count() or 1,
                         help='processes running episodes (default: one per core)')
+    parser.add_argument('--ray', nargs='?', const='auto', metavar='ADDRESS',
+                        help='run the episodes on the Ray cluster at ADDRESS (host:port; none: '
+                             "the one this machine is in) instead of --workers processes "
+                             "(pip install -e '.[scale]')")
     parser.add_argument('--population', type=int,
                         help='kick_ball: policies a generation (default 12)')
     parser.add_argument('--seeds-per-generation', type=int,
@@ -72,7 +76,9 @@ def main(argv=None):
     from tqdm import tqdm
 
     from miro_ball.learn.rollouts import make_pool
+    from miro_ball.learn.ray_rollouts import ray_pool
 
+    pool = ray_pool(options.ray, parser.error) if options.ray else make_pool(options.workers)
     budget = options.minutes * 60
     with tqdm(total=round(budget), unit='s', desc=options.task, file=sys.stderr,
               bar_format='{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total:.0f} s{postfix}'
@@ -81,7 +87,6 @@ def main(argv=None):
             bar.update(min(elapsed, budget) - bar.n)
             bar.set_postfix_str(note)
 
-        pool = make_pool(options.workers)
         try:
             started = time.monotonic()
             summary = TASKS[options.task].train(
