@@ -131,6 +131,7 @@ def measure_ray(nodes, population, seeds, episode_s):
     settings) on a Ray cluster of ``nodes`` nodes of one CPU each, made on this machine (its
     start and each worker's first episode are not counted)."""
     import numpy as np
+    import psutil
 
     from miro_ball.bench.grade_bench import ray_cluster
     from miro_ball.learn.policy import LinearPolicy
@@ -142,17 +143,19 @@ def measure_ray(nodes, population, seeds, episode_s):
     settings = training.settings(episode_s)
     rng = np.random.default_rng(SEED)
     params = [rng.normal(size=LinearPolicy.size()) for _ in range(population)]
+    me = psutil.Process()  # the cluster's daemons and workers are its descendants
     with ray_cluster(nodes) as address:
         pool = RayRollouts(address)
         try:
             evaluate_population(settings, params[:1], list(range(2 * nodes)), pool)  # warm
-            start = time.perf_counter()
+            cpu, start = cpu_seconds(me), time.perf_counter()
             outcomes = evaluate_population(settings, params, list(range(seeds)), pool)
             wall = time.perf_counter() - start
+            busy = (cpu_seconds(me) - cpu) / wall
         finally:
             pool.terminate()
     ticks = sum(o.steps for row in outcomes for o in row) * training.frame_skip
-    return {'ticks_per_s': ticks / wall, 'episodes': population * seeds}
+    return {'ticks_per_s': ticks / wall, 'cores_busy': busy, 'per_cpu_s': ticks / wall / busy}
 
 
 def run_child(args, *extra):
@@ -201,12 +204,33 @@ def env_rows(results, processes):
 
 
 def ray_rows(ray):
-    """The table of rollouts on a Ray cluster of 1 and of 2 nodes."""
+    """The table of rollouts on a Ray cluster of 1 and of 2 nodes (cores busy: of every
+    process of the cluster and the driver)."""
     one, two = (median(ray[nodes], 'ticks_per_s') for nodes in (1, 2))
-    return ['| Ray cluster on this machine | steps/s of rollouts | ratio |', '|---|---|---|',
-            f'| 1 node of 1 CPU | {one:,.0f} | |',
-            f'| 2 nodes of 1 CPU each | {two:,.0f} | {two / one:.2f}x (goal >= '
-            f'{SCALING_GOAL}x) |']
+    bound = 2 * median(ray[2], 'per_cpu_s') / median(ray[1], 'per_cpu_s')
+    return ['| Ray cluster on this machine | steps/s of rollouts | cores busy | steps/CPU s | '
+            'ratio | ratio bound, a core each |', '|---|---|---|---|---|---|',
+            f'| 1 node of 1 CPU | {one:,.0f} | {median(ray[1], "cores_busy"):.2f} | '
+            f'{median(ray[1], "per_cpu_s"):,.0f} | | |',
+            f'| 2 nodes of 1 CPU each | {two:,.0f} | {median(ray[2], "cores_busy"):.2f} | '
+            f'{median(ray[2], "per_cpu_s"):,.0f} | {two / one:.2f}x | {bound:.2f}x |',
+            '', f'Goal: 2 nodes >= {SCALING_GOAL}x one.']
+
+
+def cpu_notes(results, processes):
+    """Per case, the CPU a step costs alone and in the vector env, and whether the vector
+    env had its cores (on a busy machine it shares them)."""
+    notes = []
+    for label, _ in CASES:
+        one, many = results[label, 1], results[label, processes]
+        alone, vector = (1000 / median(r, 'per_cpu_s') for r in (one, many))
+        busy = median(many, 'cores_busy')
+        notes.append(f'- {label}: {alone:.3f} ms of CPU a step in one process, {vector:.3f} ms '
+                     f'in the vector env (+{vector - alone:.3f} ms: its pipes and batching); '
+                     f'it had {busy:.2f} of {processes} cores' +
+                     (' (the rest were busy with other work)' if busy < 0.9 * processes
+                      else '') + '.')
+    return notes
 
 
 def main(argv=None):
@@ -263,7 +287,7 @@ def main(argv=None):
         for nodes in ray:
             ray[nodes].append(run_child(args, '--one', 'ray', '--nodes', str(nodes)))
     ended = load()
-    rows = env_rows(results, args.processes)
+    rows = env_rows(results, args.processes) + [''] + cpu_notes(results, args.processes)
     physics_line = (f'Physics step alone (SimWorld.step, default world, robot driving, '
                     f'{PHYSICS_STEPS} steps): {median(physics, "ms_per_step"):.3f} ms, '
                     f'{median(physics, "ticks_per_s"):,.0f} platform ticks/s.')
