@@ -35,10 +35,10 @@ def build_parser():
     parser.add_argument('--population', type=int,
                         help='kick_ball: policies a generation (default 12)')
     parser.add_argument('--seeds-per-generation', type=int,
-                        help='kick_ball: placements each policy of a generation meets (default 4)')
+                        help='kick_ball: placements each policy of a generation meets (default 8)')
     parser.add_argument('--imitate', type=int, metavar='N',
                         help="kick_ball: start from imitating N episodes of the hand-written "
-                             "'improved' controller, then search (default 20; 0: from scratch)")
+                             "'improved' controller, then search (default 50; 0: from scratch)")
     parser.add_argument('--episode-s', type=float,
                         help='kick_ball: simulated seconds an episode lasts at most (default 10)')
     return parser
