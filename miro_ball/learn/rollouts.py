@@ -145,9 +145,14 @@ def evaluate_population(settings, params_list, seeds, pool=None, done=None):
 
 
 def _quiet_worker():
+    import signal
+
     import cv2
 
     cv2.setNumThreads(1)  # one process per core: OpenCV's own threads would only contend
+    # Ctrl+C reaches the whole process group: the parent stops the pool, the workers say
+    # nothing (a traceback from each otherwise).
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def make_pool(workers):

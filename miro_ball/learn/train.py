@@ -93,6 +93,11 @@ def main(argv=None):
                 options.out, options.minutes, options.seed, pool, progress,
                 population=options.population, seeds=options.seeds_per_generation,
                 episode_s=options.episode_s, demonstrations=options.imitate)
+        except KeyboardInterrupt:
+            # The policy is saved after every generation: what was learnt is kept.
+            print(f'\n{PROG}: stopped; the latest policy (if a generation ended) is in '
+                  f'{options.out}', file=sys.stderr)
+            return 130
         finally:
             if pool is not None:
                 pool.terminate()
