@@ -25,22 +25,34 @@ class RayRollouts:
     def __init__(self, address):
         self.ray = connect(address)
         self.remote = self.ray.remote(num_cpus=1, max_retries=RETRIES)(_in_worker)
-        self.pending = []
+        self.pending = {}  # task -> the index of its job
 
     def imap(self, function, jobs, chunksize=1):
         """function(job) of each job, in order, as each is ready (chunksize: as a
-        multiprocessing Pool's, not used: a task is one episode)."""
-        ray = self.ray
-        self.pending = [self.remote.remote(function, job) for job in jobs]
-        while self.pending:
-            yield ray.get(self.pending[0])
-            self.pending.pop(0)
+        multiprocessing Pool's, not used: a task is one episode). Two tasks a CPU of the
+        cluster are out at a time, the next sent as one ends. Two nodes of one CPU here, the
+        trainer's episodes: all sent at once, the head node's queue kept most of them and the
+        other node ran dry (1.57x one node's speed); one a CPU, the other node's worker waited
+        about 70 ms for each next task (1.65x); two a CPU, 1.80x."""
+        ray, jobs = self.ray, list(jobs)
+        width = 2 * max(1, int(ray.cluster_resources().get('CPU', 1)))
+        ready, sent, given = {}, 0, 0
+        while given < len(jobs):
+            while sent < len(jobs) and len(self.pending) < width:
+                self.pending[self.remote.remote(function, jobs[sent])] = sent
+                sent += 1
+            if given in ready:
+                yield ready.pop(given)
+                given += 1
+                continue
+            [task], _ = ray.wait(list(self.pending), num_returns=1)
+            ready[self.pending.pop(task)] = ray.get(task)
 
     def terminate(self):
         """Cancel what is still to run and leave the cluster (it keeps running)."""
-        for ref in self.pending:
-            self.ray.cancel(ref, force=True)
-        self.pending = []
+        for task in self.pending:
+            self.ray.cancel(task, force=True)
+        self.pending = {}
         self.ray.shutdown()
 
 
