@@ -4,10 +4,12 @@ tick, frame_skip=1) of ``miro_ball/KickBall-v0``.
 ``python -m miro_ball.bench.learn_bench [--seconds 5] [--repeats 5] [--output BENCHMARKS.md]``
 
 Cases: state only (``eyes=None``: no image drawn), both eyes at 64x48 and both at 160x90,
-drawn every step (no detector: the environment's own cost). Each in one process, and as
-``gymnasium.make_vec(..., vectorization_mode='async')`` with one process per core; the
-ratio of the two says whether the vector env really uses every core, and so does the CPU it
-took (cores busy = CPU seconds of the measuring process and its workers / wall seconds).
+drawn every step (no detector: the environment's own cost). Each in one process; in one
+process per core side by side, each stepping an environment of its own (as training's
+workers do: their steps a second added up); and as
+``gymnasium.make_vec(..., vectorization_mode='async')`` with one process per core. The
+ratios to one process say whether every core is used, and so does the CPU each took
+(cores busy = CPU seconds of the measuring process and its workers / wall seconds).
 On a shared machine the cores are not all ours: steps per CPU second hardly depend on the
 others' load, and processes x their ratio bounds the ratio a core each would give.
 The action is a fixed wheels action (``PickActions(env, 'wheels')``): nothing else changes,
@@ -158,16 +160,38 @@ def measure_ray(nodes, population, seeds, episode_s):
     return {'ticks_per_s': ticks / wall, 'cores_busy': busy, 'per_cpu_s': ticks / wall / busy}
 
 
+def run_children(args, count, *extra):
+    """Figures of ``count`` child processes run side by side, or None (and a line) for
+    each that failed."""
+    children = [subprocess.Popen([sys.executable, '-m', 'miro_ball.bench.learn_bench',
+                                  '--seconds', str(args.seconds), *extra],
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                for _ in range(count)]
+    figures = []
+    for child in children:
+        out, err = child.communicate()
+        lines = [line for line in out.splitlines() if line.startswith('{')]
+        if child.returncode or not lines:
+            print(f'{" ".join(extra)}: run failed: {err.strip().splitlines()[-1:]}')
+            figures.append(None)
+        else:
+            figures.append(json.loads(lines[-1]))
+    return figures
+
+
 def run_child(args, *extra):
     """Figures of one child process, or None (and a line) if it failed."""
-    done = subprocess.run([sys.executable, '-m', 'miro_ball.bench.learn_bench',
-                           '--seconds', str(args.seconds), *extra],
-                          capture_output=True, text=True)
-    lines = [line for line in done.stdout.splitlines() if line.startswith('{')]
-    if done.returncode or not lines:
-        print(f'{" ".join(extra)}: run failed: {done.stderr.strip().splitlines()[-1:]}')
+    return run_children(args, 1, *extra)[0]
+
+
+def side_by_side(figures):
+    """One measurement of processes run side by side: their steps a second added up (None
+    if one failed)."""
+    if None in figures:
         return None
-    return json.loads(lines[-1])
+    return {'steps_per_s': sum(f['steps_per_s'] for f in figures),
+            'cores_busy': sum(f['cores_busy'] for f in figures),
+            'per_cpu_s': statistics.mean(f['per_cpu_s'] for f in figures)}
 
 
 def load():
@@ -183,17 +207,20 @@ def env_rows(results, processes):
     """The table of steps a second: one process, one per core, ratios. Steps per CPU
     second (steps/s / cores busy) hardly depend on what else the machine runs: the bound
     on the ratio with a core for each process is processes x their ratio."""
-    head = (f'| case | 1 process: steps/s | cores busy | steps/CPU s | {processes} processes: '
-            'steps/s | cores busy | steps/CPU s | ratio | ratio bound, a core each | '
-            'gym-pybullet-drones 2.1.0 | ours / theirs | goal |')
+    head = (f'| case | 1 process: steps/s | cores busy | steps/CPU s | {processes} processes, '
+            'an environment each: steps/s | ratio | async vector env of '
+            f'{processes}: steps/s | cores busy | steps/CPU s | ratio | ratio bound, a core '
+            'each | gym-pybullet-drones 2.1.0 | ours / theirs | goal |')
     rows = [head, '|' + '---|' * (head.count('|') - 1)]
     for label, _ in CASES:
         one, many = results[label, 1], results[label, processes]
         single, vector = median(one, 'steps_per_s'), median(many, 'steps_per_s')
+        apart = median(results[label, 'apart'], 'steps_per_s')
         theirs, goal = REFERENCE.get(label), GOALS.get(label)
         rows.append(
             f'| {label} | {single:,.0f} | {median(one, "cores_busy"):.2f} | '
-            f'{median(one, "per_cpu_s"):,.0f} | {vector:,.0f} | '
+            f'{median(one, "per_cpu_s"):,.0f} | {apart:,.0f} | {apart / single:.2f}x | '
+            f'{vector:,.0f} | '
             f'{median(many, "cores_busy"):.2f} | {median(many, "per_cpu_s"):,.0f} | '
             f'{vector / single:.2f}x | '
             f'{processes * median(many, "per_cpu_s") / median(one, "per_cpu_s"):.2f}x |'
@@ -270,7 +297,7 @@ def main(argv=None):
     print(f'learning environments benchmark: {ENV_ID}, frame_skip 1, fixed wheels, '
           f'{args.seconds:g} s x {args.repeats} repeats per case; 1 process and '
           f'{args.processes}; load average (1, 5, 15 min) at start {started}', flush=True)
-    results = {(label, n): [] for label, _ in CASES for n in (1, args.processes)}
+    results = {(label, n): [] for label, _ in CASES for n in (1, args.processes, 'apart')}
     physics = []
     for index in range(args.repeats):
         print(f'  repeat {index + 1} of {args.repeats}', flush=True)
@@ -278,6 +305,8 @@ def main(argv=None):
             for n in (1, args.processes):
                 results[label, n].append(run_child(args, '--one', label,
                                                    '--processes', str(n)))
+            results[label, 'apart'].append(side_by_side(run_children(
+                args, args.processes, '--one', label, '--processes', '1')))
         physics.append(run_child(args, '--one', 'physics'))
     ray = {1: [], 2: []}
     for index in range(args.ray_repeats):
@@ -291,7 +320,7 @@ def main(argv=None):
                     f'{median(physics, "ticks_per_s"):,.0f} platform ticks/s.')
     load_line = f'Load average (1, 5, 15 min): at start {started}; at end {ended}.'
     ray_lines = ['', f'Rollouts of KickBall training (`learn.train kick_ball`\'s settings: '
-                 'eyes 64x48, ball detector, frame_skip 5) through `learn.ray_rollouts`, a '
+                 'eyes 160x90, ball detector, frame_skip 5) through `learn.ray_rollouts`, a '
                  f'population of {RAY_POPULATION} x {RAY_SEEDS} seeds, episodes of at most '
                  f'{RAY_EPISODE_S:g} s, on a Ray cluster made on this machine '
                  '(`ray.cluster_utils.Cluster`, one CPU a node; its start not counted): '
@@ -304,7 +333,8 @@ def main(argv=None):
             f'`python -m miro_ball.bench.learn_bench --seconds {args.seconds:g} --repeats '
             f'{args.repeats}`: environment steps a second of `{ENV_ID}` (one step = one '
             '20 ms platform tick, frame_skip 1, a fixed wheels action, no detector), medians; '
-            f'{args.processes} processes = `gymnasium.make_vec(..., '
+            f'{args.processes} processes, an environment each: side by side, their steps '
+            'a second added up; the async vector env: `gymnasium.make_vec(..., '
             'vectorization_mode="async")`. Cores busy: CPU seconds of the process and its '
             'workers a wall second.', '', *rows, '', physics_line, *ray_lines, '', load_line,
             '',
