@@ -31,6 +31,19 @@ def marked_world():
         world.close()
 
 
+def mark_area_px(camera, kc, eye, x, y):
+    """Pixels the mark at (x, y) in FOOT covers in ``eye`` (0 if a corner is out of view): a
+    2 cm mark a metre away, seen at a grazing angle, is less than the 4 pixels
+    red_centroid needs."""
+    corners = [camera.floor_to_pixel(kc, eye, x + dx, y + dy)
+               for dx, dy in ((-1, -1), (1, -1), (1, 1), (-1, 1))
+               for dx, dy in [(dx * MARKER_HALF, dy * MARKER_HALF)]]
+    if any(corner is None for corner in corners):
+        return 0.0
+    u, v = np.array(corners).T
+    return 0.5 * abs(np.dot(u, np.roll(v, 1)) - np.dot(v, np.roll(u, 1)))
+
+
 def red_centroid(rgb):
     """(u, v) of the red pixels' centre, or None when fewer than 4 are red."""
     r, g, b = (rgb[:, :, i].astype(int) for i in range(3))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, HealthCheck, settings, strategies as st
 
-from floor_mark import FLOOR_TOLERANCE, red_centroid
+from floor_mark import FLOOR_TOLERANCE, mark_area_px, red_centroid
 from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT, LIFT_RAD_CALIB, PITCH, TILT_RAD, YAW
 from miro_ball.controller.detection import BallDetector
 from miro_ball.miro.camera_model import CameraModel, LENSES
@@ -20,6 +20,9 @@ from miro_sim_bullet.scene.world_file import load_world
 RENDERERS = ['tiny', pytest.param('egl', marks=pytest.mark.skipif(
     not probe_egl()[0], reason='EGL unavailable: ' + probe_egl()[1]))]
 SMALL_BALL = 0.03  # small enough that its image centroid is its projected centre
+# The floor mark's least image, px: twice the red pixels red_centroid needs (its edge pixels
+# are part red).
+MIN_MARK_PX = 8
 
 
 @pytest.fixture(params=RENDERERS)
@@ -131,6 +134,7 @@ def test_pixel_to_floor_finds_a_floor_mark_where_it_is(marked_floor, lens, eye, 
     x, y = distance * math.cos(bearing), distance * math.sin(bearing)
     predicted = camera.floor_to_pixel(kc, eye, x, y)
     assume(predicted is not None and 8 < predicted[0] < 632 and 8 < predicted[1] < 352)
+    assume(mark_area_px(camera, kc, eye, x, y) >= MIN_MARK_PX)  # big enough to be found
     gx, gy, gz, gyaw = robot.ground_truth()  # FOOT in the world
     kc.set_pose(gx, gy, gyaw, gz)
     world_xy = kc.change_frame_abs(FOOT, WORLD, (x, y, 0.0))
