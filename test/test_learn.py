@@ -12,6 +12,8 @@ from gymnasium.utils.env_checker import check_env
 import miro_ball.learn
 from miro_ball.controller.behaviour import BehaviourParams, make_behaviour
 from miro_ball.controller.contract import Action
+from miro_ball.controller.detection import Ball
+from miro_ball.controller.detectors import DETECTORS
 from miro_ball.learn.controllers import run_controller
 from miro_ball.learn.env import MiroEnv
 from miro_ball.learn.kbandit import EXPRESSION_NAMES
@@ -151,6 +153,22 @@ def test_a_controller_of_the_contract_kicks_in_the_environment_unchanged():
                                                             BehaviourParams(seed=1)), seed=2)
     assert info['kicked'] and not info['fell'], info
     assert total > 10.0
+    env.close()
+
+
+def test_each_frame_is_run_through_the_detectors_once_however_often_percepts_are_read(
+        monkeypatch):
+    # The motion detector compares a frame with its eye's previous one: run twice on one
+    # frame, it would see no motion.
+    seen, ball = [], Ball(0.0, 0.0, 0.1)
+    monkeypatch.setitem(DETECTORS, 'counted',
+                        lambda params: lambda image, camera: seen.append(image) or ball)
+    env = MiroEnv(KickBall(), eyes=(32, 24), detectors=('counted',))
+    env.reset(seed=1)
+    for _ in range(3):
+        assert env.percepts().found('counted') == (ball, ball)
+        env.step(Action(wheels=(0.1, 0.1)))
+    assert len(seen) == 2 * 4  # both eyes, the reset's frame and three steps'
     env.close()
 
 

@@ -16,7 +16,7 @@ import gymnasium as gym
 from miro_ball.controller.contract import Action
 from miro_ball.learn import spaces
 from miro_ball.learn.rig import WorldRig
-from miro_ball.learn.tasks import Task
+from miro_ball.learn.tasks import play, Task
 from miro_ball.miro.camera_model import PINHOLE
 from miro_ball.miro.constants import PLATFORM_TICK_S
 
@@ -76,13 +76,7 @@ class MiroEnv(gym.Env):
     def step_action(self, action):
         """step() with the contract's Action (a part left None: the robot keeps the last)."""
         self.rig.act(self.robot, action)
-        terminated = False
-        for _ in range(self.frame_skip):
-            self.rig.tick(self.task.physics_step)
-            self.task.tick(self.rig)
-            terminated = self.task.terminated()
-            if terminated:
-                break
+        terminated = play(self.rig, self.task, self.frame_skip)
         self.rig.look()
         truncated = not terminated and self.task.truncated(self.rig.t - self._start)
         return (self._observation(), float(self.task.reward(self.rig)), terminated, truncated,

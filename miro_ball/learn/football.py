@@ -36,7 +36,7 @@ from miro_ball.controller.contract import Action
 from miro_ball.learn import spaces
 from miro_ball.learn.rig import WorldRig
 from miro_ball.learn.tasks import (APPROACH_WEIGHT, FALL_PENALTY, KICK_REWARD, KickBall,
-                                   settle)
+                                   play, settle)
 from miro_ball.miro.camera_model import PINHOLE
 from miro_ball.miro.constants import PLATFORM_TICK_S
 from miro_sim_bullet.scene.world_file import RobotSpec, World, load_world
@@ -131,6 +131,7 @@ class Football(KickBall):
                 self._fell.add(name)
         return rewards
 
+
 class FootballEnv(ParallelEnv):
     """``robots``: how many MiRos play (1 to MAX_PLAYERS), named miro01, ... ``world``: the
     pitch (any world file with a ball and a [ground] at height 0 whose size is the pitch;
@@ -202,14 +203,9 @@ class FootballEnv(ParallelEnv):
                     action = spaces.to_action(action, self.frame_skip)
                 self.rig.act(agent, action)
         task = self.task
-        for _ in range(self.frame_skip):
-            self.rig.tick(task.physics_step)
-            task.tick(self.rig)
-            if task.terminated():
-                break
+        terminated = play(self.rig, task, self.frame_skip)
         self.rig.look()
         rewards = task.reward(self.rig)
-        terminated = task.terminated()
         truncated = not terminated and task.truncated(self.rig.t - self._start)
         info = task.info()
         agents = self.agents

@@ -26,12 +26,6 @@ from miro_sim_bullet.render.eye_images import to_bgr
 SIDES = (1, -1)  # left eye, right eye: EYES order
 
 
-def to_argb(rgb):
-    """0xFFRRGGBB of an (R, G, B) triple of 0..255."""
-    r, g, b = (int(min(max(v, 0), 255)) for v in rgb)
-    return 0xFF000000 | r << 16 | g << 8 | b
-
-
 class WorldRig:
     """A world (SimWorld or what SimWorld takes: a bundled name, a path, a World) with eyes
     of ``eyes`` = (width, height) pixels through ``lens`` (None: no image is ever drawn)
@@ -39,10 +33,8 @@ class WorldRig:
     ``hears``: the microphones are worked out and each robot's latest block kept."""
 
     def __init__(self, world='miro', eyes=None, lens=PINHOLE, detectors=(), hears=False,
-                 renderer='auto', robot_name=None):
-        self.sim = world if isinstance(world, SimWorld) else SimWorld(world,
-                                                                     robot_name=robot_name)
-        self.eye_size = eyes
+                 renderer='auto'):
+        self.sim = world if isinstance(world, SimWorld) else SimWorld(world)
         self.camera = None if eyes is None else CameraModel(*eyes, lens, CAM_HFOV_DEG_SIM)
         self.renderer = renderer
         self.cameras = None
@@ -50,7 +42,8 @@ class WorldRig:
             self._cameras()
         self.detector_names = tuple(detectors)
         self.hears = hears
-        self.images = {}  # robot -> (left, right) BGR images of the latest tick
+        self.images = {}  # robot -> (left, right) BGR images of the latest look()
+        self.found = {}  # robot -> (left, right) {detector: result} in those images
         self.heard = {}  # robot -> the latest MicBlock
         self._detectors = {}
 
@@ -63,6 +56,7 @@ class WorldRig:
         """The world as it was built: bodies, robots' platforms, time; no rebuild."""
         self.sim.rewind()
         self.images.clear()
+        self.found.clear()
         self.heard.clear()
         self._detectors = {name: [make_detectors(self.detector_names, DetectionParams())
                                   for _ in SIDES] for name in self.sim.robots}
@@ -82,14 +76,19 @@ class WorldRig:
                     self.heard[name] = robot.heard
 
     def look(self):
-        """Draw every robot's eyes now (one pass for all) and run their detectors."""
+        """Draw every robot's eyes now (one pass for all) and run their detectors, once a
+        frame: the motion detector compares each frame with its eye's previous one."""
         if self.camera is None:
             return
         requests = [(robot, side) for robot in self.sim.robots.values() for side in SIDES]
         drawn = self.cameras.render_views(self.cameras.eye_views(requests), self.camera,
                                           rgba=True)
         for index, name in enumerate(self.sim.robots):
-            self.images[name] = tuple(to_bgr(image) for image in drawn[2 * index:2 * index + 2])
+            images = tuple(to_bgr(image) for image in drawn[2 * index:2 * index + 2])
+            self.images[name] = images
+            self.found[name] = tuple(
+                {key: detect(image, self.camera) for key, detect in detectors.items()}
+                for image, detectors in zip(images, self._detectors[name]))
 
     def _cameras(self):
         if self.cameras is None:
@@ -109,18 +108,14 @@ class WorldRig:
 
     # -- the contract -------------------------------------------------------------------------
     def percepts(self, name):
-        """Robot ``name``'s Percepts now: its latest tick's readings, its eyes' images (as
-        look() drew them) and the detectors' results in them."""
+        """Robot ``name``'s Percepts now: its latest tick's readings, its eyes' images and
+        the detectors' results in them (as the latest look() made them)."""
         robot = self.sim.robots[name]
         sensors = robot.sensors
         images = self.images.get(name, (None, None))
-        eyes = []
-        for side, image in enumerate(images):
-            found = {}
-            if image is not None:
-                found = {key: detect(image, self.camera)
-                         for key, detect in self._detectors[name][side].items()}
-            eyes.append(Eye(self.camera, image, found, self.t if image is not None else None))
+        found = self.found.get(name, ({}, {}))
+        eyes = [Eye(self.camera, image, seen, None if image is None else self.t)
+                for image, seen in zip(images, found)]
         heard = self.heard.get(name)
         sound = None if heard is None else locate(heard.samples, sensors.kinematic_positions)
         return Percepts(

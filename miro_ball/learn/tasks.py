@@ -49,6 +49,17 @@ class Task:
         return {}
 
 
+def play(rig, task, ticks):
+    """Up to ``ticks`` platform ticks of the world, judged by ``task``; whether it ended
+    (terminated) on one of them."""
+    for _ in range(ticks):
+        rig.tick(task.physics_step)
+        task.tick(rig)
+        if task.terminated():
+            return True
+    return False
+
+
 def settle(rig, seconds=SETTLE_S):
     """Let what was placed come to rest (ticks, none of them judged)."""
     for _ in range(round(seconds / (rig.sim.dt * rig.sim.ticks_per_platform_tick))):

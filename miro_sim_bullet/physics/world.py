@@ -114,12 +114,13 @@ class SimWorld:
         cache of its contacts, which a restored snapshot keeps (rewind())."""
         kw = self._kw()
         movable = set(self.objects.values())
-        robots = {robot.body_id: index for index, robot in enumerate(self.robots.values())}
+        for index, robot in enumerate(self.robots.values()):
+            robot.model.set_collision_filter(robot_group(index), ALL_GROUPS)
+        robots = {robot.body_id for robot in self.robots.values()}
         for body in range(pb.getNumBodies(**kw)):
             if body in robots:
-                self.robots[self.body_labels[body][0]].model.set_collision_filter(
-                    robot_group(robots[body]), ALL_GROUPS)
-            elif body in movable:
+                continue
+            if body in movable:
                 pb.setCollisionFilterGroupMask(body, -1, MOVABLE_GROUP, ALL_GROUPS, **kw)
             else:
                 pb.setCollisionFilterGroupMask(body, -1, STATIC_GROUP,
