@@ -70,16 +70,10 @@ class Processes:
     def stop(self, grace_s=10.0):
         """Stop every child, all told at once; returns the names of those that had to be
         killed (they ignored Ctrl+C for grace_s)."""
+        stopped = stop_all([child.proc for child in self.children], grace_s)
         for child in self.children:
-            if child.proc.poll() is None:
-                _signal_group(child.proc.pid, signal.SIGINT)
-        deadline = time.monotonic() + grace_s
-        killed = []
-        for child in self.children:
-            if not stop_group(child.proc, max(0.0, deadline - time.monotonic()),
-                              interrupted=True):
-                killed.append(child.name)
             child.log.close()
+        killed = [child.name for child, ok in zip(self.children, stopped) if not ok]
         self.children = []
         return killed
 
@@ -88,6 +82,17 @@ class Processes:
 
     def __exit__(self, *_):
         self.stop()
+
+
+def stop_all(procs, grace_s):
+    """Stop every one of procs (Popen, each leading a group) as stop_group does, all told at
+    once: side by side, the slowest sets the time. Whether each stopped in time, in order."""
+    for proc in procs:
+        if proc.poll() is None:
+            _signal_group(proc.pid, signal.SIGINT)
+    deadline = time.monotonic() + grace_s
+    return [stop_group(proc, max(0.0, deadline - time.monotonic()), interrupted=True)
+            for proc in procs]
 
 
 def stop_group(proc, grace_s, interrupted=False):
