@@ -20,6 +20,8 @@ setup(
         ('share/' + PACKAGE + '/worlds', glob('worlds/*.toml')),
         ('share/' + PACKAGE + '/worlds/pictures', glob('worlds/pictures/*.png')),
         ('share/' + PACKAGE + '/worlds/sounds', glob('worlds/sounds/*.ogg')),
+        # The launch files, where ros2 launch miro_ball NAME looks for them.
+        ('share/' + PACKAGE + '/launch', glob('launch/*.launch.*')),
     ] + [
         # The interface packages, for python -m miro_ball.build_interfaces after a plain pip
         # install (colcon builds them from interfaces/ itself).
