@@ -5,8 +5,14 @@ optional [ground] plane and any number of shapes: [[box]], [[cylinder]] and
 [[sphere]], plus three compound tables that expand into static boxes and
 cylinders when the file is loaded: [[ring]] (wall panels on a circle),
 [[wall]] (wall panels in a straight row) and [[table]] (a top on four legs).
-README "Worlds" documents every key. Mistakes raise WorldError, one line:
+docs/worlds.md documents every key. Mistakes raise WorldError, one line:
 ``file: key: problem``.
+
+A world may carry ``tags`` (what GetAvailableWorlds filters on) and declare named poses,
+[[pose]] tables: places a tool may ask for by name (GetNamedPoses), beside the ones every
+world has, where its robots and ball start (named_poses()). One table of a world file
+(a [ball] or one [[box]], [[sphere]] or [[cylinder]]) is also what a spawn request
+carries: load_entity().
 
 Names (ground truth, and the ROS namespace of each robot) follow ROS name
 rules (a letter, then letters, digits or underscores) and are unique among
@@ -39,7 +45,7 @@ import importlib.resources
 import math
 import reprlib
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 
@@ -54,6 +60,14 @@ MAX_ROBOTS = 16
 MAX_PANELS = 1000
 MAX_SHAPES = 2000
 PANEL_SIZE = (0.01, 0.65, 0.30)  # the MDK's wall panel: thickness, width, height (m)
+MAX_TAGS = 32
+MAX_TAG_LENGTH = 64
+MAX_POSES = 100
+MAX_CATALOGUE = 1000  # world files listed from one folder
+START_SUFFIX = '_start'  # of the poses named_poses() makes: a declared pose cannot end so
+ENTITY_KINDS = ('ball', 'box', 'sphere', 'cylinder')  # what load_entity() builds
+# A bundled world's or model's URI; file:// URIs and paths name a user's files.
+BUNDLED_URI = 'package://miro_ball/worlds/'
 MAX_PICTURE_BYTES = 8_000_000
 MAX_PICTURE_SIDE = 2048
 MAX_PICTURE_PIXELS = 16_000_000  # all of a world's different pictures together
@@ -142,10 +156,32 @@ class RobotSpec:
 
 
 @dataclass(frozen=True)
+class NamedPose:
+    """A place a tool may ask for by name: the point on the floor a robot stands on (or a
+    ball's centre), and the heading."""
+    name: str
+    description: str = ''
+    tags: tuple = ()
+    position: tuple = (0.0, 0.0, 0.0)
+    yaw: float = 0.0
+
+
+@dataclass(frozen=True)
+class Model:
+    """One entity of a spawn request: a Shape (named when the table names it, else None)
+    or the Ball, and what its file says about it."""
+    body: Shape | Ball
+    description: str = ''
+    tags: tuple = ()
+
+
+@dataclass(frozen=True)
 class World:
     name: str
     source: str
     description: str = ''
+    tags: tuple = ()
+    poses: tuple = ()  # of NamedPose, as the file declares them (named_poses() adds starts)
     robots: tuple = (RobotSpec(None, (0.0, 0.0, 0.0)),)  # never empty
     ball: Ball | None = None
     ground_height: float | None = None
@@ -163,8 +199,9 @@ def bundled_worlds():
 
 
 def load_world(name_or_path, sound_folders=()):
-    """A bundled world by name ('miro', 'empty', ...) or a user's .toml file; its sound
-    files may also come from ``sound_folders`` (resolved Paths: scene.sounds)."""
+    """A bundled world by name ('miro', 'empty', ...) or URI (world_uri()), or a user's
+    .toml file by path or file:// URI; its sound files may also come from
+    ``sound_folders`` (resolved Paths: scene.sounds)."""
     raw, source, folder = _read(str(name_or_path))
     if len(raw) > MAX_FILE_BYTES:
         raise WorldError(f'{source}: larger than {MAX_FILE_BYTES} bytes')
@@ -172,30 +209,112 @@ def load_world(name_or_path, sound_folders=()):
         text = raw.decode('utf-8')
     except UnicodeDecodeError:
         raise WorldError(f'{source}: not a UTF-8 text file') from None
+    return _Parser(source, folder, sound_folders).world(_toml(text, source),
+                                                       Path(source).stem)
+
+
+def _toml(text, source):
+    """The tables of a TOML text, or WorldError in one line."""
+    if len(text) > MAX_FILE_BYTES:
+        raise WorldError(f'{source}: larger than {MAX_FILE_BYTES} bytes')
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except ValueError as err:  # TOMLDecodeError, or int() refusing a 5000-digit number
         raise WorldError(f'{source}: not valid TOML: {err}') from None
     except RecursionError:
         raise WorldError(f'{source}: nested too deeply') from None
-    return _Parser(source, folder, sound_folders).world(data, Path(source).stem)
 
 
 def load_sounds(text, source, sound_folders=()):
     """The [[sound]] tables of a TOML text (what /miro_sim/sound carries) as Sounds, their
     files from the bundled sounds or ``sound_folders`` only; a WorldError in one line as
     for a world file (``source`` names it)."""
-    if len(text) > MAX_FILE_BYTES:
-        raise WorldError(f'{source}: larger than {MAX_FILE_BYTES} bytes')
-    try:
-        data = tomllib.loads(text)
-    except ValueError as err:
-        raise WorldError(f'{source}: not valid TOML: {err}') from None
-    except RecursionError:
-        raise WorldError(f'{source}: nested too deeply') from None
+    data = _toml(text, source)
     parser = _Parser(source, sound_folders=sound_folders)
     parser.keys('top level', data, {'sound'})
     return parse_sounds(parser, data.get('sound', []))
+
+
+def load_entity(text, source):
+    """The Model of a TOML text holding one entity as a world file writes it: a [ball], or
+    one [[box]], [[sphere]] or [[cylinder]] (one-table forms [box] ... too), with optional
+    top-level ``description`` and ``tags``; checked by the world file's rules, WorldError
+    in one line. Its position is the file's (the spawn request's pose replaces it)."""
+    data = _toml(text, source)
+    parser = _Parser(source)
+    parser.keys('top level', data, {'description', 'tags', *ENTITY_KINDS})
+    kinds = [kind for kind in ENTITY_KINDS if kind in data]
+    tables = [data[kind] for kind in kinds]
+    if len(kinds) != 1 or (isinstance(tables[0], list) and len(tables[0]) != 1):
+        parser.fail('top level', 'must hold exactly one entity: a [ball], or one [[box]], '
+                                 '[[sphere]] or [[cylinder]]')
+    kind = kinds[0]
+    table = tables[0][0] if isinstance(tables[0], list) else tables[0]
+    if kind == 'ball':
+        body = parser.ball(table)
+    else:
+        body = parser.shape(kind, kind, 0, table)
+        if parser.pictures:
+            parser.fail(f'{kind}.picture', 'a spawned box carries no picture')
+        # Unnamed, the spawn request names it (the world file's 'box0' would not be unique).
+        body = replace(body, name=body.name if 'name' in table else None)
+    return Model(body, parser.description(data), parser.tags('tags', data.get('tags', [])))
+
+
+def world_uri(name):
+    """The URI of a bundled world (or model: 'models/box'), as GetAvailableWorlds lists it."""
+    return f'{BUNDLED_URI}{name}.toml'
+
+
+def world_catalogue(folders=()):
+    """(worlds, problems): worlds = [(name, uri, description, tags)] of every bundled
+    world and every *.toml file in each folder given (its uri the file's absolute path);
+    problems = one line for each folder that cannot be read and each file that is no
+    world, for the caller to report. Each world is read whole, so what is listed loads
+    (the bundled ones take about 30 ms together, 100 ms the first time in a process)."""
+    entries = [(name, world_uri(name), _read_world(name)) for name in bundled_worlds()]
+    problems = []
+    for folder in folders:
+        try:
+            files = sorted(p for p in Path(folder).iterdir() if p.suffix == '.toml')
+        except OSError as err:
+            problems.append(f'{folder}: cannot list world files: {err.strerror or err}')
+            continue
+        if len(files) > MAX_CATALOGUE:
+            problems.append(f'{folder}: more than {MAX_CATALOGUE} world files; '
+                            f'listing the first {MAX_CATALOGUE}')
+        entries += [(p.stem, str(p.resolve()), _read_world(p)) for p in files[:MAX_CATALOGUE]]
+    worlds = []
+    for name, uri, world in entries:
+        if isinstance(world, World):
+            worlds.append((name, uri, world.description, world.tags))
+        else:
+            problems.append(world)
+    return worlds, problems
+
+
+def _read_world(name_or_path):
+    """The World, or the one line saying why it is none."""
+    try:
+        return load_world(name_or_path)
+    except WorldError as err:
+        return str(err)
+
+
+def named_poses(world, robot_name):
+    """The NamedPoses of a world: where each robot starts ('<robot>_start'; a single
+    unnamed robot is ``robot_name``) and the ball ('ball_start', its centre), then the
+    poses the file declares."""
+    starts = [NamedPose(f'{robot.name or robot_name}{START_SUFFIX}',
+                        f'where {robot.name or robot_name} starts', ('start', 'robot'),
+                        (robot.pose[0], robot.pose[1], robot.floor), robot.pose[2])
+              for robot in world.robots]
+    if world.ball is not None:
+        ball = world.ball
+        starts.append(NamedPose(f'{BALL_NAME}{START_SUFFIX}', 'where the ball starts',
+                                ('start', BALL_NAME),
+                                (*ball.position, ball.floor + ball.radius)))
+    return starts + list(world.poses)
 
 
 def bundled_pictures():
@@ -225,6 +344,12 @@ def _read(name):
     and its folder (None for a bundled world)."""
     if not name:
         raise WorldError(f'empty world name: {_choices()}')
+    if name.startswith(BUNDLED_URI) and name.endswith('.toml'):
+        name = name[len(BUNDLED_URI):-len('.toml')]
+        if '/' in name:  # models/ are entities, not worlds
+            raise WorldError(f'unknown world {_show(name)}: {_choices()}')
+    elif name.startswith('file://'):
+        name = name[len('file://'):]
     path = Path(name)
     if path.suffix == '.toml' or path.parent != Path('.'):
         try:
@@ -331,12 +456,10 @@ class _Parser:
         self.shapes.append(shape)
 
     def world(self, data, name):
-        self.keys('top level', data, {'description', 'robot', 'ball', 'ground', 'box',
-                                      'cylinder', 'sphere', 'ring', 'wall', 'table', 'sound',
-                                      'hearing'})
-        description = data.get('description', '')
-        if not isinstance(description, str):
-            self.fail('description', 'must be a string')
+        self.keys('top level', data, {'description', 'tags', 'pose', 'robot', 'ball',
+                                      'ground', 'box', 'cylinder', 'sphere', 'ring', 'wall',
+                                      'table', 'sound', 'hearing'})
+        description = self.description(data)
         robots = self.robots(data.get('robot', {}))
         for kind in ('box', 'cylinder', 'sphere'):
             for i, table in enumerate(self.array(kind, data.get(kind, []))):
@@ -352,6 +475,8 @@ class _Parser:
             name=name,
             source=self.source,
             description=description,
+            tags=self.tags('tags', data.get('tags', [])),
+            poses=self.poses(data.get('pose', [])),
             robots=robots,
             ball=self.ball(data['ball']) if 'ball' in data else None,
             ground_height=None if ground is None else self.number(
@@ -365,6 +490,51 @@ class _Parser:
             sounds=parse_sounds(self, data.get('sound', [])),
             hearing=parse_hearing(self, data.get('hearing')),
         )
+
+    def description(self, table, where='description'):
+        value = table.get('description', '')
+        if not isinstance(value, str):
+            self.fail(where, 'must be a string')
+        return value
+
+    def tags(self, where, value):
+        if not isinstance(value, list) or len(value) > MAX_TAGS or not all(
+                isinstance(tag, str) and 0 < len(tag) <= MAX_TAG_LENGTH for tag in value):
+            self.fail(where, f'must be a list of at most {MAX_TAGS} strings of 1 to '
+                             f'{MAX_TAG_LENGTH} characters, got {_show(value)}')
+        return tuple(value)
+
+    def poses(self, value):
+        tables = self.array('pose', value)
+        if len(tables) > MAX_POSES:
+            self.fail('pose', f'at most {MAX_POSES} poses, got {len(tables)}')
+        names, poses = set(), []
+        for i, table in enumerate(tables):
+            where = f'pose[{i}]'
+            self.keys(where, table, {'name', 'position', 'yaw', 'description', 'tags'})
+            name = self.require(where, table, 'name')
+            try:
+                check_name(name, 'pose name')
+            except ValueError as err:
+                self.fail(f'{where}.name', str(err))
+            if name.endswith(START_SUFFIX):
+                self.fail(f'{where}.name', f"names ending {START_SUFFIX!r} are the robots' "
+                                           "and the ball's starts")
+            if name in names:
+                self.fail(f'{where}.name', f'{name!r} is already the name of another pose')
+            names.add(name)
+            position = table.get('position', [0, 0])
+            if not isinstance(position, list) or len(position) not in (2, 3):
+                self.fail(f'{where}.position', f'must be [x, y] or [x, y, z], '
+                                               f'got {_show(position)}')
+            position = position + [0.0] * (3 - len(position))  # z: on the floor
+            poses.append(NamedPose(
+                name=name,
+                description=self.description(table, f'{where}.description'),
+                tags=self.tags(f'{where}.tags', table.get('tags', [])),
+                position=self.vector(f'{where}.position', position, 3),
+                yaw=self.number(f'{where}.yaw', table.get('yaw', 0.0))))
+        return tuple(poses)
 
     def robots(self, value):
         if isinstance(value, dict):  # the single table [robot]
