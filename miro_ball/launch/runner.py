@@ -1,0 +1,113 @@
+"""The processes of a launch file, run: each in a process group (and session) of its own,
+its output printed line by line after its label; one that ends restarted or ending the run
+(``exits``); on Ctrl+C or SIGTERM, all told to stop at once as a terminal tells one, and
+killed if they have not after STOP_GRACE_S (``run.processes.stop_all``).
+
+The children's own sessions keep a terminal's Ctrl+C from reaching them straight: the
+launcher tells each one itself, so that it knows which it told and waits for them all.
+"""
+import subprocess
+import sys
+import threading
+import time
+
+from miro_ball.launch.exits import Restart, after_exit
+from miro_ball.run.processes import stop_all
+
+POLL_S = 0.05
+STOP_GRACE_S = 5.0  # our nodes stop within a second of their Ctrl+C
+READER_WAIT_S = 1.0  # for the last lines of a process that ended
+
+
+class Output:
+    """Lines of every process, each whole, after its label."""
+
+    def __init__(self, stream=None):
+        self.stream = stream or sys.stdout
+        self.lock = threading.Lock()
+
+    def say(self, label, line):
+        with self.lock:
+            try:
+                self.stream.write(f'[{label}] {line}\n')
+                self.stream.flush()
+            except (OSError, ValueError):  # nobody reads our output any more: go on
+                pass
+
+    def follow(self, label, pipe):
+        """A thread that prints what pipe brings, line by line, until it closes."""
+        def read():
+            with pipe:
+                for raw in pipe:
+                    self.say(label, raw.decode(errors='replace').rstrip('\r\n'))
+        thread = threading.Thread(target=read, daemon=True)
+        thread.start()
+        return thread
+
+
+class Running:
+    """A process of the plan, started (proc, its output's reader) or waiting to restart."""
+
+    def __init__(self, process, command):
+        self.process, self.command = process, command
+        self.proc = self.reader = None
+        self.restart_at = None
+
+
+def run(processes, commands, env, stop, output=None, clock=time.monotonic):
+    """Run processes (plan.Process) with their commands until stop.requested (a
+    common.stopping.StopRequest) or one ends that is not to be restarted; every one is
+    stopped on the way out. The exit code: 0 after a stop, 1 if one ended or had to be
+    killed."""
+    output = output or Output()
+    running = [Running(process, command) for process, command in zip(processes, commands)]
+    code = 0
+    try:
+        for one in running:
+            _start(one, env, output)
+        while not stop.requested and code == 0:
+            time.sleep(POLL_S)
+            code = _look(running, env, output, clock())
+    finally:
+        started = [one for one in running if one.proc is not None]
+        stopped = stop_all([one.proc for one in started], STOP_GRACE_S)
+        for one, ok in zip(started, stopped):
+            if not ok:
+                output.say('launch', f'{one.process.label} ignored Ctrl+C for '
+                                     f'{STOP_GRACE_S:g} s: killed')
+                code = 1
+            one.reader.join(READER_WAIT_S)
+    return code
+
+
+def _start(one, env, output):
+    try:
+        one.proc = subprocess.Popen(one.command, env=env, stdout=subprocess.PIPE,
+                                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                    start_new_session=True)
+    except OSError as err:
+        one.proc = None
+        raise SystemExit(f'python -m miro_ball.launch: error: {one.process.label} can not be '
+                         f'started: {err}') from None
+    one.reader = output.follow(one.process.label, one.proc.stdout)
+    one.restart_at = None
+
+
+def _look(running, env, output, now):
+    """One look at every process: restart those due, deal with those that ended; 1 if the
+    run is to end."""
+    for one in running:
+        if one.restart_at is not None:
+            if now >= one.restart_at:
+                _start(one, env, output)
+            continue
+        code = one.proc.poll()
+        if code is None:
+            continue
+        one.reader.join(READER_WAIT_S)  # its last words before ours
+        decision = after_exit(one.process, code, now)
+        output.say('launch', decision.line)
+        if not isinstance(decision, Restart):
+            return 1
+        one.proc, one.restart_at = None, decision.at
+    return 0
