@@ -1,0 +1,284 @@
+"""A spawn request (SpawnEntity's name, allow_renaming, uri, resource_string, namespace)
+made into what to build, or Refused with the standard's SpawnResult code.
+
+What can be spawned (SPAWN_FORMATS): MiRo-E from its URDF (the one every simulated MiRo
+publishes on /<robot>/robot_description, or SPAWNABLE_MIRO), and a ball, box, sphere or
+cylinder from one table in the world file's TOML syntax (the bundled models in
+worlds/models/, or a text of one's own).
+"""
+import importlib.resources
+from dataclasses import dataclass, replace
+from functools import cache
+from pathlib import Path
+from urllib.parse import unquote
+from xml.etree import ElementTree
+
+import miro_ball
+from miro_ball.miro.interface import BALL_NAME, check_name
+from miro_ball.miro.urdf import MAX_URDF_BYTES, urdf
+from miro_sim_bullet.control.codes import Refused, SpawnResult
+from miro_sim_bullet.control.entities import entity_bounds
+from miro_sim_bullet.scene.world_file import (Ball, BUNDLED_URI, load_entity, MAX_FILE_BYTES,
+                                              WorldError)
+
+SPAWN_FORMATS = ('urdf', 'toml')
+PACKAGE_URI = 'package://miro_ball/'
+SPAWNABLE_MIRO = PACKAGE_URI + 'robots/miro.urdf'  # written from the body model, no file
+MODELS = 'models'  # worlds/models/: the bundled spawnable shapes
+MIRO_DESCRIPTION = 'MiRo-E, with its whole ROS interface under its name'
+MAX_RESOURCE_BYTES = max(MAX_URDF_BYTES, MAX_FILE_BYTES)
+
+
+@dataclass(frozen=True)
+class RobotSpawn:
+    """A MiRo to build: its name is its namespace."""
+    name: str
+
+
+@dataclass(frozen=True)
+class ShapeSpawn:
+    """A shape or the ball to build. body: a world_file.Shape (kind box, sphere or
+    cylinder; its name is ``name``) or the world_file.Ball (``name`` is 'ball'). The
+    request's pose replaces the body's position."""
+    name: str
+    body: object
+    description: str = ''
+    tags: tuple = ()
+
+
+def resolve_uri(uri):
+    """(text, source) of a resource: SPAWNABLE_MIRO (MiRo's URDF, from the body model),
+    package://miro_ball/worlds/... (the bundled worlds and models, wherever installed),
+    package://miro_ball/<path> (the installed share/miro_ball, or the checkout),
+    package://<other>/<path> (with ament_index, in a ROS 2 install), file:///path or an
+    absolute path. Refused: NO_RESOURCE when there is no such file, RESOURCE_PARSE_ERROR
+    when it is too big or no UTF-8 text."""
+    if uri == SPAWNABLE_MIRO:
+        return urdf(), uri
+    return _read_text(_locate(uri), uri)
+
+
+def parse_spawn(name, allow_renaming, uri, resource_string, namespace, taken,
+                resolve=resolve_uri):
+    """RobotSpawn or ShapeSpawn for a request, or Refused. ``taken``: the names in use
+    (with 'ball' when the world has its ball); ``resolve``: uri -> (text, source), by
+    default resolve_uri.
+
+    - The resource is ``uri`` when given (Resource.msg: the string is only used when the
+      uri is empty), else ``resource_string``; both empty: NO_RESOURCE.
+    - A URDF (text starting with '<', or a uri ending .urdf) must be MiRo-E's: not XML is
+      RESOURCE_PARSE_ERROR, XML that is no <robot> UNSUPPORTED_FORMAT, another robot
+      UNSUPPORTED_ASSETS. A TOML (a uri ending .toml, or any other text) holds one entity
+      (world_file.load_entity); a mistake in it is RESOURCE_PARSE_ERROR. Another file
+      type is UNSUPPORTED_FORMAT.
+    - Names: empty takes the TOML table's name, else the namespace's, else with
+      allow_renaming a fresh '<kind>N' (miro1, box1, ...), else NAME_INVALID. No ROS name,
+      or 'ball' for anything but the ball: NAME_INVALID. Taken: with allow_renaming
+      '<name>_N', else NAME_NOT_UNIQUE. The ball is always 'ball', one to a world.
+    - Namespace: a MiRo's topics live under /<its name>, so '' or the name (with or
+      without its '/'); a shape has none. Anything else: NAMESPACE_INVALID. A MiRo whose
+      namespace was asked for is not renamed.
+    """
+    text, source = _resource(uri, resource_string, resolve)
+    if _is_urdf(uri, text):
+        _check_miro(text, source)
+        return RobotSpawn(_robot_name(name, allow_renaming, namespace, taken))
+    try:
+        model = load_entity(text, source)
+    except WorldError as err:
+        raise Refused(SpawnResult.RESOURCE_PARSE_ERROR, str(err)) from None
+    if namespace not in ('', '/'):
+        raise Refused(SpawnResult.NAMESPACE_INVALID, f'namespace {namespace[:60]!r}: only a '
+                                                     'MiRo has a namespace (its topics)')
+    if isinstance(model.body, Ball):
+        return ShapeSpawn(_ball_name(name, taken), model.body, model.description, model.tags)
+    given = name or model.body.name or ''
+    kind = model.body.kind
+    final = _unique(given or _fresh(kind, taken, allow_renaming), allow_renaming, taken)
+    return ShapeSpawn(final, replace(model.body, name=final), model.description, model.tags)
+
+
+def spawnables():
+    """[(uri, description, bounds)] of the bundled models: MiRo-E, then each
+    worlds/models/*.toml; bounds as the standard's (type, points), in the model's frame."""
+    models = importlib.resources.files('miro_sim_bullet.worlds') / MODELS
+    found = [(SPAWNABLE_MIRO, MIRO_DESCRIPTION, entity_bounds('robot', ()))]
+    for file in sorted(models.iterdir(), key=lambda f: f.name):
+        if file.name.endswith('.toml'):
+            uri = f'{BUNDLED_URI}{MODELS}/{file.name}'
+            model = load_entity(file.read_text(encoding='utf-8'), uri)
+            found.append((uri, model.description, body_bounds(model.body)))
+    return found
+
+
+def body_bounds(body):
+    """The standard's bounds of a world_file Shape or Ball in its own frame (its centre)."""
+    if isinstance(body, Ball) or body.kind == 'sphere':
+        return entity_bounds('sphere', (body.radius,))
+    if body.kind == 'box':
+        return entity_bounds('box', body.size)
+    return entity_bounds('cylinder', (body.radius, body.length))
+
+
+# -- the resource -----------------------------------------------------------------------
+def _resource(uri, resource_string, resolve):
+    if uri:
+        suffix = Path(uri).suffix.lower()
+        if suffix not in ('.urdf', '.toml') and uri != SPAWNABLE_MIRO:
+            raise Refused(SpawnResult.UNSUPPORTED_FORMAT,
+                          f'{uri[:80]!r}: a {suffix or "file without a suffix"} cannot be '
+                          f'spawned: formats are {", ".join(SPAWN_FORMATS)} (.urdf, .toml)')
+        return resolve(uri)
+    if not resource_string:
+        raise Refused(SpawnResult.NO_RESOURCE, 'no resource: give a uri (see get_spawnables) '
+                                               'or a resource_string (URDF or TOML)')
+    return resource_string, 'resource_string'
+
+
+def _is_urdf(uri, text):
+    if uri:
+        return uri.lower().endswith('.urdf')
+    return text.lstrip().startswith('<')
+
+
+@cache
+def _miro_links():
+    return {link.get('name') for link in ElementTree.fromstring(urdf()).iter('link')}
+
+
+def _check_miro(text, source):
+    if len(text) > MAX_URDF_BYTES:
+        raise Refused(SpawnResult.RESOURCE_PARSE_ERROR,
+                      f'{source}: a URDF of at most {MAX_URDF_BYTES} characters is needed')
+    if '<!ENTITY' in text:  # entity expansion: no URDF needs it
+        raise Refused(SpawnResult.RESOURCE_PARSE_ERROR, f'{source}: XML entity declarations '
+                                                        'are not accepted')
+    try:
+        robot = ElementTree.fromstring(text)
+    except (ElementTree.ParseError, ValueError) as err:
+        raise Refused(SpawnResult.RESOURCE_PARSE_ERROR, f'{source}: not XML: {err}') from None
+    if robot.tag != 'robot':
+        raise Refused(SpawnResult.UNSUPPORTED_FORMAT,
+                      f'{source}: <{str(robot.tag)[:40]}> is no URDF <robot>: formats are '
+                      f'{", ".join(SPAWN_FORMATS)}')
+    links = {link.get('name') for link in robot.iter('link')}
+    if links != _miro_links():
+        other = sorted(str(name) for name in links ^ _miro_links())
+        raise Refused(SpawnResult.UNSUPPORTED_ASSETS,
+                      f"{source}: only MiRo-E's URDF can be spawned (the one on "
+                      f'/<robot>/robot_description, or {SPAWNABLE_MIRO}); this robot\'s '
+                      f'links differ from it ({", ".join(other[:3])[:80]} ...)')
+
+
+def _locate(uri):
+    """The path a uri names, or Refused(NO_RESOURCE)."""
+    if uri.startswith('package://'):
+        package, _, rest = uri[len('package://'):].partition('/')
+        if not rest or '..' in Path(rest).parts:
+            raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: no file of a package named')
+        if package == 'miro_ball' and rest.startswith('worlds/'):
+            return Path(str(importlib.resources.files('miro_sim_bullet.worlds'))) / rest[7:]
+        return _share(package, uri) / rest
+    path = Path(unquote(uri[len('file://'):]) if uri.startswith('file://') else uri)
+    if not path.is_absolute():
+        raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: a uri is package://, file:// '
+                                               'or an absolute path')
+    return path
+
+
+def _share(package, uri):
+    """The share folder of a package: ament_index's, else (for ours) the checkout's root."""
+    try:
+        from ament_index_python.packages import get_package_share_directory
+        return Path(get_package_share_directory(package))
+    except (ImportError, LookupError, ValueError, OSError):  # no package, or no ament index
+        pass
+    root = Path(miro_ball.__file__).resolve().parent.parent
+    if package == 'miro_ball' and (root / 'package.xml').is_file():
+        return root
+    raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: no package {package[:40]!r} found')
+
+
+def _read_text(path, uri):
+    try:
+        if not path.is_file():
+            raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: no such file')
+        with path.open('rb') as file:
+            raw = file.read(MAX_RESOURCE_BYTES + 1)
+    except OSError as err:
+        raise Refused(SpawnResult.NO_RESOURCE,
+                      f'{uri[:80]!r}: cannot read: {err.strerror or err}') from None
+    if len(raw) > MAX_RESOURCE_BYTES:
+        raise Refused(SpawnResult.RESOURCE_PARSE_ERROR,
+                      f'{uri[:80]!r}: larger than {MAX_RESOURCE_BYTES} bytes')
+    try:
+        return raw.decode('utf-8'), uri
+    except UnicodeDecodeError:
+        raise Refused(SpawnResult.RESOURCE_PARSE_ERROR,
+                      f'{uri[:80]!r}: not a UTF-8 text file') from None
+
+
+# -- names ------------------------------------------------------------------------------
+def _valid(name):
+    try:
+        check_name(name, 'entity name')
+    except ValueError as err:
+        raise Refused(SpawnResult.NAME_INVALID, str(err)) from None
+    if name == BALL_NAME:
+        raise Refused(SpawnResult.NAME_INVALID, f"{BALL_NAME!r} is the ball's name")
+    return name
+
+
+def _fresh(kind, taken, allow_renaming):
+    if not allow_renaming:
+        raise Refused(SpawnResult.NAME_INVALID, 'no name given: name it, or allow renaming '
+                                                f'for a fresh one ({kind}1, {kind}2, ...)')
+    number = 1
+    while f'{kind}{number}' in taken:
+        number += 1
+    return f'{kind}{number}'
+
+
+def _unique(name, allow_renaming, taken):
+    _valid(name)
+    if name not in taken:
+        return name
+    if not allow_renaming:
+        raise Refused(SpawnResult.NAME_NOT_UNIQUE, f'{name!r} is taken: choose another name, '
+                                                   'or allow renaming')
+    number = 1
+    while f'{name}_{number}' in taken:
+        number += 1
+    return _valid(f'{name}_{number}')
+
+
+def _robot_name(name, allow_renaming, namespace, taken):
+    if not isinstance(namespace, str):
+        raise Refused(SpawnResult.NAMESPACE_INVALID, 'the namespace must be a string')
+    asked = namespace[1:] if namespace.startswith('/') else namespace
+    if asked and name and asked != name:
+        raise Refused(SpawnResult.NAMESPACE_INVALID,
+                      f"namespace {namespace[:60]!r}: a MiRo's topics live under its name: "
+                      f"give '' or '/{name}'")
+    if asked:
+        try:
+            check_name(asked, 'namespace')
+        except ValueError as err:
+            raise Refused(SpawnResult.NAMESPACE_INVALID, str(err)) from None
+        if asked in taken:  # renamed, its topics would not be where they were asked for
+            raise Refused(SpawnResult.NAME_NOT_UNIQUE,
+                          f'{asked!r} is taken, and a MiRo spawned in a namespace keeps it: '
+                          'choose another')
+        return _valid(asked)
+    return _unique(name or _fresh('miro', taken, allow_renaming), allow_renaming, taken)
+
+
+def _ball_name(name, taken):
+    if name not in ('', BALL_NAME):
+        raise Refused(SpawnResult.NAME_INVALID, f"a [ball] is the ball, named {BALL_NAME!r} "
+                                                '(spawn a [[sphere]] with a mass for another '
+                                                'ball-like object)')
+    if BALL_NAME in taken:
+        raise Refused(SpawnResult.NAME_NOT_UNIQUE, 'the world has its ball already (one to a '
+                                                   'world; a [[sphere]] can be another)')
+    return BALL_NAME
