@@ -272,8 +272,18 @@ def world_catalogue(folders=()):
     problems = one line for each folder that cannot be read and each file that is no
     world, for the caller to report. Each world is read whole, so what is listed loads
     (the bundled ones take about 30 ms together, 100 ms the first time in a process)."""
-    entries = [(name, world_uri(name), _read_world(name)) for name in bundled_worlds()]
-    problems = []
+    worlds, problems = [], []
+
+    def read(name, uri, source):
+        try:
+            world = load_world(source)
+        except WorldError as err:
+            problems.append(str(err))
+        else:
+            worlds.append((name, uri, world.description, world.tags))
+
+    for name in bundled_worlds():
+        read(name, world_uri(name), name)
     for folder in folders:
         try:
             files = sorted(p for p in Path(folder).iterdir() if p.suffix == '.toml')
@@ -283,22 +293,9 @@ def world_catalogue(folders=()):
         if len(files) > MAX_CATALOGUE:
             problems.append(f'{folder}: more than {MAX_CATALOGUE} world files; '
                             f'listing the first {MAX_CATALOGUE}')
-        entries += [(p.stem, str(p.resolve()), _read_world(p)) for p in files[:MAX_CATALOGUE]]
-    worlds = []
-    for name, uri, world in entries:
-        if isinstance(world, World):
-            worlds.append((name, uri, world.description, world.tags))
-        else:
-            problems.append(world)
+        for path in files[:MAX_CATALOGUE]:
+            read(path.stem, str(path.resolve()), str(path))
     return worlds, problems
-
-
-def _read_world(name_or_path):
-    """The World, or the one line saying why it is none."""
-    try:
-        return load_world(name_or_path)
-    except WorldError as err:
-        return str(err)
 
 
 def named_poses(world, robot_name):
