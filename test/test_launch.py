@@ -1,0 +1,138 @@
+"""python -m miro_ball.launch as a user runs it: the football pitch comes up from one command
+(the simulator, a controller per robot, the GUI), a robot kicks, and one Ctrl+C ends every
+process; a process that ends stops the others, unless its file says respawn."""
+import queue
+import signal
+import subprocess
+import sys
+import threading
+import time
+import urllib.request
+
+from geometry_msgs.msg import PointStamped
+
+from miro_ball.common import proc_tree
+from miro_ball.controller.names import NODE_NAME as CONTROLLER
+from miro_ball.miro.interface import SimTopics
+from rostools import Probe, kill_if_running, spin_until
+
+UP_GUARD_S = 120.0  # hang guards only
+STOP_GUARD_S = 10.0
+ROBOTS = ('miro01', 'miro02', 'miro03')  # the football pitch's
+
+
+class Launch:
+    """python -m miro_ball.launch ... in a session of its own, its output read as it comes."""
+
+    def __init__(self, *args):
+        self.proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.launch', *args],
+                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                     text=True, start_new_session=True)
+        self.lines, self.output = queue.Queue(), []
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        for line in self.proc.stdout:
+            self.lines.put(line)
+        self.lines.put(None)
+
+    def line(self, text):
+        """The first line from now on that holds text."""
+        deadline = time.monotonic() + UP_GUARD_S
+        while time.monotonic() < deadline:
+            try:
+                line = self.lines.get(timeout=0.5)
+            except queue.Empty:
+                continue
+            assert line is not None, 'the launch ended:\n' + ''.join(self.output)
+            self.output.append(line)
+            if text in line:
+                return line
+        raise AssertionError(f'no {text!r}:\n' + ''.join(self.output))
+
+    def ctrl_c(self):
+        """One SIGINT; (exit code, seconds to exit, the descendants left, its whole output)."""
+        children = proc_tree.descendants(self.proc.pid)
+        sent = time.monotonic()
+        self.proc.send_signal(signal.SIGINT)
+        return self.finish(sent, children)
+
+    def finish(self, since=None, children=()):
+        since = since or time.monotonic()
+        try:
+            self.proc.wait(timeout=STOP_GUARD_S)
+        finally:
+            kill_if_running(self.proc)
+        seconds = time.monotonic() - since
+        while (line := self.lines.get(timeout=STOP_GUARD_S)) is not None:
+            self.output.append(line)
+        return self.proc.returncode, seconds, proc_tree.wait_gone(children, 0), \
+            ''.join(self.output)
+
+
+def test_football_comes_up_from_one_command_a_robot_kicks_and_one_ctrl_c_ends_it_all(
+        ros_context, executor):
+    probe = Probe(ros_context, executor, 'launch_probe')
+    touches = probe.watch(PointStamped, SimTopics().touches)
+    launch = Launch('football', 'gui_port:=0')
+    try:
+        url = launch.line('[miro_gui] miro_gui: open ').split(' open ', 1)[1].strip()
+        with urllib.request.urlopen(url, timeout=10) as page:
+            assert page.status == 200 and b'<html' in page.read().lower()
+        spin_until(executor, lambda: any(t.header.frame_id in ROBOTS for t in touches),
+                   UP_GUARD_S, 'a robot touching the ball')
+        names = set(probe.node.get_fully_qualified_node_names())
+        assert {f'/{robot}/{CONTROLLER}' for robot in ROBOTS} | {'/miro_sim'} <= names
+    finally:
+        code, seconds, left, output = launch.ctrl_c()
+    assert code == 0 and left == [], output
+    assert seconds < 3.0, output  # every node stops within a second of its Ctrl+C
+    assert 'Traceback' not in output and output.rstrip().endswith('[launch] stopped'), output
+    for label in ('miro_sim', *(f'{robot}/kick_blue_ball' for robot in ROBOTS)):
+        assert f'\n[{label}] ' in output, label
+
+
+def launch_file(folder, text):
+    path = folder / 'test.launch.xml'
+    path.write_text(f'<launch>{text}</launch>')
+    return str(path)
+
+
+def script(folder, name, code):
+    """An <executable> cmd attribute running code (a file of its own) with this Python."""
+    (folder / f'{name}.py').write_text(code)
+    return f'{sys.executable} {folder / name}.py'
+
+
+def test_a_process_that_ends_is_said_in_one_line_and_the_others_are_stopped(tmp_path):
+    ready = tmp_path / 'ready'
+    waiter = script(tmp_path, 'waiter', f"""import pathlib, signal, sys, time
+signal.signal(signal.SIGINT, lambda *_: sys.exit(print('stopped by Ctrl+C')))
+pathlib.Path({str(ready)!r}).touch()
+time.sleep(99)
+""")
+    quitter = script(tmp_path, 'quitter', f"""import os, sys, time
+while not os.path.exists({str(ready)!r}):  # the waiter is up
+    time.sleep(0.01)
+print('bye')
+sys.exit(3)
+""")
+    launch = Launch(launch_file(tmp_path, f'''<executable name="waiter" cmd="{waiter}"/>
+                                            <executable name="quitter" cmd="{quitter}"/>'''))
+    code, _, _, output = launch.finish()
+    assert code == 1, output
+    assert '[quitter] bye\n[launch] quitter exited with code 3; stopping the others\n' in output
+    assert output.endswith('[waiter] stopped by Ctrl+C\n[launch] ended\n'), output
+
+
+def test_a_process_whose_file_says_respawn_is_restarted(tmp_path):
+    count = tmp_path / 'starts'
+    again = script(tmp_path, 'again', f"open({str(count)!r}, 'a').write('x'); print('up')")
+    launch = Launch(launch_file(tmp_path, f'''<executable name="again" respawn="true"
+                                            respawn_delay="0.1" cmd="{again}"/>'''))
+    for _ in range(3):
+        launch.line('[again] up')
+    code, _, left, output = launch.ctrl_c()
+    assert code == 0 and left == [], output
+    assert output.count('[launch] again exited with code 0; respawning in 0.1 s') >= 2, output
+    assert len(count.read_text()) >= 3  # each time, the program itself ran anew
