@@ -52,16 +52,15 @@ def read_file(path):
     """The root entity (<launch>) of the launch file at path; LaunchError if it can not be
     read, is neither XML nor YAML, or steps outside the subset."""
     path = Path(path)
+    read = {'.xml': _from_xml, '.yaml': _from_yaml, '.yml': _from_yaml}.get(path.suffix)
+    if read is None:
+        raise LaunchError(f'{path}: not a launch file in XML or YAML (.launch.xml, '
+                          '.launch.yaml; Python launch files need ros2 launch)')
     try:
         text = path.read_text()
     except (OSError, UnicodeDecodeError) as err:
         raise LaunchError(f'{path}: can not be read ({err})') from None
-    if path.suffix == '.xml':
-        return _from_xml(text, path)
-    if path.suffix in ('.yaml', '.yml'):
-        return _from_yaml(text, path)
-    raise LaunchError(f'{path}: not a launch file in XML or YAML (.launch.xml, .launch.yaml; '
-                      'Python launch files need ros2 launch)')
+    return read(text, path)
 
 
 def _checked(kind, attrs, path, parent):
@@ -70,7 +69,7 @@ def _checked(kind, attrs, path, parent):
     key = f'{parent}/{kind}' if f'{parent}/{kind}' in SUBSET else kind
     where = f'{path}: <{kind}>'
     if key not in SUBSET or (parent and kind not in SUBSET[parent][1]):
-        inside = f' inside <{parent}>' if parent else ''
+        inside = f' inside <{parent}>' if parent not in ('', 'launch') else ''
         raise LaunchError(f'{where}{inside} is not supported by python -m miro_ball.launch '
                           '(docs/launch.md lists the subset)')
     allowed, _ = SUBSET[key]
@@ -113,21 +112,20 @@ def _from_yaml(text, path):
 def _yaml_entity(kind, body, path, parent):
     where = f'{path}: <{kind}>'
     if kind in ACTION_LISTS:  # a list of actions, or (a group) a mapping with its children
-        attrs = dict(body) if isinstance(body, dict) else {}
+        attrs = {str(k): v for k, v in body.items()} if isinstance(body, dict) else {}
         listed = attrs.pop('children', []) if isinstance(body, dict) else body
         if not isinstance(listed, list):
             raise LaunchError(f'{where} holds a list of actions')
-        attrs = _scalars(attrs, where)
         key = _checked(kind, attrs, path, parent)
+        attrs = _scalars(attrs, where)
         return Entity(key, attrs, path,
                       [_yaml_entity(*_one_key(item, where), path, key) for item in listed])
     if not isinstance(body, dict):
         raise LaunchError(f'{where} is a mapping of its attributes')
     children = SUBSET.get(kind, ((), ()))[1]
-    attrs = _scalars({name: value for name, value in body.items() if name not in children},
-                     where)
+    attrs = {str(name): value for name, value in body.items() if name not in children}
     key = _checked(kind, attrs, path, parent)
-    entity = Entity(key, attrs, path)
+    entity = Entity(key, _scalars(attrs, where), path)
     for child in (name for name in body if name in children):
         if not isinstance(body[child], list):
             raise LaunchError(f'{where}: {child} holds a list of mappings')
@@ -147,11 +145,11 @@ def _scalars(attrs, where):
     text = {}
     for name, value in attrs.items():
         if isinstance(value, bool):
-            text[str(name)] = 'true' if value else 'false'
+            text[name] = 'true' if value else 'false'
         elif isinstance(value, (str, int, float)):
-            text[str(name)] = str(value)
+            text[name] = str(value)
         elif value is None:
-            text[str(name)] = ''
+            text[name] = ''
         else:
             raise LaunchError(f'{where}: attribute {name!r} must be a single value')
     return text

@@ -144,8 +144,12 @@ def _include(entity, scope, found):
     inner = scope.inner(file=target, depth=scope.depth + 1)
     for arg in entity.children:
         inner.configs[arg.attrs['name']] = substitute(arg.attrs['value'], scope)
+    try:
+        root = read_file(target)
+    except LaunchError as err:  # say which file's include it is
+        raise LaunchError(f'{entity.file}: <include>: {err}') from None
     start = len(found.declared)
-    _actions(read_file(target).children, inner, found)
+    _actions(root.children, inner, found)
     passed = {arg.attrs['name'] for arg in entity.children}
     # What the include sets and no file declared before it, a user can not set.
     for name in passed - set(found.declared[:start]):
