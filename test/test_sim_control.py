@@ -14,7 +14,7 @@ from miro_sim_bullet.control.spawning import (parse_spawn, resolve_uri, RobotSpa
                                               ShapeSpawn, SPAWNABLE_MIRO, spawnables)
 from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.scene.world_file import (Ball, bundled_worlds, load_world, named_poses,
-                                              Shape, world_catalogue, WorldError)
+                                              world_catalogue, WorldError)
 
 BOX_URI = 'package://miro_ball/worlds/models/box.toml'
 BALL_URI = 'package://miro_ball/worlds/models/ball.toml'
