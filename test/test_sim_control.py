@@ -238,13 +238,16 @@ def test_the_uri_is_used_when_both_uri_and_text_are_given():
 
 @settings(max_examples=150, deadline=None)
 @given(name=st.text(max_size=12), renaming=st.booleans(),
+       uri=st.one_of(st.just(''), st.text(max_size=30), st.sampled_from([
+           BOX_URI, SPAWNABLE_MIRO, 'package://miro_ball/x/../../a.toml', 'file:///a.urdf',
+           'package://../x.urdf', '/\x00.toml'])),
        text=st.one_of(st.text(max_size=200), st.sampled_from([
            urdf()[:5000], '[box]\nsize = [1, 1, 1]', '[ball]\nradius = 0.1',
            '<robot name="x"><link name="a"/></robot>'])),
        namespace=st.text(max_size=8), taken=st.sets(st.sampled_from(['ball', 'box1', 'x'])))
-def test_garbage_requests_are_refused_never_crash(name, renaming, text, namespace, taken):
+def test_garbage_requests_are_refused_never_crash(name, renaming, uri, text, namespace, taken):
     try:
-        made = parse_spawn(name, renaming, '', text, namespace, taken)
+        made = parse_spawn(name, renaming, uri, text, namespace, taken)
     except Refused as error:
         assert error.code in range(101, 110) and '\n' not in str(error)
     else:

@@ -7,6 +7,7 @@ cylinder from one table in the world file's TOML syntax (the bundled models in
 worlds/models/, or a text of one's own).
 """
 import importlib.resources
+import re
 from dataclasses import dataclass, replace
 from functools import cache
 from pathlib import Path
@@ -27,6 +28,7 @@ SPAWNABLE_MIRO = PACKAGE_URI + 'robots/miro.urdf'  # written from the body model
 MODELS = 'models'  # worlds/models/: the bundled spawnable shapes
 MIRO_DESCRIPTION = 'MiRo-E, with its whole ROS interface under its name'
 MAX_RESOURCE_BYTES = max(MAX_URDF_BYTES, MAX_FILE_BYTES)
+_PACKAGE = re.compile(r'[A-Za-z][A-Za-z0-9_]*')  # a ROS package's name
 
 
 @dataclass(frozen=True)
@@ -174,8 +176,9 @@ def _locate(uri):
     """The path a uri names, or Refused(NO_RESOURCE)."""
     if uri.startswith('package://'):
         package, _, rest = uri[len('package://'):].partition('/')
-        if not rest or '..' in Path(rest).parts:
-            raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: no file of a package named')
+        if not _PACKAGE.fullmatch(package) or not rest or '..' in Path(rest).parts:
+            raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: not package://PACKAGE/PATH '
+                                                   'of a file inside the package')
         if package == 'miro_ball' and rest.startswith('worlds/'):
             return Path(str(importlib.resources.files('miro_sim_bullet.worlds'))) / rest[7:]
         return _share(package, uri) / rest
