@@ -126,7 +126,7 @@ def body_bounds(body):
 def _resource(uri, resource_string, resolve):
     if uri:
         suffix = Path(uri).suffix.lower()
-        if suffix not in ('.urdf', '.toml') and uri != SPAWNABLE_MIRO:
+        if suffix not in ('.urdf', '.toml'):
             raise Refused(SpawnResult.UNSUPPORTED_FORMAT,
                           f'{uri[:80]!r}: a {suffix or "file without a suffix"} cannot be '
                           f'spawned: formats are {", ".join(SPAWN_FORMATS)} (.urdf, .toml)')
