@@ -303,3 +303,14 @@ def test_ros2s_own_launch_reads_every_bundled_file():
     for path in bundled():
         entity, parser = Parser.load(str(path))
         assert parser.parse_description(entity).entities, path
+
+
+def test_docs_launch_md_lists_every_bundled_file_with_its_own_arguments():
+    rows = {line.split('|')[1].strip(' `'): line
+            for line in (ROOT / 'docs' / 'launch.md').read_text().splitlines()
+            if line.startswith('| `') and '.launch.' in line.split('|')[1]}
+    assert sorted(rows) == [path.name for path in bundled()]
+    for path in bundled():
+        own = [arg.name for arg in make_plan(path, {}, share_folder, os.environ).args.values()
+               if arg.file == path]
+        assert own and all(f'`{name}`' in rows[path.name] for name in own), path.name
