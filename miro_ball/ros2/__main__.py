@@ -7,7 +7,10 @@ with no ROS 2 of its own (the ROS wheels from PyPI), with ros2's arguments and o
         '{twist: {linear: {x: 0.2}}}' -r 10
     python -m miro_ball.ros2 interface show miro2_msg/msg/SensorsPackage
     python -m miro_ball.ros2 param get /miro_sim camera_rate
-    python -m miro_ball.ros2 service call /miro_sim/reset std_srvs/srv/Trigger
+    python -m miro_ball.ros2 service call /miro_sim/set_simulation_state \\
+        simulation_interfaces/srv/SetSimulationState '{state: {state: 2}}'
+    python -m miro_ball.ros2 action send_goal /miro_sim/simulate_steps \\
+        simulation_interfaces/action/SimulateSteps '{steps: 100}' -f
 
 It sees the ROS domain of the shell it runs in (ROS_DOMAIN_ID), as ros2 does. Without
 ros2's daemon, a listing listens until the graph is complete (3.5 s or more; if it is still
@@ -20,7 +23,7 @@ import sys
 
 from rclpy.executors import ExternalShutdownException
 
-from miro_ball.ros2 import verbs
+from miro_ball.ros2 import actions, verbs
 from miro_ball.ros2.convert import TRUNCATE
 from miro_ball.ros2.graph import CliError, Graph
 
@@ -43,14 +46,16 @@ def build_parser():
         sub = commands.add_parser(name, help=about, description=about)
         return sub.add_subparsers(dest='verb', metavar='VERB', required=True)
 
-    def verb(parent, name, about, run, needs_graph=True):
+    def verb(parent, name, about, run, needs_graph=True, own_ctrl_c=False):
         sub = parent.add_parser(name, help=about, description=about)
-        sub.set_defaults(run=run, needs_graph=needs_graph)
+        sub.set_defaults(run=run, needs_graph=needs_graph, own_ctrl_c=own_ctrl_c)
         return sub
 
     topic = group('topic', 'topics: list, echo, hz, info, pub')
     v = verb(topic, 'list', 'the topics of the graph', verbs.topic_list)
     v.add_argument('-t', '--show-types', action='store_true', help='with their types')
+    v.add_argument('--include-hidden-topics', action='store_true',
+                   help="those of a name part that starts with '_' too (an action's)")
     v = verb(topic, 'echo', "print a topic's messages as YAML", verbs.topic_echo)
     v.add_argument('topic')
     v.add_argument('--once', action='store_true', help='one message, then exit')
@@ -80,10 +85,17 @@ def build_parser():
     verb(node, 'list', 'the nodes of the graph', verbs.node_list)
     v = verb(node, 'info', "a node's publishers, subscribers and services", verbs.node_info)
     v.add_argument('node', help='its full name, as /miro_sim')
+    v.add_argument('--include-hidden', action='store_true',
+                   help="topics and services of a name part that starts with '_' too")
 
-    interface = group('interface', 'message and service types: show')
+    interface = group('interface', 'message, service and action types: list, show')
+    v = verb(interface, 'list', 'the installed types', verbs.interface_list, needs_graph=False)
+    v.add_argument('-m', '--only-msgs', action='store_true', help='the message types only')
+    v.add_argument('-s', '--only-srvs', action='store_true', help='the service types only')
+    v.add_argument('-a', '--only-actions', action='store_true', help='the action types only')
     v = verb(interface, 'show', "a type's fields", verbs.interface_show, needs_graph=False)
-    v.add_argument('type', help='as miro2_msg/msg/SensorsPackage or std_srvs/srv/Trigger')
+    v.add_argument('type', help='as miro2_msg/msg/SensorsPackage, std_srvs/srv/Trigger or '
+                   'simulation_interfaces/action/SimulateSteps')
 
     param = group('param', "a node's parameters: list, get, set")
     v = verb(param, 'list', "a node's parameter names", verbs.param_list)
@@ -99,10 +111,27 @@ def build_parser():
     service = group('service', 'services: list, call')
     v = verb(service, 'list', 'the services of the graph', verbs.service_list)
     v.add_argument('-t', '--show-types', action='store_true', help='with their types')
+    v.add_argument('--include-hidden-services', action='store_true',
+                   help="those of a name part that starts with '_' too (an action's)")
     v = verb(service, 'call', 'call a service with a request given as YAML', verbs.service_call)
     v.add_argument('service')
     v.add_argument('type', help='as std_srvs/srv/Trigger')
     v.add_argument('values', nargs='?', default='{}', help="the request's fields as YAML")
+
+    action = group('action', 'actions: list, info, send_goal')
+    v = verb(action, 'list', 'the actions of the graph', actions.action_list)
+    v.add_argument('-t', '--show-types', action='store_true', help='with their types')
+    v.add_argument('-c', '--count-actions', action='store_true', help='only how many')
+    v = verb(action, 'info', "an action's clients and servers", actions.action_info)
+    v.add_argument('action', help='as /miro_sim/simulate_steps')
+    v.add_argument('-t', '--show-types', action='store_true', help='with their types')
+    v.add_argument('-c', '--count', action='store_true', help='only how many')
+    v = verb(action, 'send_goal', 'send a goal given as YAML and wait for its result '
+             '(Ctrl+C cancels it)', actions.action_send_goal, own_ctrl_c=True)
+    v.add_argument('action', help='as /miro_sim/simulate_steps')
+    v.add_argument('type', help='as simulation_interfaces/action/SimulateSteps')
+    v.add_argument('goal', nargs='?', default='{}', help="the goal's fields as YAML")
+    v.add_argument('-f', '--feedback', action='store_true', help='print each feedback')
     return parser
 
 
@@ -115,7 +144,7 @@ def main(argv=None):
     graph = None
     try:
         if args.needs_graph:
-            graph = Graph()
+            graph = Graph(own_ctrl_c=args.own_ctrl_c)
         return args.run(args, graph)
     except (CliError, ValueError) as err:
         print(f'{PROG}: {err}', file=sys.stderr)

@@ -112,7 +112,7 @@ def fill(msg, data, path=''):
             elif fields[name].startswith(('sequence<', 'array<')) or '[' in fields[name]:
                 setattr(msg, name, _sequence(msg, name, value, where))
             else:
-                setattr(msg, name, _scalar(current, value, fields[name], where))
+                setattr(msg, name, _scalar(value, fields[name], where))
         except (AssertionError, TypeError, OverflowError) as err:
             raise ValueError(f'{where} ({fields[name]}) can not be {value!r}: {err}') from None
     return msg
@@ -122,29 +122,57 @@ def _sequence(msg, name, value, where):
     if not isinstance(value, list):
         raise ValueError(f'{where} is a sequence: give a list, as [1, 2]')
     slot = msg.SLOT_TYPES[list(msg.get_fields_and_field_types()).index(name)]
-    inner = getattr(slot, 'value_type', None)
+    size, most = getattr(slot, 'size', None), getattr(slot, 'maximum_size', None)
+    if size is not None and len(value) != size:
+        raise ValueError(f'{where} holds exactly {size} items: give {size}, not {len(value)}')
+    if most is not None and len(value) > most:
+        raise ValueError(f'{where} holds at most {most} items, not {len(value)}')
+    inner = slot.value_type
     if hasattr(inner, 'namespaces'):  # a sequence of messages
         module = __import__('.'.join(inner.namespaces), fromlist=[inner.name])
-        return [fill(getattr(module, inner.name)(), item, f'{where}[{k}].')
-                for k, item in enumerate(value)]
-    return value
+        items = []
+        for k, item in enumerate(value):
+            if not isinstance(item, dict):
+                raise ValueError(f'{where}[{k}] is a {inner.name}: give a mapping')
+            items.append(fill(getattr(module, inner.name)(), item, f'{where}[{k}].'))
+        return items
+    # a string's slot type has no typename (its bound is its maximum_size)
+    kind = getattr(inner, 'typename', 'string')
+    return [_scalar(item, kind, f'{where}[{k}]') for k, item in enumerate(value)]
 
 
-def _scalar(current, value, type_name, where):
-    if isinstance(current, bool):
+FLOATS = ('float', 'double', 'long double')
+INTEGERS = {'octet': (0, 255), **{f'int{bits}': (-2 ** (bits - 1), 2 ** (bits - 1) - 1)
+                                  for bits in (8, 16, 32, 64)},
+            **{f'uint{bits}': (0, 2 ** bits - 1) for bits in (8, 16, 32, 64)}}
+
+
+def _scalar(value, type_name, where):
+    """value checked against a field's type ('uint8', 'double', 'string<=8', ...): the
+    generated classes check nothing unless ROS_PYTHON_CHECK_FIELDS=1, and an integer out of
+    range was sent wrapped (uint8 300 as 44) or failed in the C code with a traceback."""
+    if type_name == 'boolean':
         if not isinstance(value, bool):
             raise ValueError(f'{where} is a bool: give true or false')
         return value
-    if isinstance(current, float):
+    if type_name in FLOATS:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ValueError(f'{where} is a {type_name}: give a number, not {value!r}')
         return float(value)
-    if isinstance(current, int):
+    if type_name in INTEGERS:
+        low, high = INTEGERS[type_name]
         if isinstance(value, bool) or not isinstance(value, int):
             raise ValueError(f'{where} is a {type_name}: give an integer, not {value!r}')
-        return value
-    if isinstance(current, str) and not isinstance(value, str):
-        return str(value)
+        if not low <= value <= high:
+            raise ValueError(f'{where} is a {type_name}: give an integer from {low} to {high}, '
+                             f'not {value}')
+        return bytes([value]) if type_name == 'octet' else value
+    if type_name.startswith(('string', 'wstring')):
+        text = value if isinstance(value, str) else str(value)
+        most = type_name.partition('<=')[2]
+        if most and len(text) > int(most):
+            raise ValueError(f'{where} is a {type_name}: at most {most} characters')
+        return text
     return value
 
 

@@ -27,8 +27,14 @@ class CliError(Exception):
 class Graph:
     """A node of the command line, on the default context; closed with close()."""
 
-    def __init__(self, name='miro_ball_ros2'):
-        rclpy.init(args=[])
+    def __init__(self, name='miro_ball_ros2', own_ctrl_c=False):
+        """own_ctrl_c: Ctrl+C raises KeyboardInterrupt and the node stays up, for a verb
+        that still has something to say to the graph (a goal to cancel); else rclpy's
+        handler shuts the node down and wakes whatever waits on it."""
+        from rclpy.signals import SignalHandlerOptions
+
+        rclpy.init(args=[], signal_handler_options=SignalHandlerOptions.NO if own_ctrl_c
+                   else SignalHandlerOptions.ALL)
         self.node = Node(f'{name}_{os.getpid()}', start_parameter_services=False)
         self.domain = self.node.context.get_domain_id()
 

@@ -11,7 +11,7 @@ from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import GetParameters, ListParameters, SetParameters
 from rclpy.node import NodeNameNonExistentError
 
-from miro_ball.common.definitions import expanded, split_type
+from miro_ball.common.definitions import expanded, prefixes, split_type
 from miro_ball.ros2 import convert
 from miro_ball.ros2.graph import CliError
 
@@ -53,6 +53,15 @@ def absolute(name):
     return full
 
 
+def visible(listing, include_hidden):
+    """listing ({name: types}) without the names ros2 hides unless asked: those with a part
+    that starts with '_', as an action's /name/_action/feedback."""
+    from rclpy.topic_or_service_is_hidden import topic_or_service_is_hidden
+
+    return {name: types for name, types in listing.items()
+            if include_hidden or not topic_or_service_is_hidden(name)}
+
+
 def print_listing(listing, show_types):
     """'name' or 'name [type, ...]' a line, sorted: ros2's topic and service lists."""
     for name, types in sorted(listing.items()):
@@ -62,7 +71,8 @@ def print_listing(listing, show_types):
 
 # -- topic ------------------------------------------------------------------------------------
 def topic_list(args, graph):
-    return print_listing(graph.settle(graph.topics), args.show_types)
+    return print_listing(visible(graph.settle(graph.topics), args.include_hidden_topics),
+                         args.show_types)
 
 
 def topic_info(args, graph):
@@ -166,23 +176,30 @@ def node_list(args, graph):
 
 
 def node_info(args, graph):
+    from rclpy.action.graph import (get_action_client_names_and_types_by_node,
+                                    get_action_server_names_and_types_by_node)
+
     name, namespace = graph.find_node(args.node)
     node = graph.node
     sections = (('Subscribers', node.get_subscriber_names_and_types_by_node),
                 ('Publishers', node.get_publisher_names_and_types_by_node),
                 ('Service Servers', node.get_service_names_and_types_by_node),
-                ('Service Clients', node.get_client_names_and_types_by_node))
+                ('Service Clients', node.get_client_names_and_types_by_node),
+                ('Action Servers', lambda *at: get_action_server_names_and_types_by_node(
+                    node, *at)),
+                ('Action Clients', lambda *at: get_action_client_names_and_types_by_node(
+                    node, *at)))
     try:
-        found = graph.settle(lambda: [sorted(listing(name, namespace))
-                                      for _, listing in sections])
+        found = graph.settle(lambda: [
+            sorted(visible(dict(listing(name, namespace)), args.include_hidden).items())
+            for _, listing in sections])
     except NodeNameNonExistentError:
         raise CliError(f'{args.node} left the ROS graph while it was listed') from None
     print(f'{namespace.rstrip("/")}/{name}')
     for (title, _), listing in zip(sections, found):
         print(f'  {title}:')
-        for topic, types in listing:
-            print(f'    {topic}: {", ".join(types)}')
-    print('  Action Servers:\n\n  Action Clients:\n')
+        # ros2 prints the lines of a section with one print, so an empty one is a blank line
+        print('\n'.join(f'    {topic}: {", ".join(types)}' for topic, types in listing))
     return 0
 
 
@@ -262,7 +279,8 @@ def param_set(args, graph):
 
 # -- service, interface -----------------------------------------------------------------------
 def service_list(args, graph):
-    return print_listing(graph.settle(graph.services), args.show_types)
+    return print_listing(visible(graph.settle(graph.services), args.include_hidden_services),
+                         args.show_types)
 
 
 def service_call(args, graph):
@@ -274,6 +292,35 @@ def service_call(args, graph):
     print(f'requester: making request: {request!r}\n')
     response = graph.call(service, srv_class, request)
     print(f'response:\n{response!r}\n')
+    return 0
+
+
+def installed_interfaces():
+    """{'msg': [...], 'srv': [...], 'action': [...]} of 'pkg/kind/Name' of every package
+    installed (the ament index's rosidl_interfaces, each package from the first prefix
+    that has it), sorted."""
+    found = {}
+    for prefix in reversed(prefixes()):  # the first prefix wins: read it last
+        index = prefix / 'share' / 'ament_index' / 'resource_index' / 'rosidl_interfaces'
+        for resource in sorted(index.glob('*')) if index.is_dir() else []:
+            found[resource.name] = resource.read_text().split()
+    kinds = {'msg': set(), 'srv': set(), 'action': set()}
+    for package, entries in found.items():
+        for entry in entries:  # 'msg/Bounds.idl', 'msg/Bounds.msg', ...
+            kind, _, file_name = entry.split(';')[0].partition('/')
+            if kind in kinds and file_name:
+                kinds[kind].add(f'{package}/{kind}/{file_name.rsplit(".", 1)[0]}')
+    return {kind: sorted(names) for kind, names in kinds.items()}
+
+
+def interface_list(args, graph=None):
+    kinds = installed_interfaces()
+    chosen = [kind for kind, only in (('msg', args.only_msgs), ('srv', args.only_srvs),
+                                      ('action', args.only_actions)) if only] or list(kinds)
+    for kind in chosen:
+        print({'msg': 'Messages:', 'srv': 'Services:', 'action': 'Actions:'}[kind])
+        for name in kinds[kind]:
+            print(f'    {name}')
     return 0
 
 
