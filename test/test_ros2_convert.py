@@ -3,9 +3,9 @@ import math
 
 import pytest
 import yaml
-from geometry_msgs.msg import PoseArray, TwistStamped
+from geometry_msgs.msg import PoseArray, PoseWithCovariance, TwistStamped
 from sensor_msgs.msg import Image
-from std_msgs.msg import Float32MultiArray
+from std_msgs.msg import ByteMultiArray, Float32MultiArray, UInt8MultiArray
 
 from miro_ball.common.definitions import expanded
 from miro_ball.ros2.convert import field, fill, parse_yaml, to_data, to_yaml
@@ -41,6 +41,21 @@ def test_a_list_of_messages_is_filled_from_a_list_of_mappings():
 def test_a_value_that_does_not_fit_is_named(values, says):
     with pytest.raises(ValueError, match=says):
         fill(TwistStamped(), values)
+
+
+@pytest.mark.parametrize('cls,values,says', [
+    # The generated classes check nothing by default: uint8 300 went out as 44, -1 and a
+    # list item that is no mapping were tracebacks.
+    (UInt8MultiArray, {'data': [1, 300]}, r'data\[1\] is a uint8: give an integer from 0 to 255'),
+    (UInt8MultiArray, {'layout': {'data_offset': -1}}, 'from 0 to 4294967295, not -1'),
+    (PoseArray, {'poses': [3]}, r'poses\[0\] is a Pose: give a mapping'),
+    (PoseWithCovariance, {'covariance': [1.0]}, 'holds exactly 36 items'),
+    (Float32MultiArray, {'data': [1.0, 'a']}, r'data\[1\] is a float: give a number'),
+])
+def test_integer_ranges_array_sizes_and_list_items_are_checked(cls, values, says):
+    with pytest.raises(ValueError, match=says):
+        fill(cls(), values)
+    assert list(fill(ByteMultiArray(), {'data': [0, 255]}).data) == [b'\x00', b'\xff']
 
 
 def test_interface_text_expands_nested_types_a_tab_in():
