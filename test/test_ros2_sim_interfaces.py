@@ -204,7 +204,8 @@ def test_service_calls_fill_nested_messages_and_lists_of_them(sim):
     answers = run_all(
         command('service', 'call', f'/{NODE}/set_simulation_state',
                 'simulation_interfaces/srv/SetSimulationState', '{state: {state: 2}}'),
-        command('service', 'call', f'/{NODE}/get_entities', 'simulation_interfaces/srv/GetEntities',
+        command('service', 'call', f'/{NODE}/get_entities',
+                'simulation_interfaces/srv/GetEntities',
                 '{filters: {filter: "miro.*", categories: [{category: 1}, {category: 4}]}}'),
         command('service', 'call', f'/{NODE}/spawn_entities',
                 'simulation_interfaces/srv/SpawnEntities', '{spawn_requests: [{name: box2, '

@@ -176,6 +176,8 @@ def node_list(args, graph):
 
 
 def node_info(args, graph):
+    from functools import partial
+
     from rclpy.action.graph import (get_action_client_names_and_types_by_node,
                                     get_action_server_names_and_types_by_node)
 
@@ -185,10 +187,8 @@ def node_info(args, graph):
                 ('Publishers', node.get_publisher_names_and_types_by_node),
                 ('Service Servers', node.get_service_names_and_types_by_node),
                 ('Service Clients', node.get_client_names_and_types_by_node),
-                ('Action Servers', lambda *at: get_action_server_names_and_types_by_node(
-                    node, *at)),
-                ('Action Clients', lambda *at: get_action_client_names_and_types_by_node(
-                    node, *at)))
+                ('Action Servers', partial(get_action_server_names_and_types_by_node, node)),
+                ('Action Clients', partial(get_action_client_names_and_types_by_node, node)))
     try:
         found = graph.settle(lambda: [
             sorted(visible(dict(listing(name, namespace)), args.include_hidden).items())
@@ -303,7 +303,8 @@ def installed_interfaces():
     for prefix in reversed(prefixes()):  # the first prefix wins: read it last
         index = prefix / 'share' / 'ament_index' / 'resource_index' / 'rosidl_interfaces'
         for resource in sorted(index.glob('*')) if index.is_dir() else []:
-            found[resource.name] = resource.read_text().split()
+            if resource.is_file():
+                found[resource.name] = resource.read_text(errors='replace').split()
     kinds = {'msg': set(), 'srv': set(), 'action': set()}
     for package, entries in found.items():
         for entry in entries:  # 'msg/Bounds.idl', 'msg/Bounds.msg', ...
