@@ -6,6 +6,7 @@ listen until the graph is complete (settling.py says when), or until what is ask
 by name shows up.
 """
 import os
+import signal
 import sys
 import time
 
@@ -35,6 +36,9 @@ class Graph:
 
         rclpy.init(args=[], signal_handler_options=SignalHandlerOptions.NO if own_ctrl_c
                    else SignalHandlerOptions.ALL)
+        if own_ctrl_c:  # also where SIGINT came ignored (a shell's job started with &), as
+            # rclpy's handler takes it there too
+            signal.signal(signal.SIGINT, signal.default_int_handler)
         self.node = Node(f'{name}_{os.getpid()}', start_parameter_services=False)
         self.domain = self.node.context.get_domain_id()
 
