@@ -1,5 +1,5 @@
 """python -m miro_ball.build_interfaces: what it builds, skips and says, without building
-(./dev.sh setup has built both packages into this venv before the tests run)."""
+(./dev.sh setup has built the packages into this venv before the tests run)."""
 import shutil
 import subprocess
 import sys
@@ -18,7 +18,8 @@ def said():
 def test_packages_built_from_unchanged_sources_are_not_built_again():
     lines, say = said()
     assert b.build_all(Path(sys.prefix), say=say) == []
-    assert lines == ['tf2_msgs: up to date', 'miro2_msg: up to date']
+    assert lines == ['tf2_msgs: up to date', 'miro2_msg: up to date',
+                     'simulation_interfaces: up to date']
 
 
 def test_changed_sources_are_built_again(tmp_path, monkeypatch):
@@ -30,7 +31,7 @@ def test_changed_sources_are_built_again(tmp_path, monkeypatch):
     lines, say = said()
     with pytest.raises(b.BuildError, match=r'cannot build miro2_msg: missing a compiler'):
         b.build_all(Path(sys.prefix), say=say)
-    assert lines == ['tf2_msgs: up to date']
+    assert lines == ['tf2_msgs: up to date', 'simulation_interfaces: up to date']
 
 
 def test_what_is_missing_is_named_with_what_does_not_work_without_it(tmp_path, monkeypatch):
@@ -41,12 +42,13 @@ def test_what_is_missing_is_named_with_what_does_not_work_without_it(tmp_path, m
     message = str(error.value)
     assert '\n' not in message
     for needed in ('cmake (Debian: cmake)', 'c++ (Debian: g++)', "pip install 'miro_ball[msgs]'",
-                   '/tf and /tf_static', 'sensors/package', 'the rest runs'):
+                   '/tf and /tf_static', 'sensors/package', 'standard control services',
+                   'the rest runs'):
         assert needed in message
 
 
 def test_a_package_another_prefix_provides_is_used_not_built(tmp_path):
-    lines, say = said()  # this venv provides both, seen from another prefix
+    lines, say = said()  # this venv provides them all, seen from another prefix
     assert b.build_all(tmp_path, say=say) == []
     assert all('provided by' in line and 'not built' in line for line in lines)
 

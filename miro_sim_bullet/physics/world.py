@@ -6,6 +6,7 @@ sleeps or looks at the wall clock, and nothing draws: the cameras
 (render.cameras.Cameras) take a world and draw its client's bodies.
 """
 import math
+from dataclasses import replace
 
 from miro_ball.miro.constants import PLATFORM_TICK_S
 from miro_ball.miro.interface import default_robot_name
@@ -14,8 +15,8 @@ from miro_sim_bullet.acoustics.hearing import Acoustics
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.robot import MiroRobot
 from miro_sim_bullet.physics.sensors import GRAVITY
-from miro_sim_bullet.scene.world_file import (BALL_NAME, MAX_ROBOTS, PICTURE_UV, Shape, World,
-                                              load_world)
+from miro_sim_bullet.scene.world_file import (BALL_NAME, MAX_ROBOTS, PICTURE_UV, RobotSpec,
+                                              Shape, World, load_world)
 
 # Collision groups. Bit 0 stays in every mask because Bullet's ray tests carry group 1.
 # Static bodies skip each other (a wall panel touching the floor is work for nothing);
@@ -57,67 +58,89 @@ class SimWorld:
         self.robot_name = robot_name or default_robot_name()
         self.dt = physics_dt
         self.ticks_per_platform_tick = max(1, round(PLATFORM_TICK_S / physics_dt))
+        self.loaded = self.description  # as loaded: what a full reset goes back to
         self.client = pb.connect(pb.DIRECT)
         self.generation = 0
+        self.spawned = set()  # names of the entities added at run time (spawn())
         self._build()
 
     # -- building -----------------------------------------------------------------------------
     def _kw(self):
         return {'physicsClientId': self.client}
 
-    def _build(self):
+    def _build(self, keep_time=False):
         kw = self._kw()
         pb.resetSimulation(**kw)
         pb.setPhysicsEngineParameter(fixedTimeStep=self.dt, deterministicOverlappingPairs=1,
                                      numSolverIterations=SOLVER_ITERATIONS, **kw)
         pb.setGravity(0, 0, -GRAVITY, **kw)
-        self.step_index = 0
+        if not keep_time:
+            self.step_index = 0
         world = self.description
         # body id -> (name or group, 'static' | 'mover' | 'robot'): what the scene calls it.
         self.body_labels = {}
+        self.shape_of = {}  # body id -> the world_file Shape (or Ball) it was made from
         if world.ground_height is not None:
             ground = self._shape(Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
                                        size=(*world.ground_size, 0.1), colour=world.ground_colour))
             self.body_labels[ground] = ('ground', 'static')
         self.objects = {}  # name -> body id of everything movable but the robots
+        self.statics = {}  # name -> body id of the named static shapes
         for shape in world.shapes:
-            body = self._shape(shape)
-            if shape.mass > 0:
-                self.objects[shape.name] = body
-                self.body_labels[body] = (shape.name, 'mover')
-            else:
-                self.body_labels[body] = (shape.name or _table(shape), 'static')
+            self._add_shape(shape)
         self.ball_id = None
         if world.ball is not None:
-            ball = world.ball
-            self.ball_id = self._shape(Shape(
-                kind='sphere', position=(*ball.position, ball.floor + ball.radius),
-                radius=ball.radius, colour=ball.colour, mass=ball.mass, friction=ball.friction,
-                restitution=ball.restitution, name=BALL_NAME, source='ball'))
-            self.objects[BALL_NAME] = self.ball_id
-            self.body_labels[self.ball_id] = (BALL_NAME, 'mover')
+            self._add_ball(world.ball)
         self.robots = {}
-        for index, spec in enumerate(world.robots):
-            name = spec.name or self.robot_name
-            robot = MiroRobot(self.client, name, spec, clock=lambda: self.time,
-                              ray_mask=ALL_GROUPS & ~robot_group(index))
-            self.robots[name] = robot
-            self.body_labels[robot.body_id] = (name, 'robot')
+        self._bits = {}  # robot name -> its collision group's bit number
+        for spec in world.robots:
+            self._add_robot(spec)
         self._filter_collisions()
         self._pictures()  # last, so that the other bodies keep their ids
         self._new_acoustics()
         self.generation += 1
         self._built = pb.saveState(**kw)
 
+    def _add_ball(self, ball):
+        self.ball_id = self._shape(Shape(
+            kind='sphere', position=(*ball.position, ball.floor + ball.radius),
+            radius=ball.radius, colour=ball.colour, mass=ball.mass, friction=ball.friction,
+            restitution=ball.restitution, name=BALL_NAME, source='ball'))
+        self.objects[BALL_NAME] = self.ball_id
+        self.body_labels[self.ball_id] = (BALL_NAME, 'mover')
+        self.shape_of[self.ball_id] = ball
+
+    def _add_shape(self, shape):
+        body = self._shape(shape)
+        self.shape_of[body] = shape
+        if shape.mass > 0:
+            self.objects[shape.name] = body
+            self.body_labels[body] = (shape.name, 'mover')
+        else:
+            if shape.name:
+                self.statics[shape.name] = body
+            self.body_labels[body] = (shape.name or _table(shape), 'static')
+        return body
+
+    def _add_robot(self, spec):
+        name = spec.name or self.robot_name
+        bit = min(set(range(MAX_ROBOTS)) - set(self._bits.values()))
+        robot = MiroRobot(self.client, name, spec, clock=lambda: self.time,
+                          ray_mask=ALL_GROUPS & ~robot_group(bit))
+        self._bits[name] = bit
+        self.robots[name] = robot
+        self.body_labels[robot.body_id] = (name, 'robot')
+        return robot
+
     def _filter_collisions(self):
         """Every body in its collision group. Setting a body's filter also empties Bullet's
         cache of its contacts, which a restored snapshot keeps (rewind())."""
         kw = self._kw()
         movable = set(self.objects.values())
-        for index, robot in enumerate(self.robots.values()):
-            robot.model.set_collision_filter(robot_group(index), ALL_GROUPS)
+        for name, robot in self.robots.items():
+            robot.model.set_collision_filter(robot_group(self._bits[name]), ALL_GROUPS)
         robots = {robot.body_id for robot in self.robots.values()}
-        for body in range(pb.getNumBodies(**kw)):
+        for body in (pb.getBodyUniqueId(k, **kw) for k in range(pb.getNumBodies(**kw))):
             if body in robots:
                 continue
             if body in movable:
@@ -126,10 +149,14 @@ class SimWorld:
                 pb.setCollisionFilterGroupMask(body, -1, STATIC_GROUP,
                                                ALL_GROUPS & ~STATIC_GROUP, **kw)
 
-    def _new_acoustics(self):
+    def _new_acoustics(self, playing=()):
+        """The world's sound for the robots there are now; ``playing``: sounds added at run
+        time that go on (scene.sounds.Sound)."""
         world = self.description
         self.acoustics = Acoustics(self.robots, world.sounds, world.hearing,
                                    ground=world.ground_height or 0.0)
+        for sound in playing:
+            self.acoustics.add_sound(sound)
 
     def _shape(self, shape):
         kw = self._kw()
@@ -175,14 +202,154 @@ class SimWorld:
                                  rgbaColor=(1, 1, 1, 1), **kw)
 
     def reset(self):
-        """Back to the world's initial state (rebuilt from scratch: deterministic)."""
+        """Back to the world as loaded, time zero (rebuilt from scratch: deterministic):
+        what was spawned since is gone, what was deleted is back."""
+        self.description, self.spawned = self.loaded, set()
         self._build()
+
+    def reset_state(self):
+        """Everything there is now back to where it started (a spawned entity: where it
+        was spawned), time going on."""
+        self._build(keep_time=True)
+
+    def reset_time(self):
+        """Time from zero; nothing moves."""
+        self.step_index = 0
+
+    def load(self, world):
+        """Another world in place of this one (a World), built from scratch, time zero."""
+        self.loaded = world
+        self.reset()
+
+    # -- entities added and removed at run time -----------------------------------------------
+    def names(self):
+        """Every name in use: robots, movable objects (the ball among them), named statics."""
+        return {*self.robots, *self.objects, *self.statics}
+
+    def entities(self):
+        """{name: body id} of every body but the drawn parts and pictures: the robots,
+        the movable objects, the named statics and the unnamed ones, named '<table>_<k>'
+        (the k-th of a world-file table: 'wall_3', 'ring_0', 'ground_0')."""
+        named = {**{name: robot.body_id for name, robot in self.robots.items()},
+                 **self.objects, **self.statics}
+        counts = {}
+        for body, (label, kind) in self.body_labels.items():
+            if kind == 'static' and body not in self.statics.values():
+                index = counts[label] = counts.get(label, -1) + 1
+                name = f'{label}_{index}'
+                if name not in named:
+                    named[name] = body
+        return named
+
+    def body_state(self, body):
+        """(position, orientation xyzw, linear velocity, angular velocity) of a body's base
+        in the world frame."""
+        kw = self._kw()
+        return (*pb.getBasePositionAndOrientation(body, **kw), *pb.getBaseVelocity(body, **kw))
+
+    def set_body_velocity(self, body, linear, angular):
+        pb.resetBaseVelocity(body, linear, angular, **self._kw())
+
+    def spawn_ball(self, ball, x, y, z):
+        """The world's ball (world_file.Ball), its centre at (x, y, z) (z None: on its
+        floor); ValueError if it has one already."""
+        if self.ball_id is not None:
+            raise ValueError('the world has its ball already')
+        floor = ball.floor if z is None else z - ball.radius
+        ball = replace(ball, position=(float(x), float(y)), floor=float(floor))
+        self._add_ball(ball)
+        pb.setCollisionFilterGroupMask(self.ball_id, -1, MOVABLE_GROUP, ALL_GROUPS,
+                                       **self._kw())
+        self._added(BALL_NAME, replace(self.description, ball=ball))
+
+    def spawn_robot(self, name, x, y, yaw, floor=0.0):
+        """A MiRo named ``name`` standing at (x, y, yaw) on a floor at height ``floor``,
+        powered up; ValueError if the world has MAX_ROBOTS already or the name is taken."""
+        if len(self.robots) >= MAX_ROBOTS:
+            raise ValueError(f'the world has {MAX_ROBOTS} robots, the most it can hold')
+        self._check_free(name)
+        spec = RobotSpec(name, (float(x), float(y), float(yaw)), float(floor))
+        robot = self._add_robot(spec)
+        robot.model.set_collision_filter(robot_group(self._bits[name]), ALL_GROUPS)
+        self._added(name, replace(self.description,
+                                  robots=(*self.description.robots, spec)))
+        return robot
+
+    def spawn_shape(self, shape):
+        """A named box, sphere or cylinder (world_file.Shape; mass 0 = static)."""
+        self._check_free(shape.name)
+        body = self._add_shape(shape)
+        if shape.mass > 0:
+            pb.setCollisionFilterGroupMask(body, -1, MOVABLE_GROUP, ALL_GROUPS, **self._kw())
+        else:
+            pb.setCollisionFilterGroupMask(body, -1, STATIC_GROUP, ALL_GROUPS & ~STATIC_GROUP,
+                                           **self._kw())
+        self._added(shape.name, replace(self.description,
+                                        shapes=(*self.description.shapes, shape)))
+
+    def _check_free(self, name):
+        if not name or name in self.names():
+            raise ValueError(f'the name {name!r} is taken or empty')
+
+    def _added(self, name, description):
+        self.description = description
+        self.spawned.add(name)
+        self._changed()
+
+    def remove(self, name):
+        """Take the entity ``name`` (entities()) out of the world; KeyError if there is
+        none."""
+        kw = self._kw()
+        world = self.description
+        if name in self.robots:
+            robot = self.robots.pop(name)
+            del self._bits[name]
+            for body in (robot.body_id, *robot.model.drawn.bodies.values()):
+                pb.removeBody(body, **kw)
+            del self.body_labels[robot.body_id]
+            self.shape_of.pop(robot.body_id, None)
+            world = replace(world, robots=tuple(
+                spec for spec in world.robots if (spec.name or self.robot_name) != name))
+        elif name == BALL_NAME and self.ball_id is not None:
+            pb.removeBody(self.ball_id, **kw)
+            del self.objects[BALL_NAME], self.body_labels[self.ball_id]
+            del self.shape_of[self.ball_id]
+            self.ball_id = None
+            world = replace(world, ball=None)
+        else:
+            body = self.entities()[name]
+            self.objects.pop(name, None)
+            self.statics.pop(name, None)
+            shapes = list(world.shapes)
+            shapes.remove(self.shape_of.pop(body))
+            pb.removeBody(body, **kw)
+            del self.body_labels[body]
+            world = replace(world, shapes=tuple(shapes))
+        self.description = world
+        self.spawned.discard(name)
+        self._changed()
+
+    def remove_spawned(self):
+        """Every entity spawned since the world was loaded (or last reset) taken out."""
+        for name in sorted(self.spawned):
+            self.remove(name)
+
+    def _changed(self):
+        """The set of bodies changed: the robots' sound, the renderers' copy of the scene
+        and rewind()'s snapshot follow."""
+        self._new_acoustics(source.sound for _, source in self.acoustics.sounds.values()
+                            if source.sound not in self.description.sounds)
+        self.generation += 1
+        self._built = None
 
     def rewind(self):
         """Back to the state right after the build without building anew (a learning
         environment's reset: about 50 times cheaper than reset()): PyBullet's snapshot of
         the built bodies restored, time from zero, each robot's platform and the world's
         sound started again. Body ids stay, so renderers keep what they read."""
+        if self._built is None:  # bodies were added or removed since the snapshot
+            self._build()
+            return
         pb.restoreState(self._built, **self._kw())
         # Without this the contacts cached before the rewind warm-start the solver after
         # it, and the same seed no longer gives the same trajectory.

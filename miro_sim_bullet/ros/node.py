@@ -19,6 +19,7 @@ import argparse
 import collections
 import sys
 import time
+from pathlib import Path
 
 import cv2
 from rclpy.clock import Clock, ClockType
@@ -37,6 +38,7 @@ from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.interface import CLOCK, CLOCK_QOS, PLATFORM, robot_name, SIM_NODE_NAME, \
     TF, TF_STATIC, TF_TYPE
 from miro_ball.miro.stream_kinds import BLOCK, CAMERA, Schedule, Timing
+from miro_sim_bullet.control.codes import SimulationState
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.eye_pipeline import EyePipeline
@@ -48,10 +50,13 @@ from miro_sim_bullet.ros.params import SimParams
 from miro_sim_bullet.ros.robot_interface import RobotInterface
 from miro_sim_bullet.ros.scene import SCENE_RATE_HZ
 from miro_sim_bullet.ros.scene_interface import SceneInterface
+from miro_sim_bullet.ros.sim_control import ControlInterface
 from miro_sim_bullet.ros.sim_interface import SimInterface
+from miro_sim_bullet.ros.step_action import StepAction
 from miro_sim_bullet.ros.tf import TfInterface
 from miro_sim_bullet.scene.sounds import sound_folders
-from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, WorldError
+from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, World, world_uri, \
+    WorldError
 
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 TYPE_CHECK_PERIOD_S = 1.0  # wall seconds between looks for control publishers of a wrong type
@@ -87,33 +92,41 @@ class SimNode(Node):
         self.said = Throttled(self.get_logger().info)  # what clients ask often (a reset)
         # The world file is read first: a typo in its name is said at once, not after the
         # look for another simulator (peer_check_s).
-        folders = sound_folders(p.sound_folders)
+        self.sound_folders = folders = sound_folders(p.sound_folders)
         world = load_world(p.world, folders)
+        self.world_uri = world_uri(p.world) if p.world in bundled_worlds() \
+            else str(Path(p.world).resolve())
         # Before the look for another simulator: two started together see each other.
         self.pub_clock = self.create_publisher(ClockMsg, CLOCK, profile(CLOCK_QOS))
         if guard_domain:  # before the world is built: a refusal costs no time
             refuse_shared_domain(self, p.peer_check_s)
             self._clock_watch = ClockWatch(self, own=1)
+        self.robot_name = unnamed_robot
         self.sim = SimWorld(world, physics_dt=p.physics_dt, robot_name=unnamed_robot)
-        self.cameras = Cameras(self.sim, p.renderer, log=self.get_logger().info)
-        self.eyes = EyePipeline(self.cameras, p.eye_workers, log=self.get_logger().info,
-                                warn=self.get_logger().warning)
+        self._make_cameras()
         self.camera = CameraModel(p.frame_width, p.frame_height, p.lens, p.hfov_deg)
         self.paused = p.paused
+        # What the standard's simulation state adds to paused: a stop (reset and paused),
+        # no world, a world loading, a quit asked for.
+        self.stopped = self.no_world = self.loading = self.quitting = False
         self.frames_published = 0
         # Seconds spent drawing and encoding each camera instant (summed over helper processes).
         self.render_seconds = []
         # Wall seconds per stage of the loop in this thread (the benchmark's profile).
         self.stage_seconds = collections.Counter()
         ros = Endpoints.of(self)
-        self.robots = {name: RobotInterface(name, ros, self._robot_lookup(name), self.warn)
-                       for name in self.sim.robots}
-        self.sim_interface = self.scene = None
+        self.robots = {}  # name -> RobotInterface
+        self._robot_endpoints = {}  # name -> the Endpoints its interface was made with
+        self._sync_robots()
+        self.sim_interface = self.scene = self.control = self.step_action = None
         if privileged:
-            self.sim_interface = SimInterface(ros, self.sim, self.cameras, reset=self.reset,
-                                              pause=self.pause, step=self.step, warn=self.warn,
+            self.sim_interface = SimInterface(ros, self.sim, self.cameras,
+                                              reset=lambda: self.reset(0), pause=self.pause,
+                                              step=self.step_count, warn=self.warn,
                                               sound_folders=folders)
             self.scene = SceneInterface(ros, self.sim)
+            self.control = ControlInterface(ros, self, self.warn)
+            self.step_action = StepAction(self, self.context)
         # Called after every physics step with the world: an in-process judge sees each
         # contact, however brief.
         self.step_observers = []
@@ -121,10 +134,8 @@ class SimNode(Node):
             f'world {self.sim.description.source}; robots {", ".join(self.robots)}; renderer '
             f'{self.cameras.renderer.name}; cameras {p.frame_width}x{p.frame_height} @ '
             f'{p.camera_rate:g} Hz; real-time factor {p.real_time_factor:g}')
-        try:
-            self.tf = TfInterface(ros, self.sim, convert.stamp(self.sim.time))
-        except ValueError:
-            self.tf = None
+        self.tf = self._tf_endpoints = None
+        self._make_tf()
         missing = [(row.name, row.type) for row in next(iter(self.robots.values())).missing_types]
         if self.tf is None:
             missing.append((f'{TF} and {TF_STATIC}', TF_TYPE))
@@ -149,6 +160,33 @@ class SimNode(Node):
         # The world's robots are made anew by a reset: looked up each time.
         return lambda: self.sim.robots[name]
 
+    def _make_cameras(self):
+        self.cameras = Cameras(self.sim, self.params.renderer, log=self.get_logger().info)
+        self.eyes = EyePipeline(self.cameras, self.params.eye_workers,
+                                log=self.get_logger().info, warn=self.get_logger().warning)
+
+    def _sync_robots(self):
+        """A RobotInterface for each robot of the world, and none for a robot gone."""
+        for name in [name for name in self.robots if name not in self.sim.robots]:
+            del self.robots[name]
+            self._robot_endpoints.pop(name).destroy()
+        for name in self.sim.robots:
+            if name not in self.robots:
+                ros = self._robot_endpoints[name] = Endpoints.owned(self)
+                self.robots[name] = RobotInterface(name, ros, self._robot_lookup(name),
+                                                   self.warn)
+
+    def _make_tf(self):
+        """/tf and /tf_static for the robots there are now (made again when they change:
+        /tf_static keeps one message, which must hold every robot's fixed frames)."""
+        if self._tf_endpoints is not None:
+            self._tf_endpoints.destroy()
+        self._tf_endpoints = Endpoints.owned(self)
+        try:
+            self.tf = TfInterface(self._tf_endpoints, self.sim, convert.stamp(self.sim.time))
+        except ValueError:
+            self.tf = None
+
     def _make_timer(self):
         # Free-running, the simulator steps whenever the executor is free (period 0);
         # paused, such a timer would keep a core busy doing nothing: it looks in at 200 Hz.
@@ -164,6 +202,7 @@ class SimNode(Node):
             self.destroy_timer(self.timer)
             self.timer = self._make_timer()
         self.paused = params.paused
+        self.stopped = self.stopped and params.paused  # played: no longer stopped
         self._restart_schedule(keep_time=True)
         if params.paused:
             self._publish_eyes(wait=True)  # nothing drawn is held back while paused
@@ -187,14 +226,85 @@ class SimNode(Node):
                         f'{wanted} only: the robot does not hear it')
 
     # -- what the simulator's services do to time ---------------------------------------------
-    def reset(self):
-        """The world back to its initial state, time and schedule from zero."""
+    @property
+    def state(self):
+        """The standard's simulation state (control.codes.SimulationState)."""
+        if self.quitting:
+            return SimulationState.QUITTING
+        if self.loading:
+            return SimulationState.LOADING_WORLD
+        if self.no_world:
+            return SimulationState.NO_WORLD
+        if self.paused:
+            return SimulationState.STOPPED if self.stopped else SimulationState.PAUSED
+        return SimulationState.PLAYING
+
+    def act(self, action):
+        """'play', 'pause', 'stop' (reset and pause) or 'quit' (the node ends at its next
+        turn, as a program: exit code 0)."""
+        if action == 'quit':
+            self.quitting = True
+            self.get_logger().info('quitting, as asked')
+            return
+        if action == 'stop':
+            self.reset(0)
+        self.pause(action != 'play')
+        self.stopped = action == 'stop'
+
+    def reset(self, scope):
+        """ResetSimulation's scope (bits: 1 time, 2 state, 4 spawned; 0 or all three: the
+        world as loaded, time zero): the schedule follows the time."""
         self._publish_eyes(wait=True)  # the instants before the reset come first
-        self.sim.reset()
+        bits = scope & 0b111
+        if bits in (0, 0b111):
+            self.sim.reset()
+        else:
+            if bits & 0b100:
+                self.sim.remove_spawned()
+            if bits & 0b010:
+                self.sim.reset_state()
+            if bits & 0b001:
+                self.sim.reset_time()
         if self.sim_interface is not None:
             self.sim_interface.forget_touches()
-        self._restart_schedule()
-        self.said('reset', 'world reset')
+        if self.control is not None:
+            self.control.forget()
+        self.world_changed()
+        self._restart_schedule(keep_time=not bits & 0b001 and bits not in (0, 0b111))
+        self.said('reset', f'world reset (scope {scope})')
+
+    def world_changed(self):
+        """Robots or objects came or went: their interfaces follow."""
+        if set(self.robots) != set(self.sim.robots):
+            self._sync_robots()
+            self._make_tf()
+        if self.sim_interface is not None:
+            self.sim_interface.sync_objects()
+
+    def load(self, world, uri):
+        """Another world (a World) in place of this one, the node's interfaces with it; the
+        state is LOADING_WORLD meanwhile, and paused after."""
+        self.loading = True
+        try:
+            self._publish_eyes(wait=True)
+            self.eyes.close()
+            self.cameras.close()
+            self.sim.load(world)
+            self._make_cameras()
+            self.world_uri, self.no_world = uri, False
+            self.reset(0)
+            if self.sim_interface is not None:
+                self.sim_interface.world_loaded(self.cameras)
+        finally:
+            self.loading = False
+        self.pause(True)
+        self.get_logger().info(f'world {world.source} loaded; robots '
+                               f'{", ".join(self.robots) or "none"}; paused')
+
+    def unload(self):
+        """No world: nothing in it, nothing to step, until load()."""
+        self.load(World(name='', source='(no world)', robots=()), '')
+        self.no_world = True
 
     def pause(self, paused):
         """Pause or run; whether paused now. Through the parameter, so that it always says
@@ -202,12 +312,21 @@ class SimNode(Node):
         self.set_parameters([Parameter('paused', value=paused)])
         return self.paused
 
-    def step(self):
-        """(done, message): step_count physics steps, only while paused."""
+    def step(self, steps):
+        """(done, message): ``steps`` physics steps, only while paused (and not stopped:
+        a step leaves the stop, as the standard's state machine says)."""
         if not self.paused:
-            return False, 'step works only while paused'
-        self.advance(self.params.step_count)
-        return True, f'stepped {self.params.step_count}; time {self.sim.time:.3f} s'
+            return False, ('stepping works only while paused: set the simulation state to '
+                           'paused first')
+        if self.no_world or self.loading:
+            return False, 'no world is loaded'
+        self.stopped = False
+        self.advance(steps)
+        return True, f'stepped {steps}; time {self.sim.time:.3f} s'
+
+    def step_count(self):
+        """The old ~/step service: step_count physics steps."""
+        return self.step(self.params.step_count)
 
     # -- time ---------------------------------------------------------------------------------
     def _restart_schedule(self, keep_time=False):
@@ -218,7 +337,11 @@ class SimNode(Node):
             self._next_scene = 0.0
 
     def _on_timer(self):
-        if self.paused:
+        if self.quitting:
+            raise SystemExit(0)
+        if self.step_action is not None and self.step_action.serve():
+            return
+        if self.paused or self.no_world:
             if self.eyes.pending:  # paused by in-process code, not by the parameter
                 self._publish_eyes(wait=True)
             return
@@ -310,6 +433,7 @@ class SimNode(Node):
             self.tf.publish(when)
         if platform_tick and self.sim_interface is not None:
             self.sim_interface.publish_ground_truth(when)
+            self.control.tick()
 
     def _submit_eyes(self, overlap):
         """Ask for every eye someone subscribes to, of every robot, drawn together."""
@@ -344,6 +468,8 @@ class SimNode(Node):
         self.stage_seconds['eyes: wait and publish'] += time.perf_counter() - started
 
     def destroy_node(self):
+        if self.step_action is not None:
+            self.step_action.close()
         self.eyes.close()
         self.cameras.close()
         self.sim.close()

@@ -46,8 +46,9 @@ class SimInterface:
         # A robot's every touch of a tick would be 10 messages; its first is what counts.
         self.pub_touches = ros.publisher(PointStamped, t.touches, 10 * len(world.robots))
         self._touches = {}  # robot name -> (simulated s, ball x, y, z) of this tick's first
-        self.pub_objects = {name: ros.publisher(PoseStamped, t.object_pose(name), 10)
-                            for name in (*world.objects, *world.robots)}
+        self._ros = ros
+        self.pub_objects = {}  # name -> publisher of its ground truth (sync_objects())
+        self.sync_objects()
         self.pub_overhead = ros.publisher(CompressedImage, t.overhead, 2)
         self.sub_set_pose = ros.subscription(PoseStamped, t.set_pose, self._on_set_pose, 10)
         self.sub_sound = ros.subscription(String, t.sound, self._on_sound, 10)
@@ -59,6 +60,22 @@ class SimInterface:
             ros.service(SetBool, t.pause, self._on_pause, qos_profile=SERVICE_QOS),
             ros.service(Trigger, t.step, self._on_step, qos_profile=SERVICE_QOS),
         ]
+
+    def sync_objects(self):
+        """A ground-truth publisher for every movable object and robot there is now (they
+        come and go at run time: spawned, deleted, another world loaded)."""
+        wanted = {*self.world.objects, *self.world.robots}
+        for name in [name for name in self.pub_objects if name not in wanted]:
+            self._ros.destroy_publisher(self.pub_objects.pop(name))
+        for name in sorted(wanted - set(self.pub_objects)):
+            self.pub_objects[name] = self._ros.publisher(
+                PoseStamped, SimTopics().object_pose(name), 10)
+
+    def world_loaded(self, cameras):
+        """Another world was loaded: its overhead view, drawn by its cameras."""
+        self.cameras = cameras
+        self.overhead = overhead_camera(self.world.description)
+        self.sync_objects()
 
     # -- requests -----------------------------------------------------------------------------
     def _on_set_pose(self, msg):

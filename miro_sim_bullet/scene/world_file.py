@@ -213,6 +213,13 @@ def load_world(name_or_path, sound_folders=()):
                                                        Path(source).stem)
 
 
+def parse_world(text, source, sound_folders=()):
+    """A world from the text of a world file (LoadWorld's resource_string); ``source``
+    names it in messages and as its name. Its pictures and sounds are bundled ones or
+    absolute paths."""
+    return _Parser(source, None, sound_folders).world(_toml(text, source), source)
+
+
 def _toml(text, source):
     """The tables of a TOML text, or WorldError in one line."""
     if len(text) > MAX_FILE_BYTES:

@@ -1,0 +1,442 @@
+"""The standard simulator interface (simulation_interfaces, Jazzy 1.5.1) under /miro_sim/.
+
+Every service of the standard, named as its type in snake_case relative to the simulator
+node (/miro_sim/get_entities_states, ...); the simulate_steps action is step_action's. A
+tool written for Gazebo, Isaac Sim or O3DE drives this simulator through them: its state
+(playing, paused, stopped, quitting), stepping, resetting by scope, its entities (list,
+state, info, bounds, spawn, delete), named poses, spawnable models and worlds.
+
+What the requests mean is decided by plain logic (control.*: filters, spawn requests, the
+state table, pose checks); what they do to time and to the node's interfaces (a robot
+spawned gets its topics, a world loaded gets new ones) belongs to the node, reached
+through ``host`` (node.SimNode). Every refusal is the standard's result code and one line,
+said as a rate-limited warning too.
+"""
+import dataclasses
+
+from geometry_msgs.msg import Vector3
+from simulation_interfaces import msg as si
+from simulation_interfaces import srv
+
+from miro_ball.miro.interface import BALL_NAME
+from miro_ball.miro.rotations import yaw_of, yaw_quaternion
+from miro_sim_bullet.control import codes
+from miro_sim_bullet.control.codes import EntityCategory, Refused, Result
+from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter
+from miro_sim_bullet.control.poses import check_pose, in_world, WORLD_FRAMES
+from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, RobotSpawn,
+                                              SPAWN_FORMATS, spawnables)
+from miro_sim_bullet.control.states import transition
+from miro_sim_bullet.ros import convert
+from miro_sim_bullet.scene.world_file import (Ball, named_poses, parse_world, world_catalogue,
+                                              WorldError, load_world)
+
+MAX_SPAWNS = 64  # entities one SpawnEntities request may ask for
+_F = si.SimulatorFeatures
+FEATURES = (
+    _F.SPAWNING, _F.DELETING, _F.NAMED_POSES, _F.ENTITY_TAGS, _F.ENTITY_BOUNDS,
+    _F.ENTITY_BOUNDS_BOX, _F.ENTITY_CATEGORIES, _F.SPAWNING_RESOURCE_STRING,
+    _F.ENTITY_STATE_GETTING, _F.ENTITY_STATE_SETTING, _F.ENTITY_INFO_GETTING,
+    _F.ENTITY_INFO_SETTING, _F.SPAWNABLES, _F.SIMULATION_RESET, _F.SIMULATION_RESET_TIME,
+    _F.SIMULATION_RESET_STATE, _F.SIMULATION_RESET_SPAWNED, _F.SIMULATION_STATE_GETTING,
+    _F.SIMULATION_STATE_SETTING, _F.SIMULATION_STATE_PAUSE, _F.STEP_SIMULATION_SINGLE,
+    _F.STEP_SIMULATION_MULTIPLE, _F.STEP_SIMULATION_ACTION, _F.WORLD_LOADING,
+    _F.WORLD_RESOURCE_STRING, _F.WORLD_TAGS, _F.WORLD_UNLOADING, _F.WORLD_INFO_GETTING,
+    _F.AVAILABLE_WORLDS, _F.SPAWNING_ENTITIES)
+CUSTOM_INFO = ('miro_ball: MiRo-E robots in PyBullet. Spawn MiRo-E from its URDF (any '
+               'robot_description of ours, or package://miro_ball/robots/miro.urdf) and '
+               'balls, boxes, spheres and cylinders from a world file\'s TOML table; worlds '
+               'are TOML world files. A robot\'s pose is the point on its floor under the '
+               'wheel axle, and its heading.')
+ROBOT_TAGS = ('miro', 'robot')
+
+
+def _result(code=Result.OK, message=''):
+    return si.Result(result=code, error_message=message)
+
+
+class ControlInterface:
+    """The services of the standard, made with ros (Endpoints) for ``host``, the node:
+    it has ``sim`` (the SimWorld), ``state`` (codes.SimulationState), ``robot_name`` (for
+    a world's unnamed robot), ``world_folders`` (more worlds to list) and the acts
+    act(action) ('play', 'pause', 'stop', 'quit'), step(n) -> (done, message),
+    reset(scope), world_changed() and load(world) / unload(). warn(kind, message) is a
+    rate-limited warning."""
+
+    def __init__(self, ros, host, warn):
+        self.host, self._warn = host, warn
+        self.info = {}  # entity name -> Entity (set_entity_info's, or its defaults)
+        self._velocity = {}  # entity name -> ((t, v, w) at the last platform tick, before)
+        handlers = {
+            srv.GetSimulatorFeatures: self._features, srv.GetSimulationState: self._get_state,
+            srv.SetSimulationState: self._set_state, srv.StepSimulation: self._step,
+            srv.ResetSimulation: self._reset, srv.GetEntities: self._get_entities,
+            srv.GetEntitiesStates: self._get_entities_states,
+            srv.GetEntityState: self._get_entity_state,
+            srv.SetEntityState: self._set_entity_state, srv.GetEntityInfo: self._get_info,
+            srv.SetEntityInfo: self._set_info, srv.GetEntityBounds: self._get_bounds,
+            srv.SpawnEntity: self._spawn_entity, srv.SpawnEntities: self._spawn_entities,
+            srv.DeleteEntity: self._delete, srv.GetNamedPoses: self._named_poses,
+            srv.GetNamedPoseBounds: self._named_pose_bounds,
+            srv.GetSpawnables: self._spawnables, srv.GetAvailableWorlds: self._worlds,
+            srv.GetCurrentWorld: self._current_world, srv.LoadWorld: self._load_world,
+            srv.UnloadWorld: self._unload_world}
+        from miro_sim_bullet.ros.sim_interface import SERVICE_QOS
+        self.services = [ros.service(kind, service_name(kind), self._guarded(handler),
+                                     qos_profile=SERVICE_QOS)
+                         for kind, handler in handlers.items()]
+
+    @property
+    def sim(self):
+        return self.host.sim
+
+    def _guarded(self, handler):
+        """A refusal becomes the response's result (and a warning), whatever the service."""
+        def serve(request, response):
+            try:
+                handler(request, response)
+            except Refused as refused:
+                self._warn(f'control:{handler.__name__}', f'{handler.__name__[1:]}: {refused}')
+                target = response.result
+                if isinstance(target, si.SpawnResult):  # SpawnEntities: per request
+                    target = target.result
+                target.result, target.error_message = refused.code, str(refused)
+            return response
+        return serve
+
+    # -- the simulation -----------------------------------------------------------------------
+    def _features(self, request, response):
+        response.features = si.SimulatorFeatures(features=list(FEATURES),
+                                                 spawn_formats=list(SPAWN_FORMATS),
+                                                 custom_info=CUSTOM_INFO)
+
+    def _get_state(self, request, response):
+        response.state.state = self.host.state
+        response.result = _result()
+
+    def _set_state(self, request, response):
+        self.host.act(transition(self.host.state, request.state.state))
+        response.result = _result()
+
+    def _step(self, request, response):
+        self._need_world()
+        done, message = self.host.step(request.steps)
+        if not done:
+            raise Refused(Result.OPERATION_FAILED, message)
+        response.result = _result()
+
+    def _reset(self, request, response):
+        self._need_world()
+        scope = request.scope
+        if scope & ~0xFF:
+            raise Refused(Result.OPERATION_FAILED, f'no reset scope {scope}')
+        self.host.reset(scope)
+        response.result = _result()
+
+    def _need_world(self):
+        if self.host.state in (codes.SimulationState.NO_WORLD,
+                               codes.SimulationState.LOADING_WORLD):
+            raise Refused(Result.INCORRECT_STATE, 'no world is loaded: load_world first')
+
+    # -- entities -----------------------------------------------------------------------------
+    def entity(self, name):
+        """The Entity ``name`` is (its info), or Refused NOT_FOUND."""
+        bodies = self.sim.entities()
+        if name not in bodies:
+            shown = ', '.join(sorted(bodies)[:12]) + (', ...' if len(bodies) > 12 else '')
+            raise Refused(Result.NOT_FOUND, f'no entity {name[:80]!r}: there are {shown}')
+        return self.info.get(name) or self._default_info(name, bodies[name])
+
+    def _default_info(self, name, body):
+        sim = self.sim
+        if name in sim.robots:
+            return Entity(name, EntityCategory.ROBOT, 'MiRo-E', ROBOT_TAGS)
+        if name == BALL_NAME and body == sim.ball_id:
+            return Entity(name, EntityCategory.DYNAMIC_OBJECT, 'the ball', (BALL_NAME,))
+        shape = sim.shape_of[body]
+        category = EntityCategory.DYNAMIC_OBJECT if shape.mass > 0 \
+            else EntityCategory.STATIC_OBJECT
+        table = shape.source.split('[')[0] or shape.kind
+        return Entity(name, category, f'a {shape.kind} ({shape.source})',
+                      tuple(dict.fromkeys((shape.kind, table))))
+
+    def pose(self, name):
+        """(position, orientation) of an entity in the world frame; a robot's is its
+        FOOT frame: the point on its floor under the axle, turned to its heading."""
+        sim = self.sim
+        if name in sim.robots:
+            x, y, z, yaw = sim.robots[name].ground_truth()
+            return (x, y, z), yaw_quaternion(yaw)
+        return sim.body_state(sim.entities()[name])[:2]
+
+    def _filtered(self, filters):
+        keep = entity_filter(filters.filter, [c.category for c in filters.categories],
+                             list(filters.tags.tags), filters.tags.filter_mode,
+                             (filters.bounds.type,
+                              [(p.x, p.y, p.z) for p in filters.bounds.points]))
+        return [name for name in self.sim.entities()
+                if keep(self.entity(name), self.pose(name)[0])]
+
+    def _get_entities(self, request, response):
+        response.entities = self._filtered(request.filters)
+        response.result = _result()
+
+    def _get_entities_states(self, request, response):
+        response.entities = self._filtered(request.filters)
+        response.states = [self.state_of(name) for name in response.entities]
+        response.result = _result()
+
+    def _get_entity_state(self, request, response):
+        self.entity(request.entity)
+        response.state = self.state_of(request.entity)
+        response.result = _result()
+
+    def state_of(self, name):
+        """EntityState of an entity now, ground truth in the world frame: its pose, its
+        base's velocity and the mean acceleration over the last platform tick."""
+        position, orientation = self.pose(name)
+        _, _, linear, angular = self.sim.body_state(self.sim.entities()[name])
+        stamped = convert.pose(position, orientation, convert.stamp(self.sim.time))
+        state = si.EntityState(header=stamped.header, pose=stamped.pose)
+        state.twist.linear, state.twist.angular = _vector(linear), _vector(angular)
+        now, before = self._velocity.get(name, (None, None))
+        if now is not None and before is not None and now[0] > before[0]:
+            dt = now[0] - before[0]
+            state.acceleration.linear = _vector([(a - b) / dt for a, b in zip(now[1], before[1])])
+            state.acceleration.angular = _vector([(a - b) / dt
+                                                  for a, b in zip(now[2], before[2])])
+        return state
+
+    def tick(self):
+        """Each platform tick: every movable entity's velocity, for the accelerations."""
+        sim = self.sim
+        bodies = {**{name: robot.body_id for name, robot in sim.robots.items()},
+                  **sim.objects}
+        self._velocity = {name: ((sim.time, *sim.body_state(body)[2:]),
+                                 self._velocity.get(name, (None,))[0])
+                          for name, body in bodies.items()}
+
+    def _set_entity_state(self, request, response):
+        entity = self.entity(request.entity)
+        state = request.state
+        pose = check_pose(*_pose_tuple(state.pose), code=srv.SetEntityState.Response.INVALID_POSE)
+        position, orientation = in_world(self._frame(state.header.frame_id), pose)
+        if entity.category == EntityCategory.STATIC_OBJECT:
+            raise Refused(Result.OPERATION_FAILED, f'{entity.name} is static: it does not move')
+        self.sim.set_object_pose(entity.name, position, orientation)
+        if entity.name not in self.sim.robots:  # a robot's wheels say how it moves
+            self.sim.set_body_velocity(self.sim.entities()[entity.name],
+                                       _values(state.twist.linear), _values(state.twist.angular))
+        response.result = _result()
+
+    def _frame(self, frame_id):
+        """The world pose of a request's frame: the world, or an entity's."""
+        if frame_id in WORLD_FRAMES:
+            return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)
+        self.entity(frame_id)
+        return self.pose(frame_id)
+
+    def _get_info(self, request, response):
+        entity = self.entity(request.entity)
+        response.info = si.EntityInfo(category=si.EntityCategory(category=entity.category),
+                                      description=entity.description, tags=list(entity.tags))
+        response.result = _result()
+
+    def _set_info(self, request, response):
+        entity = self.entity(request.entity)
+        info = request.info
+        if info.category.category not in codes.CATEGORIES:
+            raise Refused(Result.OPERATION_FAILED, f'no entity category '
+                                                   f'{info.category.category}')
+        self.info[entity.name] = dataclasses.replace(
+            entity, category=info.category.category, description=info.description[:1000],
+            tags=tuple(tag[:64] for tag in info.tags[:32]))
+        response.result = _result()
+
+    def _get_bounds(self, request, response):
+        self.entity(request.entity)
+        sim = self.sim
+        body = sim.entities()[request.entity]
+        kind, points = entity_bounds('robot', ()) if request.entity in sim.robots \
+            else body_bounds(sim.shape_of[body])
+        response.bounds = _bounds(kind, points)
+        response.result = _result()
+
+    # -- spawning and deleting ----------------------------------------------------------------
+    def _spawn_entity(self, request, response):
+        response.entity_name = self.spawn(request)
+        response.result = _result()
+
+    def _spawn_entities(self, request, response):
+        if len(request.spawn_requests) > MAX_SPAWNS:
+            raise Refused(Result.OPERATION_FAILED, f'{len(request.spawn_requests)} entities '
+                          f'asked for at once; at most {MAX_SPAWNS} a request')
+        failed = 0
+        for one in request.spawn_requests:
+            result = si.SpawnResult(result=_result())
+            try:
+                result.entity_name = self.spawn(one, resource=one.entity_resource)
+            except Refused as refused:
+                failed += 1
+                self._warn('control:spawn', f'spawn_entities: {refused}')
+                result.result = _result(refused.code, str(refused))
+            response.results.append(result)
+        response.result = _result() if not failed else _result(
+            srv.SpawnEntities.Response.ENTITIES_SPAWN_FAILED,
+            f'{failed} of {len(request.spawn_requests)} entities not spawned: see results')
+
+    def spawn(self, request, resource=None):
+        """Spawn what one request (SpawnEntity's or a SpawnEntity message) asks; its name."""
+        self._need_world()
+        resource = resource or request
+        sim = self.sim
+        spawn = parse_spawn(request.name, request.allow_renaming, resource.uri,
+                            resource.resource_string, request.entity_namespace, sim.names())
+        pose = check_pose(*_pose_tuple(request.initial_pose.pose))
+        (x, y, z), orientation = in_world(self._frame(request.initial_pose.header.frame_id),
+                                          pose)
+        try:
+            if isinstance(spawn, RobotSpawn):
+                sim.spawn_robot(spawn.name, x, y, yaw_of(*orientation), floor=z)
+            elif isinstance(spawn.body, Ball):
+                sim.spawn_ball(spawn.body, x, y, max(z, spawn.body.radius + spawn.body.floor))
+            else:
+                shape = spawn.body
+                lowest = (sim.description.ground_height or 0.0) + _half_height(shape)
+                sim.spawn_shape(dataclasses.replace(shape, position=(x, y, max(z, lowest)),
+                                                    yaw=yaw_of(*orientation)))
+        except ValueError as err:  # the world is full
+            raise Refused(Result.OPERATION_FAILED, str(err)) from None
+        if not isinstance(spawn, RobotSpawn) and (spawn.description or spawn.tags):
+            base = self._default_info(spawn.name, sim.entities()[spawn.name])
+            self.info[spawn.name] = dataclasses.replace(
+                base, description=spawn.description or base.description,
+                tags=spawn.tags or base.tags)
+        self.host.world_changed()
+        return spawn.name
+
+    def _delete(self, request, response):
+        self._need_world()
+        self.entity(request.entity)
+        self.sim.remove(request.entity)
+        self.info.pop(request.entity, None)
+        self.host.world_changed()
+        response.result = _result()
+
+    def forget(self):
+        """The world was reset or another loaded: what was said about its entities goes."""
+        self.info.clear()
+        self._velocity.clear()
+
+    # -- named poses, spawnables, worlds ------------------------------------------------------
+    def _named_poses(self, request, response):
+        self._need_world()
+        keep = entity_filter('', [], list(request.tags.tags), request.tags.filter_mode,
+                             (codes.Bounds.EMPTY, []))
+        for pose in named_poses(self.sim.description, self.host.robot_name):
+            if keep(Entity(pose.name, EntityCategory.OBJECT, tags=pose.tags), pose.position):
+                msg = si.NamedPose(name=pose.name, description=pose.description,
+                                   tags=list(pose.tags))
+                msg.pose = convert.pose(pose.position, yaw_quaternion(pose.yaw),
+                                        convert.stamp(0.0)).pose
+                response.poses.append(msg)
+        response.result = _result()
+
+    def _named_pose_bounds(self, request, response):
+        raise Refused(Result.FEATURE_UNSUPPORTED, 'named poses have no bounds here: a '
+                      'named pose is a point and a heading')
+
+    def _spawnables(self, request, response):
+        if list(request.sources):
+            raise Refused(Result.FEATURE_UNSUPPORTED, 'spawnables come from the bundled '
+                          'models only (no other sources); any file:// or package:// '
+                          'URDF or TOML can still be spawned')
+        response.spawnables = [si.Spawnable(uri=uri, description=description,
+                                            spawn_bounds=_bounds(*bounds))
+                               for uri, description, bounds in spawnables()]
+        response.result = _result()
+
+    def _worlds(self, request, response):
+        worlds, problems = world_catalogue(list(request.additional_sources))
+        if problems and not request.continue_on_error:
+            raise Refused(Result.OPERATION_FAILED, problems[0])
+        keep = entity_filter('', [], list(request.filter.tags), request.filter.filter_mode,
+                             (codes.Bounds.EMPTY, []))
+        response.worlds = [_world_resource(name, uri, description, tags)
+                           for name, uri, description, tags in worlds
+                           if keep(Entity(name, EntityCategory.OBJECT, tags=tags), ())]
+        response.result = _result(Result.OK, '; '.join(problems)[:2000])
+
+    def _current_world(self, request, response):
+        if self.host.state == codes.SimulationState.NO_WORLD:
+            raise Refused(srv.GetCurrentWorld.Response.NO_WORLD_LOADED, 'no world is loaded')
+        world = self.sim.loaded
+        response.world = _world_resource(world.name, self.host.world_uri, world.description,
+                                         world.tags)
+        response.result = _result()
+
+    def _load_world(self, request, response):
+        code = srv.LoadWorld.Response
+        if self.host.state == codes.SimulationState.LOADING_WORLD:
+            raise Refused(Result.INCORRECT_STATE, 'a world is loading already')
+        try:
+            if request.uri:
+                world, uri = load_world(request.uri, self.host.sound_folders), request.uri
+            elif request.resource_string:
+                world = parse_world(request.resource_string, 'resource_string',
+                                    self.host.sound_folders)
+                uri = ''
+            else:
+                raise Refused(code.NO_RESOURCE, 'give a uri (a bundled world, a file) or a '
+                                                'resource_string (a world file\'s text)')
+        except WorldError as err:
+            unknown = 'unknown world' in str(err) or 'cannot read' in str(err)
+            raise Refused(code.NO_RESOURCE if unknown else code.RESOURCE_PARSE_ERROR,
+                          f'{err} (the current world stays loaded)') from None
+        self.host.load(world, uri)
+        self.forget()
+        response.world = _world_resource(world.name, uri, world.description, world.tags)
+        response.result = _result()
+
+    def _unload_world(self, request, response):
+        if self.host.state == codes.SimulationState.NO_WORLD:
+            raise Refused(srv.UnloadWorld.Response.NO_WORLD_LOADED, 'no world is loaded')
+        self.host.unload()
+        self.forget()
+        response.result = _result()
+
+
+def service_name(kind):
+    """/miro_sim/<the type in snake_case>: where implementers of the standard serve it."""
+    from miro_ball.miro.interface import SimTopics
+    snake = ''.join('_' + c.lower() if c.isupper() else c for c in kind.__name__).lstrip('_')
+    return SimTopics().topic(snake)
+
+
+def _half_height(shape):
+    if shape.kind == 'box':
+        return shape.size[2] / 2
+    return shape.length / 2 if shape.kind == 'cylinder' else shape.radius
+
+
+def _vector(values):
+    x, y, z = (float(v) for v in values)
+    return Vector3(x=x, y=y, z=z)
+
+
+def _values(vector):
+    return (vector.x, vector.y, vector.z)
+
+
+def _pose_tuple(pose):
+    p, q = pose.position, pose.orientation
+    return (p.x, p.y, p.z), (q.x, q.y, q.z, q.w)
+
+
+def _bounds(kind, points):
+    return si.Bounds(type=kind, points=[_vector(p) for p in points])
+
+
+def _world_resource(name, uri, description, tags):
+    return si.WorldResource(name=name, world_resource=si.Resource(uri=uri),
+                            description=description, tags=list(tags))

@@ -1,0 +1,119 @@
+"""The standard's simulate_steps action (/miro_sim/simulate_steps), served beside the node.
+
+rclpy's EventsExecutor, which the simulator spins on, takes no action server in Jazzy (a
+goal sent to one is never answered: tried). So the action lives on a small node of its own,
+/miro_sim_steps, spun by an executor of its own in a thread; it only hands goals over.
+The simulator's own thread does the stepping, as it does for every other request: each
+platform of its timer takes the goal in hand, steps it, sends feedback after every step
+and ends it when done, cancelled, or the simulator is no longer paused.
+"""
+import collections
+import threading
+
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+from simulation_interfaces.action import SimulateSteps
+
+from miro_ball.miro.interface import SimTopics
+from miro_sim_bullet.control.codes import Result
+
+ACTION_NODE = 'miro_sim_steps'
+MAX_STEPS_A_TURN = 500  # steps of a goal per turn of the simulator's timer: it stays lively
+MAX_GOALS = 16  # goals waiting their turn; more are rejected
+
+
+class Goal:
+    """One goal in the simulator's hands: steps left, and the event its server waits on."""
+
+    def __init__(self, handle):
+        self.handle = handle
+        self.left = handle.request.steps
+        self.result = SimulateSteps.Result()
+        self.done = threading.Event()
+
+    def end(self, code=Result.OK, message=''):
+        self.result.result.result, self.result.result.error_message = code, message
+        self.done.set()
+
+
+class StepAction:
+    """The action server for the simulator ``host``: host.step(n) -> (done, message) steps
+    n physics steps while paused. Call serve() from the simulator's thread, often."""
+
+    def __init__(self, host, context):
+        self.host = host
+        self.node = Node(ACTION_NODE, context=context)
+        self.waiting = collections.deque()
+        self.lock = threading.Lock()
+        self.server = ActionServer(
+            self.node, SimulateSteps, SimTopics().topic('simulate_steps'),
+            execute_callback=self._execute, goal_callback=self._accept,
+            cancel_callback=lambda goal: CancelResponse.ACCEPT,
+            callback_group=ReentrantCallbackGroup())
+        self.executor = MultiThreadedExecutor(num_threads=2, context=context)
+        self.executor.add_node(self.node)
+        self.thread = threading.Thread(target=self._spin, name=ACTION_NODE, daemon=True)
+        self.thread.start()
+
+    def _spin(self):
+        try:
+            self.executor.spin()
+        except Exception:  # the context shut down under it: the simulator is ending
+            pass
+
+    def _accept(self, request):
+        with self.lock:
+            return GoalResponse.REJECT if len(self.waiting) >= MAX_GOALS \
+                else GoalResponse.ACCEPT
+
+    def _execute(self, handle):
+        goal = Goal(handle)
+        with self.lock:
+            self.waiting.append(goal)
+        goal.done.wait()
+        if handle.is_cancel_requested:
+            handle.canceled()
+        elif goal.result.result.result == Result.OK:
+            handle.succeed()
+        else:
+            handle.abort()
+        return goal.result
+
+    def serve(self):
+        """In the simulator's thread: step the goal in hand (some of it), feedback after
+        each step; True while a goal is in hand."""
+        with self.lock:
+            if not self.waiting:
+                return False
+            goal = self.waiting[0]
+        handle = goal.handle
+        for _ in range(min(goal.left, MAX_STEPS_A_TURN)):
+            if handle.is_cancel_requested:
+                break
+            done, message = self.host.step(1)
+            if not done:
+                self._finish(goal, Result.OPERATION_FAILED, message)
+                return True
+            goal.left -= 1
+            handle.publish_feedback(SimulateSteps.Feedback(
+                completed_steps=handle.request.steps - goal.left, remaining_steps=goal.left))
+        if handle.is_cancel_requested:
+            self._finish(goal, Result.OK, f'cancelled with {goal.left} steps left')
+        elif goal.left == 0:
+            self._finish(goal, Result.OK)
+        return True
+
+    def _finish(self, goal, code, message=''):
+        with self.lock:
+            self.waiting.popleft()
+        goal.end(code, message)
+
+    def close(self):
+        with self.lock:
+            while self.waiting:
+                self.waiting.popleft().end(Result.OPERATION_FAILED, 'the simulator stopped')
+        self.executor.shutdown(timeout_sec=1.0)
+        self.node.destroy_node()
+        self.thread.join(timeout=1.0)
