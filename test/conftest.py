@@ -39,7 +39,8 @@ TIERS = {
             ('test_closed_loop', 'test_lab', 'test_grade', 'test_launch',
              'test_record', 'test_restart', 'test_scenario_bench',
              'test_signals', 'test_sim_domain', 'test_soak', 'test_tutorial', 'test_grade_class',
-             'test_grade_ray', 'test_refusals', 'test_learn_ros', 'test_learn_ray')),
+             'test_grade_ray', 'test_refusals', 'test_learn_ros', 'test_learn_ray',
+             'test_sim_standard')),
     'browser': ('the GUI in Debian\'s chromium through Playwright', ('test_gui_browser',)),
     'netns': ('hosts in network namespaces (root)', ('test_two_hosts',)),
 }

@@ -81,9 +81,12 @@ class SimWorld:
         self.body_labels = {}
         self.shape_of = {}  # body id -> the world_file Shape (or Ball) it was made from
         if world.ground_height is not None:
-            ground = self._shape(Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
-                                       size=(*world.ground_size, 0.1), colour=world.ground_colour))
+            plane = Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
+                          size=(*world.ground_size, 0.1), colour=world.ground_colour,
+                          source='ground')
+            ground = self._shape(plane)
             self.body_labels[ground] = ('ground', 'static')
+            self.shape_of[ground] = plane
         self.objects = {}  # name -> body id of everything movable but the robots
         self.statics = {}  # name -> body id of the named static shapes
         for shape in world.shapes:

@@ -125,7 +125,7 @@ class SimNode(Node):
                                               step=self.step_count, warn=self.warn,
                                               sound_folders=folders)
             self.scene = SceneInterface(ros, self.sim)
-            self.control = ControlInterface(ros, self, self.warn)
+            self.control = ControlInterface(ros, self, self.warn, self.get_logger().error)
             self.step_action = StepAction(self, self.context)
         # Called after every physics step with the world: an in-process judge sees each
         # contact, however brief.

@@ -13,6 +13,7 @@ through ``host`` (node.SimNode). Every refusal is the standard's result code and
 said as a rate-limited warning too.
 """
 import dataclasses
+import traceback
 
 from geometry_msgs.msg import Vector3
 from simulation_interfaces import msg as si
@@ -61,10 +62,10 @@ class ControlInterface:
     a world's unnamed robot), ``world_folders`` (more worlds to list) and the acts
     act(action) ('play', 'pause', 'stop', 'quit'), step(n) -> (done, message),
     reset(scope), world_changed() and load(world) / unload(). warn(kind, message) is a
-    rate-limited warning."""
+    rate-limited warning, errors(text) logs a failure of ours (with its traceback)."""
 
-    def __init__(self, ros, host, warn):
-        self.host, self._warn = host, warn
+    def __init__(self, ros, host, warn, errors):
+        self.host, self._warn, self._errors = host, warn, errors
         self.info = {}  # entity name -> Entity (set_entity_info's, or its defaults)
         self._velocity = {}  # entity name -> ((t, v, w) at the last platform tick, before)
         handlers = {
@@ -96,13 +97,19 @@ class ControlInterface:
             try:
                 handler(request, response)
             except Refused as refused:
-                self._warn(f'control:{handler.__name__}', f'{handler.__name__[1:]}: {refused}')
-                target = response.result
-                if isinstance(target, si.SpawnResult):  # SpawnEntities: per request
-                    target = target.result
-                target.result, target.error_message = refused.code, str(refused)
+                self._refuse(handler, response, refused)
+            except Exception as err:  # ours, not the client's: answered all the same
+                self._errors(f'{handler.__name__[1:]} failed: {err!r}\n'
+                             f'{traceback.format_exc()}')
+                self._refuse(handler, response, Refused(
+                    Result.OPERATION_FAILED, f'the simulator failed: {err!r} (a bug: '
+                                             'its log has the details)'))
             return response
         return serve
+
+    def _refuse(self, handler, response, refused):
+        self._warn(f'control:{handler.__name__}', f'{handler.__name__[1:]}: {refused}')
+        response.result.result, response.result.error_message = refused.code, str(refused)
 
     # -- the simulation -----------------------------------------------------------------------
     def _features(self, request, response):

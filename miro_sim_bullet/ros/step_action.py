@@ -4,8 +4,9 @@ rclpy's EventsExecutor, which the simulator spins on, takes no action server in 
 goal sent to one is never answered: tried). So the action lives on a small node of its own,
 /miro_sim_steps, spun by an executor of its own in a thread; it only hands goals over.
 The simulator's own thread does the stepping, as it does for every other request: each
-platform of its timer takes the goal in hand, steps it, sends feedback after every step
-and ends it when done, cancelled, or the simulator is no longer paused.
+turn of its timer takes the goal in hand, steps it (up to MAX_STEPS_A_TURN), sends
+feedback after every step, and ends it when done (a turn later), cancelled, or the
+simulator is no longer paused.
 """
 import collections
 import threading
@@ -14,6 +15,7 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
+from rclpy.qos import QoSProfile
 from simulation_interfaces.action import SimulateSteps
 
 from miro_ball.miro.interface import SimTopics
@@ -51,7 +53,10 @@ class StepAction:
             self.node, SimulateSteps, SimTopics().topic('simulate_steps'),
             execute_callback=self._execute, goal_callback=self._accept,
             cancel_callback=lambda goal: CancelResponse.ACCEPT,
-            callback_group=ReentrantCallbackGroup())
+            callback_group=ReentrantCallbackGroup(),
+            # Feedback after every step comes in bursts: a deep queue keeps each one for
+            # a client whose queue is deep too.
+            feedback_pub_qos_profile=QoSProfile(depth=MAX_STEPS_A_TURN))
         self.executor = MultiThreadedExecutor(num_threads=2, context=context)
         self.executor.add_node(self.node)
         self.thread = threading.Thread(target=self._spin, name=ACTION_NODE, daemon=True)
@@ -89,6 +94,9 @@ class StepAction:
                 return False
             goal = self.waiting[0]
         handle = goal.handle
+        if goal.left == 0:  # stepped last turn: the feedback has had its head start
+            self._finish(goal, Result.OK)
+            return True
         for _ in range(min(goal.left, MAX_STEPS_A_TURN)):
             if handle.is_cancel_requested:
                 break
@@ -101,8 +109,8 @@ class StepAction:
                 completed_steps=handle.request.steps - goal.left, remaining_steps=goal.left))
         if handle.is_cancel_requested:
             self._finish(goal, Result.OK, f'cancelled with {goal.left} steps left')
-        elif goal.left == 0:
-            self._finish(goal, Result.OK)
+        # Done, the goal ends at the next turn, not now: a client drops the feedback that
+        # comes after the result, and the result would overtake the last feedback.
         return True
 
     def _finish(self, goal, code, message=''):
