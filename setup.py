@@ -11,13 +11,15 @@ setup(
     # worlds/ is installed as the package miro_sim_bullet.worlds, so installed
     # code finds the bundled worlds with importlib.resources, whatever the prefix.
     package_dir={'miro_sim_bullet.worlds': 'worlds'},
-    package_data={'miro_sim_bullet.worlds': ['*.toml', 'pictures/*.png', 'sounds/*.ogg'],
+    package_data={'miro_sim_bullet.worlds': ['*.toml', 'models/*.toml', 'pictures/*.png',
+                                            'sounds/*.ogg'],
                   'miro_ball.gui': ['static/*', 'static/vendor/three/*'],
                   'miro_ball.learn': ['policies/*/*']},  # the trained policies bundled
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),
         ('share/' + PACKAGE + '/worlds', glob('worlds/*.toml')),
+        ('share/' + PACKAGE + '/worlds/models', glob('worlds/models/*.toml')),
         ('share/' + PACKAGE + '/worlds/pictures', glob('worlds/pictures/*.png')),
         ('share/' + PACKAGE + '/worlds/sounds', glob('worlds/sounds/*.ogg')),
         # The launch files, where ros2 launch miro_ball NAME looks for them.

@@ -50,13 +50,19 @@ from miro_sim_bullet.ros.params import SimParams
 from miro_sim_bullet.ros.robot_interface import RobotInterface
 from miro_sim_bullet.ros.scene import SCENE_RATE_HZ
 from miro_sim_bullet.ros.scene_interface import SceneInterface
-from miro_sim_bullet.ros.sim_control import ControlInterface
 from miro_sim_bullet.ros.sim_interface import SimInterface
-from miro_sim_bullet.ros.step_action import StepAction
 from miro_sim_bullet.ros.tf import TfInterface
 from miro_sim_bullet.scene.sounds import sound_folders
 from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, World, world_uri, \
     WorldError
+
+try:  # simulation_interfaces is built at set-up (python -m miro_ball.build_interfaces)
+    from miro_sim_bullet.ros.sim_control import ControlInterface
+    from miro_sim_bullet.ros.step_action import StepAction
+except ModuleNotFoundError as missing:
+    if missing.name != 'simulation_interfaces':
+        raise
+    ControlInterface = StepAction = None
 
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 TYPE_CHECK_PERIOD_S = 1.0  # wall seconds between looks for control publishers of a wrong type
@@ -125,8 +131,9 @@ class SimNode(Node):
                                               step=self.step_count, warn=self.warn,
                                               sound_folders=folders)
             self.scene = SceneInterface(ros, self.sim)
-            self.control = ControlInterface(ros, self, self.warn, self.get_logger().error)
-            self.step_action = StepAction(self, self.context)
+            if ControlInterface is not None:
+                self.control = ControlInterface(ros, self, self.warn, self.get_logger().error)
+                self.step_action = StepAction(self, self.context)
         # Called after every physics step with the world: an in-process judge sees each
         # contact, however brief.
         self.step_observers = []
@@ -139,6 +146,9 @@ class SimNode(Node):
         missing = [(row.name, row.type) for row in next(iter(self.robots.values())).missing_types]
         if self.tf is None:
             missing.append((f'{TF} and {TF_STATIC}', TF_TYPE))
+        if privileged and ControlInterface is None:
+            missing.append(('the standard control services (get_entities, spawn_entity, ...)',
+                            'simulation_interfaces'))
         for name, type_name in missing:
             self.get_logger().warning(
                 f'{name} not published: its type {type_name} is not installed (build it: '
@@ -433,7 +443,8 @@ class SimNode(Node):
             self.tf.publish(when)
         if platform_tick and self.sim_interface is not None:
             self.sim_interface.publish_ground_truth(when)
-            self.control.tick()
+            if self.control is not None:
+                self.control.tick()
 
     def _submit_eyes(self, overlap):
         """Ask for every eye someone subscribes to, of every robot, drawn together."""
