@@ -225,4 +225,5 @@ def test_worlds_are_listed_and_loaded_and_quitting_ends_the_simulator(sim):
     while proc.poll() is None and time.monotonic() < deadline:
         client.executor.spin_once(timeout_sec=0.1)
     assert proc.returncode == 0
-    assert 'Traceback' not in proc.stdout.read()
+    log = proc.stdout.read()
+    assert 'Traceback' not in log and 'FATAL' not in log and 'quitting, as asked' in log

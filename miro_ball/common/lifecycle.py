@@ -101,6 +101,9 @@ def run_node(prog, make_node, argv=None, *, make_executor=None, on_stop=None,
     except BaseException:
         rclpy.try_shutdown()
         raise
+    # The node's own way to end its program as Ctrl+C would, quietly (the simulator asked
+    # to quit through the standard's set_simulation_state).
+    node.request_stop = stop.request
     executor = (make_executor or SingleThreadedExecutor)()
     executor.add_node(node)
     code = 0

@@ -250,11 +250,13 @@ class SimNode(Node):
         return SimulationState.PLAYING
 
     def act(self, action):
-        """'play', 'pause', 'stop' (reset and pause) or 'quit' (the node ends at its next
-        turn, as a program: exit code 0)."""
+        """'play', 'pause', 'stop' (reset and pause) or 'quit' (a program ends as on Ctrl+C,
+        exit code 0; in-process, the spin ends with SystemExit(0) at the next turn)."""
         if action == 'quit':
             self.quitting = True
             self.get_logger().info('quitting, as asked')
+            if hasattr(self, 'request_stop'):  # run as a program (lifecycle.run_node)
+                self.request_stop()
             return
         if action == 'stop':
             self.reset(0)
