@@ -2,16 +2,17 @@
 for which page, and its deadman."""
 import dataclasses
 import json
-import math
 import time
 
 import pytest
-from geometry_msgs.msg import PoseStamped, TransformStamped, TwistStamped
+from geometry_msgs.msg import TransformStamped, TwistStamped
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import ParameterType, ParameterValue, SetParametersResult
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, JointState
+from simulation_interfaces.srv import (ResetSimulation, SetEntityState, SetSimulationState,
+                                       StepSimulation)
 from std_msgs.msg import (Float32MultiArray, String, UInt16, UInt16MultiArray, UInt32,
                           UInt32MultiArray)
 from tf2_msgs.msg import TFMessage
@@ -79,11 +80,11 @@ def test_every_control_reaches_its_topic_and_nothing_else_is_published(
         (TwistStamped, T.cmd_vel), (JointState, T.kinematic_targets),
         (Float32MultiArray, T.cosmetic_joints), (UInt32MultiArray, T.illum),
         (UInt16MultiArray, T.tone), (UInt32, T.control_flags),
-        (PoseStamped, SIM.set_pose), (UInt16, SIM.touch(T.name, 'head')))}
+        (UInt16, SIM.touch(T.name, 'head')))}
     commands = [p.Head((0.0, 0.5, 0.1, 0.0)), p.Cosmetic((0.0, 1.0, 0.5, 0.5, 0.2, 0.2)),
                 p.Illum((1, 2, 3, 4, 5, 6)), p.Tone((440, 100, 50)),
                 p.Flags(DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX), p.Drive(0.1, 0.0),
-                p.Place(BALL_NAME, 0.5, -0.25), p.Touch('head', 0.1, 0.0)]
+                p.Touch('head', 0.1, 0.0)]
     for command in commands:  # publishers are made on first use: let them match first
         bridge.submit(command, owner=1)
     assert spin_until(executor, lambda: all(got.values()))
@@ -94,13 +95,6 @@ def test_every_control_reaches_its_topic_and_nothing_else_is_published(
     assert got[T.control_flags][-1].data == DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX
     assert list(got[T.tone][-1].data) == [440, 100, 50]
     assert got[T.cmd_vel][-1].twist.linear.x == pytest.approx(0.1)
-    # A drag keeps the object's height and orientation: NaN and all zeros say so.
-    place = got[SIM.set_pose][-1]
-    assert place.header.frame_id == BALL_NAME
-    assert (place.pose.position.x, place.pose.position.y) == (0.5, -0.25)
-    assert math.isnan(place.pose.position.z)
-    o = place.pose.orientation
-    assert (o.x, o.y, o.z, o.w) == (0.0, 0.0, 0.0, 0.0)
     assert got[SIM.touch(T.name, 'head')][-1].data == pads_at(0.1, 0.0)
     # The robot part, in the robot's namespace, publishes on MiRo's topics; the bridge
     # only on the simulator's inputs.
@@ -108,7 +102,40 @@ def test_every_control_reaches_its_topic_and_nothing_else_is_published(
         NODE_NAME, '/' + T.name)}
     assert published - ROS_OWN == {t for t in got if t.startswith(f'/{T.name}/')}
     assert {name for name, _ in bridge.get_publisher_names_and_types_by_node(
-        NODE_NAME, '/')} - ROS_OWN == {SIM.set_pose, SIM.touch(T.name, 'head')}
+        NODE_NAME, '/')} - ROS_OWN == {SIM.touch(T.name, 'head')}
+
+
+def test_the_pages_pause_step_drag_reset_and_resume_the_simulator_by_the_standard(
+        bridge, make_sim, executor, events):
+    """Through simulation_interfaces' services only; every answer reaches the status line."""
+    sim = make_sim(paused=False, step_count=7)
+    opened(bridge, executor)
+    ready = [bridge.sim.clients[kind] for kind in (SetSimulationState, StepSimulation,
+                                                   ResetSimulation, SetEntityState)]
+    assert spin_until(executor, lambda: all(c.service_is_ready() for c in ready))
+
+    def status(words):
+        return spin_until(executor, lambda: json.loads(bridge.state(1))['status'] == words)
+    bridge.submit(p.SimAction('pause'), owner=1)
+    assert status('pause: done') and sim.paused and json.loads(bridge.state(1))['sim']['paused']
+    before = sim.sim.step_index
+    bridge.submit(p.SimAction('step'), owner=1)  # the simulator's own step_count
+    assert status('step: 7 physics steps') and sim.sim.step_index == before + 7
+    ball, robot = sim.sim.ball_position(), sim.sim.robot.pose()
+    bridge.submit(p.Place(BALL_NAME, 0.5, -0.25), owner=1)
+    bridge.submit(p.Place(T.name, -0.3, 0.2), owner=1)
+    # Each keeps its height (the robot its floor) and its orientation.
+    assert spin_until(executor, lambda: sim.sim.robot.pose()[:2] == pytest.approx((-0.3, 0.2)))
+    assert sim.sim.ball_position() == pytest.approx((0.5, -0.25, ball[2]), abs=1e-6)
+    assert sim.sim.robot.pose()[2:] == pytest.approx(robot[2:], abs=1e-6)
+    bridge.submit(p.Place('nothing_here', 0.0, 0.0), owner=1)
+    assert spin_until(executor, lambda: 'place refused' in json.loads(bridge.state(1))['status'])
+    assert "'nothing_here'" in json.loads(bridge.state(1))['status']
+    bridge.submit(p.SimAction('reset'), owner=1)
+    assert status('reset: done') and sim.sim.time == 0.0
+    assert sim.sim.ball_position() == pytest.approx(ball, abs=1e-3)
+    bridge.submit(p.SimAction('resume'), owner=1)
+    assert status('resume: done') and not sim.paused
 
 
 def test_a_drive_that_is_not_renewed_stops_and_another_page_cannot_stop_it(
@@ -284,7 +311,7 @@ def test_the_real_time_factor_is_set_on_the_simulator_and_read_back(
         return response
 
     def get_parameters(request, response):
-        assert request.names == ['real_time_factor', 'paused']
+        assert request.names == ['real_time_factor', 'paused', 'step_count']
         response.values = [ParameterValue(type=ParameterType.PARAMETER_DOUBLE,
                                           double_value=1.0),
                            ParameterValue(type=ParameterType.PARAMETER_BOOL, bool_value=True)]

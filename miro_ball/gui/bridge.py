@@ -16,7 +16,8 @@ methods marked so. Commands from the pages go into a queue that a guard conditio
 in the ROS thread at once, so they never wait behind images.
 
 It publishes only MiRo's control topics (from the robot parts) and the simulator's
-set_pose and touch inputs, and calls only the simulator's services.
+touch and sound inputs, and calls only the simulator's services (the standard
+simulation_interfaces', and its parameters).
 """
 import collections
 import json

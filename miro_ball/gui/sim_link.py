@@ -1,18 +1,20 @@
-"""The GUI's link to the simulator: its services (reset, step, pause, its real-time factor),
-its inputs (set_pose, the touch pads) and its clock (the time and speed the pages show).
+"""The GUI's link to the simulator: its services (reset, step, pause, a drag's move: the
+standard simulation_interfaces; its real-time factor), its inputs (the touch pads, sounds)
+and its clock (the time and speed the pages show).
 
 Only the simulator's own services and inputs are used; a simulator that is not there is
-said so in the status line, never waited for.
+said so in the status line, never waited for: every call is answered in a callback.
 """
-import math
 import time
 
-from geometry_msgs.msg import PoseStamped
+from geometry_msgs.msg import Accel, Twist
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rosgraph_msgs.msg import Clock
+from simulation_interfaces.msg import Result, SimulationState
+from simulation_interfaces.srv import (GetEntityState, GetSimulationState, ResetSimulation,
+                                       SetEntityState, SetSimulationState, StepSimulation)
 from std_msgs.msg import String, UInt16
-from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.common.clock_watch import clock_publishers, ClockWatch, shared_domain_line
 from miro_ball.common.qos import profile
@@ -22,6 +24,7 @@ from miro_ball.miro.interface import CLOCK, CONTROL_QOS, SimTopics
 
 RTF_PARAMETER = 'real_time_factor'
 PAUSED_PARAMETER = 'paused'
+STEP_COUNT_PARAMETER = 'step_count'  # physics steps the simulator's own step button takes
 GUI_SOUND_DB = -30.0  # a sound placed from the page: its RMS 1 m away, dB of full scale
 RTF_WINDOW_S = 2.0  # the real-time factor shown is measured over this much wall time
 
@@ -41,19 +44,21 @@ class SimLink:
         self.paused = None  # known only when paused or resumed from here
         self.started_paused = None  # the paused parameter, read with the real-time factor
         self.rtf_set = None  # the simulator's real_time_factor as last set or read
+        self.step_count = None  # the simulator's step_count, read with the real-time factor
         self._rtf_asked = False
+        self._after_read = []  # what waits for the parameters being read
         self._clock_samples = []  # (wall, sim) of the last RTF_WINDOW_S of /clock
         self._clock_watch = ClockWatch(node)
         self._pubs = {}
         self._sounds = 0  # placed from the pages so far (their names' numbers)
         node.create_subscription(Clock, CLOCK, self._on_clock, 10)
-        self.clients = {'reset': node.create_client(Trigger, self.topics.reset),
-                        'step': node.create_client(Trigger, self.topics.step),
-                        'pause': node.create_client(SetBool, self.topics.pause),
-                        'set_parameters': node.create_client(
+        self.clients = {kind: node.create_client(kind, self.topics.standard(kind)) for kind in (
+            GetSimulationState, SetSimulationState, StepSimulation, ResetSimulation,
+            GetEntityState, SetEntityState)}
+        self.clients.update({'set_parameters': node.create_client(
                             SetParameters, self.topics.topic('set_parameters')),
                         'get_parameters': node.create_client(
-                            GetParameters, self.topics.topic('get_parameters'))}
+                            GetParameters, self.topics.topic('get_parameters'))})
 
     def state(self):
         """What the pages show of the simulator; and the status line if two simulators'
@@ -69,7 +74,8 @@ class SimLink:
             paused = rtf == 0.0
         else:
             paused = bool(self.started_paused)
-        sim = {'present': self.clients['reset'].service_is_ready(), 'time': self.time,
+        sim = {'present': self.clients[GetSimulationState].service_is_ready(),
+               'time': self.time,
                'rtf': rtf, 'paused': paused}
         status = (shared_domain_line(clock_publishers(self.node),
                                      self.node.context.get_domain_id())
@@ -78,16 +84,18 @@ class SimLink:
 
     # -- inputs ---------------------------------------------------------------------------------
     def place(self, name, x, y):
-        """Move an object (or a robot) to x, y; its height and orientation stay its own
-        (height NaN, orientation all zeros say so to the simulator)."""
-        msg = PoseStamped()
-        msg.header.stamp = self.node.get_clock().now().to_msg()
-        msg.header.frame_id = name
-        msg.pose.position.x, msg.pose.position.y = x, y
-        msg.pose.position.z = math.nan
-        o = msg.pose.orientation
-        o.x = o.y = o.z = o.w = 0.0
-        self._publisher(PoseStamped, self.topics.set_pose).publish(msg)
+        """Move an object (or a robot) to x, y, at rest: its state is asked for first, so
+        that its height (a robot's floor) and orientation stay its own."""
+        if not self._ready('place', GetEntityState, SetEntityState):
+            return
+
+        def got(response):
+            state = response.state
+            state.pose.position.x, state.pose.position.y = x, y
+            state.twist, state.acceleration = Twist(), Accel()  # dropped where it is put
+            self._call('place', SetEntityState,
+                       SetEntityState.Request(entity=name, state=state), lambda _: None)
+        self._call('place', GetEntityState, GetEntityState.Request(entity=name), got)
 
     def play_sound(self, kind, x, y):
         """A sound of ``kind`` (protocol.SOUND_KINDS) on the floor at x, y, named by the
@@ -113,25 +121,56 @@ class SimLink:
     # -- services -------------------------------------------------------------------------------
     def call(self, action):
         """pause, resume, step or reset; the answer goes to the status line."""
-        name = 'pause' if action in ('pause', 'resume') else action
-        client = self.clients[name]
-        if not client.service_is_ready():
-            self.report(f'{action}: no simulator')
+        if action == 'step' and self.step_count is None:
+            # How far the simulator's step goes is its own parameter: asked for first.
+            if self._ready(action, StepSimulation, 'get_parameters'):
+                self._read_parameters(lambda: self.call(action) if self.step_count is not None
+                                      else self.report('step: the simulator did not say its '
+                                                       'step_count'))
             return
-        request = client.srv_type.Request()
-        if name == 'pause':
-            request.data = action == 'pause'
+        if action == 'reset':
+            kind, fields = ResetSimulation, {'scope': ResetSimulation.Request.SCOPE_DEFAULT}
+        elif action == 'step':
+            kind, fields = StepSimulation, {'steps': self.step_count}
+        else:
+            kind, fields = SetSimulationState, {'state': SimulationState(
+                state=SimulationState.STATE_PAUSED if action == 'pause'
+                else SimulationState.STATE_PLAYING)}
+        if not self._ready(action, kind):
+            return
 
+        def done(response):
+            if kind is SetSimulationState:
+                self.paused = action == 'pause'
+            said = f'{fields["steps"]} physics steps' if action == 'step' else 'done'
+            self.report(f'{action}: {said}')
+            self.said(action, f'simulator {action}: {said}')
+        self._call(action, kind, kind.Request(**fields), done)
+
+    def _ready(self, what, *kinds):
+        """Whether the simulator serves each of ``kinds``; if not, the status line says so."""
+        if all(self.clients[kind].service_is_ready() for kind in kinds):
+            return True
+        self.report(f'{what}: no simulator')
+        return False
+
+    def _call(self, what, kind, request, then):
+        """Call the standard's service ``kind``; then(response) once it succeeded (or was
+        already so); the status line says why not."""
         def done(future):
-            result = future.result()
-            if result is None:
-                self.report(f'{action}: no answer')
+            response = future.result()
+            if response is None:
+                self.report(f'{what}: no answer')
                 return
-            if name == 'pause' and result.success:
-                self.paused = request.data
-            self.report(f'{action}: {result.message}')
-            self.said(action, f'simulator {action}: {result.message}')
-        client.call_async(request).add_done_callback(done)
+            result = response.result
+            if result.result in (Result.RESULT_OK,
+                                 SetSimulationState.Response.ALREADY_IN_TARGET_STATE):
+                then(response)
+                return
+            self.report(f'{what} refused: {result.error_message}')
+            self.warn(f'refused:{what}', f'the simulator refused {what}: '
+                                         f'{result.error_message}')
+        self.clients[kind].call_async(request).add_done_callback(done)
 
     def set_rtf(self, value):
         client = self.clients['set_parameters']
@@ -156,10 +195,16 @@ class SimLink:
         client.call_async(request).add_done_callback(done)
 
     def read_rtf(self):
-        """Ask for the simulator's real_time_factor (and whether it is paused) unless known
-        or being asked."""
-        client = self.clients['get_parameters']
-        if self.rtf_set is not None or self._rtf_asked or not client.service_is_ready():
+        """Ask for the simulator's real_time_factor (and whether it is paused, and its
+        step_count) unless known or being asked."""
+        if self.rtf_set is None and self.clients['get_parameters'].service_is_ready():
+            self._read_parameters()
+
+    def _read_parameters(self, then=None):
+        """One request at a time for the parameters read_rtf says; then() after its answer."""
+        if then is not None:
+            self._after_read.append(then)
+        if self._rtf_asked:
             return
         self._rtf_asked = True
 
@@ -171,7 +216,13 @@ class SimLink:
                 self.rtf_set = values[0].double_value
             if len(values) > 1 and values[1].type == ParameterType.PARAMETER_BOOL:
                 self.started_paused = values[1].bool_value
-        client.call_async(GetParameters.Request(names=[RTF_PARAMETER, PAUSED_PARAMETER])) \
+            if len(values) > 2 and values[2].type == ParameterType.PARAMETER_INTEGER:
+                self.step_count = values[2].integer_value
+            waiting, self._after_read = self._after_read, []
+            for then in waiting:
+                then()
+        self.clients['get_parameters'].call_async(GetParameters.Request(
+            names=[RTF_PARAMETER, PAUSED_PARAMETER, STEP_COUNT_PARAMETER])) \
             .add_done_callback(done)
 
     # -- the clock ------------------------------------------------------------------------------
@@ -182,7 +233,8 @@ class SimLink:
             self._clock_watch.went_back()
             self._clock_samples.clear()  # a reset, or a new simulator
             self.paused = None
-            self.rtf_set = None  # a new simulator may run at another speed: read it again
+            # A new simulator may run at another speed, or step farther: read them again.
+            self.rtf_set = self.step_count = None
         self.time = sim
         self._clock_samples.append((now, sim))
         while self._clock_samples and now - self._clock_samples[0][0] > RTF_WINDOW_S:

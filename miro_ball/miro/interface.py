@@ -322,6 +322,14 @@ class SimTopics:
     def topic(self, relative):
         return f'/{self.node}/{relative}'
 
+    def standard(self, kind):
+        """Where a service of the standard simulation_interfaces is served: the type (or its
+        name, as 'SetEntityState') in snake_case under the node, /miro_sim/set_entity_state.
+        The one rule for those names; every tool of ours reaches the simulator this way."""
+        name = getattr(kind, '__name__', kind)
+        return self.topic(''.join('_' + c.lower() if c.isupper() else c
+                                  for c in name).lstrip('_'))
+
     @property
     def ball(self):
         """geometry_msgs/PointStamped: the ball's centre (kept for the first clients)."""
@@ -351,7 +359,8 @@ class SimTopics:
 
     @property
     def set_pose(self):
-        """geometry_msgs/PoseStamped in: move the object or robot named in header.frame_id."""
+        """geometry_msgs/PoseStamped in: move the object or robot named in header.frame_id.
+        An alias kept for old scripts: the standard's is standard('SetEntityState')."""
         return self.topic('set_pose')
 
     @property
@@ -371,12 +380,18 @@ class SimTopics:
 
     @property
     def reset(self):
+        """std_srvs/Trigger: the world as loaded. An alias kept for old scripts: the
+        standard's is standard('ResetSimulation')."""
         return self.topic('reset')
 
     @property
     def pause(self):
+        """std_srvs/SetBool: pause (true) or run. An alias kept for old scripts: the
+        standard's is standard('SetSimulationState')."""
         return self.topic('pause')
 
     @property
     def step(self):
+        """std_srvs/Trigger: the simulator's step_count physics steps, while paused. An
+        alias kept for old scripts: the standard's is standard('StepSimulation')."""
         return self.topic('step')
