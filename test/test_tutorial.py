@@ -1,6 +1,6 @@
-"""docs/tutorial.md runs as written, so it cannot rot.
+"""docs/tutorial.md and docs/sim_control.md run as written, so they cannot rot.
 
-The tutorial marks what the test runs, in the fence's info string:
+A page marks what the test runs, in the fence's info string:
 
     ```sh run              a command the reader types and waits for: must exit 0
     ```sh shell1           a command left running in a shell of its own (shell1, shell2,
@@ -27,10 +27,13 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 
 from miro_ball.common.isolation import isolated_env
 
-TUTORIAL = Path(__file__).resolve().parent.parent / 'docs' / 'tutorial.md'
+DOCS = Path(__file__).resolve().parent.parent / 'docs'
+TUTORIAL = DOCS / 'tutorial.md'
+PAGES = (TUTORIAL, DOCS / 'sim_control.md')  # the pages that run
 FENCE = re.compile(r'^```(?P<info>[^\n]*)\n(?P<body>.*?)^```\s*$', re.M | re.S)
 CTRL_C = re.compile(r'^<!--\s*test:\s*ctrl-c\s+(?P<shells>[\w ]+?)\s*-->\s*$', re.M)
 WAIT = re.compile(r'^<!--\s*test:\s*wait\s+(?P<shell>shell\d+)\s+(?P<text>.+?)\s*-->\s*$', re.M)
@@ -152,11 +155,12 @@ def test_the_page_has_steps_of_every_kind():
     assert kinds == {'run', 'python', 'file', 'background', 'ctrl-c', 'wait'}
 
 
-def test_the_tutorial_runs_as_written(tmp_path):
+@pytest.mark.parametrize('page', PAGES, ids=[page.stem for page in PAGES])
+def test_the_page_runs_as_written(page, tmp_path):
     reader = Reader(tmp_path)
     started = time.monotonic()
     try:
-        for kind, argument, body in steps(TUTORIAL.read_text()):
+        for kind, argument, body in steps(page.read_text()):
             if kind == 'run':
                 reader.run(['bash', '-e', '-c', body], body.strip())
             elif kind == 'python':
@@ -177,4 +181,4 @@ def test_the_tutorial_runs_as_written(tmp_path):
             reader.ctrl_c(shell)
     finally:
         reader.close()
-    print(f'tutorial ran in {time.monotonic() - started:.0f} s')
+    print(f'{page.name} ran in {time.monotonic() - started:.0f} s')
