@@ -1,7 +1,8 @@
 """The layering rules, in one place: who may import whom.
 
 - The simulator loads no controller, GUI, example or lab code (nodes talk only over ROS).
-- MiRo's own library (miro_ball.miro) imports neither rclpy nor PyBullet.
+- MiRo's own library (miro_ball.miro), demo mode's parts and the simulator's control logic
+  (miro_sim_bullet.control) import neither rclpy nor PyBullet.
 - No import cycles between our modules, counting imports inside functions too (a cycle
   hidden in a function is still a cycle).
 """
@@ -105,6 +106,15 @@ def test_demo_modes_parts_need_neither_ros_nor_pybullet():
     assert 'miro_ball.animal.animal' in parts
     loaded = loaded_by(', '.join(parts))
     assert not {m.split('.')[0] for m in loaded} & {'rclpy', 'pybullet'}
+
+
+def test_the_simulators_control_logic_needs_neither_ros_nor_pybullet():
+    # What a request to the standard services means (filters, spawn requests, the state
+    # table, poses) is decided in plain Python, tested alone; sim_control is its ROS side.
+    logic = sorted(m for m in our_modules() if m.startswith('miro_sim_bullet.control.'))
+    assert 'miro_sim_bullet.control.spawning' in logic
+    loaded = loaded_by(', '.join(logic))
+    assert not {m.split('.')[0] for m in loaded} & {'rclpy', 'pybullet', 'simulation_interfaces'}
 
 
 def test_the_learning_environments_need_no_ros_and_nothing_else_needs_gymnasium():
