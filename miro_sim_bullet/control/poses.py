@@ -12,6 +12,9 @@ from miro_sim_bullet.control.codes import Refused, SpawnResult
 from miro_sim_bullet.scene.world_file import MAX_MAGNITUDE
 
 WORLD_FRAMES = ('', WORLD_FRAME, '/' + WORLD_FRAME)
+# A body set moving faster than this crosses a metre in one 2 ms physics step or more and
+# passes through walls; nothing in a MiRo world moves at even a tenth of it.
+MAX_SPEED = 500.0
 
 
 def check_pose(position, orientation, code=SpawnResult.INVALID_POSE):
@@ -23,11 +26,23 @@ def check_pose(position, orientation, code=SpawnResult.INVALID_POSE):
     if any(abs(v) > MAX_MAGNITUDE for v in position):
         raise Refused(code, f'the position {_show(position)} is more than '
                             f'{MAX_MAGNITUDE:g} m from the origin')
-    norm = math.sqrt(sum(q * q for q in orientation))
+    norm = math.hypot(*orientation)  # a sum of squares overflows: 1e308 made a zero rotation
     if norm < 1e-6:
         raise Refused(code, f'the orientation {_show(orientation)} is no rotation (a zero '
                             'quaternion: give w = 1 for none)')
     return tuple(position), tuple(q / norm for q in orientation)
+
+
+def check_twist(linear, angular, code):
+    """The twist as given; Refused(code) when a number is not finite or a speed is beyond
+    MAX_SPEED (m/s, rad/s): a NaN velocity made every body of the world NaN a step later."""
+    values = (*linear, *angular)
+    if not all(math.isfinite(v) for v in values):
+        raise Refused(code, f'the twist {_show(values)} has a number that is not finite')
+    if math.hypot(*linear) > MAX_SPEED or math.hypot(*angular) > MAX_SPEED:
+        raise Refused(code, f'the twist {_show(values)} is faster than {MAX_SPEED:g} m/s or '
+                            'rad/s')
+    return tuple(linear), tuple(angular)
 
 
 def in_world(frame, pose):

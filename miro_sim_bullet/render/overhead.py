@@ -25,7 +25,7 @@ def _footprints(world):
 
 def overhead_camera(world):
     """(position, rotation, intrinsics) of a square view that holds the whole world."""
-    spots = list(_footprints(world))
+    spots = list(_footprints(world)) or [(0.0, 0.0, 1.0)]  # no world (unloaded): the origin
     x0 = min(x - r for x, _, r in spots)
     x1 = max(x + r for x, _, r in spots)
     y0 = min(y - r for _, y, r in spots)

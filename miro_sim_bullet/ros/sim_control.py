@@ -24,7 +24,7 @@ from miro_ball.miro.rotations import yaw_of, yaw_quaternion
 from miro_sim_bullet.control import codes
 from miro_sim_bullet.control.codes import EntityCategory, Refused, Result
 from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter
-from miro_sim_bullet.control.poses import check_pose, in_world, WORLD_FRAMES
+from miro_sim_bullet.control.poses import check_pose, check_twist, in_world, WORLD_FRAMES
 from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, RobotSpawn,
                                               SPAWN_FORMATS, spawnables)
 from miro_sim_bullet.control.states import transition
@@ -33,6 +33,11 @@ from miro_sim_bullet.scene.world_file import (Ball, named_poses, parse_world, wo
                                               WorldError, load_world)
 
 MAX_SPAWNS = 64  # entities one SpawnEntities request may ask for
+# A StepSimulation answers when its steps are done, and the simulator does nothing else
+# meanwhile: 10 s of simulated time took 0.4 s with one robot, 20 s with 16 (2 cores,
+# 2026-11-26). 2**64-1 steps froze it for good. The action steps in turns, and cancels.
+MAX_STEP_SECONDS = 10.0
+RESET_ALL = srv.ResetSimulation.Request.SCOPE_ALL
 _F = si.SimulatorFeatures
 FEATURES = (
     _F.SPAWNING, _F.DELETING, _F.NAMED_POSES, _F.ENTITY_TAGS, _F.ENTITY_BOUNDS,
@@ -127,6 +132,11 @@ class ControlInterface:
 
     def _step(self, request, response):
         self._need_world()
+        most = round(MAX_STEP_SECONDS / self.sim.dt)
+        if not 1 <= request.steps <= most:
+            raise Refused(Result.OPERATION_FAILED,
+                          f'{request.steps} steps: step_simulation takes 1 to {most} '
+                          f'({MAX_STEP_SECONDS:g} s); the simulate_steps action takes more')
         done, message = self.host.step(request.steps)
         if not done:
             raise Refused(Result.OPERATION_FAILED, message)
@@ -135,8 +145,10 @@ class ControlInterface:
     def _reset(self, request, response):
         self._need_world()
         scope = request.scope
-        if scope & ~0xFF:
-            raise Refused(Result.OPERATION_FAILED, f'no reset scope {scope}')
+        if scope & ~0b111 and scope != RESET_ALL:  # 8 read as 0 was a whole reset
+            raise Refused(Result.OPERATION_FAILED, f'no reset scope {scope}: 0 or 255 (all), '
+                                                   'or a sum of 1 (time), 2 (state), '
+                                                   '4 (spawned)')
         self.host.reset(scope)
         response.result = _result()
 
@@ -147,7 +159,9 @@ class ControlInterface:
 
     # -- entities -----------------------------------------------------------------------------
     def entity(self, name):
-        """The Entity ``name`` is (its info), or Refused NOT_FOUND."""
+        """The Entity ``name`` is (its info), or Refused NOT_FOUND (INCORRECT_STATE with
+        no world)."""
+        self._need_world()
         bodies = self.sim.entities()
         if name not in bodies:
             shown = ', '.join(sorted(bodies)[:12]) + (', ...' if len(bodies) > 12 else '')
@@ -177,6 +191,7 @@ class ControlInterface:
         return sim.body_state(sim.entities()[name])[:2]
 
     def _filtered(self, filters):
+        self._need_world()
         keep = entity_filter(filters.filter, [c.category for c in filters.categories],
                              list(filters.tags.tags), filters.tags.filter_mode,
                              (filters.bounds.type,
@@ -226,15 +241,23 @@ class ControlInterface:
     def _set_entity_state(self, request, response):
         entity = self.entity(request.entity)
         state = request.state
-        pose = check_pose(*_pose_tuple(state.pose), code=srv.SetEntityState.Response.INVALID_POSE)
-        position, orientation = in_world(self._frame(state.header.frame_id), pose)
+        invalid = srv.SetEntityState.Response.INVALID_POSE
+        position, orientation = self._world_pose(state.header.frame_id, state.pose, invalid)
+        linear, angular = check_twist(_values(state.twist.linear), _values(state.twist.angular),
+                                      invalid)
         if entity.category == EntityCategory.STATIC_OBJECT:
             raise Refused(Result.OPERATION_FAILED, f'{entity.name} is static: it does not move')
         self.sim.set_object_pose(entity.name, position, orientation)
         if entity.name not in self.sim.robots:  # a robot's wheels say how it moves
-            self.sim.set_body_velocity(self.sim.entities()[entity.name],
-                                       _values(state.twist.linear), _values(state.twist.angular))
+            self.sim.set_body_velocity(self.sim.entities()[entity.name], linear, angular)
         response.result = _result()
+
+    def _world_pose(self, frame_id, pose, code):
+        """A request's pose in frame ``frame_id``, checked (check_pose), in the world frame:
+        checked again there (an entity's frame may carry it out of bounds)."""
+        frame = self._frame(frame_id)
+        return check_pose(*in_world(frame, check_pose(*_pose_tuple(pose), code=code)),
+                          code=code)
 
     def _frame(self, frame_id):
         """The world pose of a request's frame: the world, or an entity's."""
@@ -297,11 +320,13 @@ class ControlInterface:
         self._need_world()
         resource = resource or request
         sim = self.sim
+        # Every name get_entities lists is taken: 'wall_3' (a world's unnamed wall) too.
         spawn = parse_spawn(request.name, request.allow_renaming, resource.uri,
-                            resource.resource_string, request.entity_namespace, sim.names())
-        pose = check_pose(*_pose_tuple(request.initial_pose.pose))
-        (x, y, z), orientation = in_world(self._frame(request.initial_pose.header.frame_id),
-                                          pose)
+                            resource.resource_string, request.entity_namespace,
+                            sim.names() | set(sim.entities()))
+        (x, y, z), orientation = self._world_pose(request.initial_pose.header.frame_id,
+                                                  request.initial_pose.pose,
+                                                  codes.SpawnResult.INVALID_POSE)
         try:
             if isinstance(spawn, RobotSpawn):
                 sim.spawn_robot(spawn.name, x, y, yaw_of(*orientation), floor=z)

@@ -64,6 +64,7 @@ MAX_TAGS = 32
 MAX_TAG_LENGTH = 64
 MAX_POSES = 100
 MAX_CATALOGUE = 1000  # world files listed from one folder
+MAX_NAME = 255  # characters of a file's name (Linux's NAME_MAX)
 START_SUFFIX = '_start'  # of the poses named_poses() makes: a declared pose cannot end so
 ENTITY_KINDS = ('ball', 'box', 'sphere', 'cylinder')  # what load_entity() builds
 # A bundled world's or model's URI; file:// URIs and paths name a user's files.
@@ -291,11 +292,12 @@ def world_catalogue(folders=()):
 
     for name in bundled_worlds():
         read(name, world_uri(name), name)
-    for folder in folders:
+    for folder in dict.fromkeys(folders):  # each once: a request may name one 10,000 times
         try:
             files = sorted(p for p in Path(folder).iterdir() if p.suffix == '.toml')
-        except OSError as err:
-            problems.append(f'{folder}: cannot list world files: {err.strerror or err}')
+        except (OSError, ValueError) as err:  # ValueError: a NUL in the name
+            problems.append(f'{_show(folder)}: cannot list world files: '
+                            f'{getattr(err, "strerror", None) or err}')
             continue
         if len(files) > MAX_CATALOGUE:
             problems.append(f'{folder}: more than {MAX_CATALOGUE} world files; '
@@ -356,13 +358,20 @@ def _read(name):
         name = name[len('file://'):]
     path = Path(name)
     if path.suffix == '.toml' or path.parent != Path('.'):
+        shown = _show(str(path))
         try:
-            with path.open('rb') as file:
-                return file.read(MAX_FILE_BYTES + 1), str(path), path.parent
+            # A FIFO would block the simulator until someone writes to it; a device never ends.
+            regular = path.is_file() or not path.exists()
+            if regular:
+                with path.open('rb') as file:
+                    return file.read(MAX_FILE_BYTES + 1), str(path), path.parent
         except OSError as err:
-            raise WorldError(f'{path}: cannot read world file: {err.strerror or err}') from None
+            raise WorldError(f'{shown}: cannot read world file: {err.strerror or err}') from None
+        except ValueError:  # a NUL in the name
+            raise WorldError(f'{shown}: cannot read world file: no such name') from None
+        raise WorldError(f'{shown}: cannot read world file: not a regular file')
     resource = _bundled() / f'{name}.toml'
-    if not resource.is_file():
+    if len(name) > MAX_NAME or not resource.is_file():  # a longer name cannot be a file
         raise WorldError(f'unknown world {_show(name)}: {_choices()}')
     return resource.read_bytes(), f'{name}.toml', None
 

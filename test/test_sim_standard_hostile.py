@@ -1,0 +1,220 @@
+"""The standard simulator services against a hostile or clumsy client, in-process.
+
+Each request gets the standard's result code and one line, never an exception of ours
+(answered 'a bug'), a hang or a world left broken: after it, the world still steps and
+every entity's state is finite.
+"""
+import math
+import os
+
+import pytest
+from geometry_msgs.msg import PoseStamped
+from simulation_interfaces import msg as si
+from simulation_interfaces import srv
+
+from fuzzmsg import hostile
+
+OK = si.Result.RESULT_OK
+FAILED = si.Result.RESULT_OPERATION_FAILED
+MIRO_URDF = 'package://miro_ball/robots/miro.urdf'
+BOX = 'package://miro_ball/worlds/models/box.toml'
+
+
+def serve(node, kind, **fields):
+    """The response of the simulator's ``kind`` service to a request of ``fields``."""
+    request = fields.pop('request', None) or kind.Request(**fields)
+    service = next(s for s in node.control.services if s.srv_type is kind)
+    response = service.callback(request, kind.Response())
+    message = response.result.error_message if hasattr(response, 'result') else ''
+    assert 'a bug' not in message and '\n' not in message, message
+    return response
+
+
+def ok(response):
+    assert response.result.result == OK, response.result.error_message
+    return response
+
+
+def still_works(node):
+    """The world steps, and every entity's state is finite numbers."""
+    states = ok(serve(node, srv.GetEntitiesStates))
+    for name, state in zip(states.entities, states.states):
+        p, q, v = state.pose.position, state.pose.orientation, state.twist.linear
+        values = (p.x, p.y, p.z, q.x, q.y, q.z, q.w, v.x, v.y, v.z)
+        assert all(math.isfinite(x) for x in values), (name, values)
+    before = node.sim.time
+    ok(serve(node, srv.StepSimulation, steps=1))
+    assert node.sim.time > before
+    return list(states.entities)
+
+
+def pose(x=0.0, y=0.0, z=0.0, q=(0.0, 0.0, 0.0, 1.0), frame=''):
+    stamped = PoseStamped()
+    stamped.header.frame_id = frame
+    stamped.pose.position.x, stamped.pose.position.y, stamped.pose.position.z = x, y, z
+    o = stamped.pose.orientation
+    o.x, o.y, o.z, o.w = q
+    return stamped
+
+
+def entity_state(stamped, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
+    state = si.EntityState(header=stamped.header, pose=stamped.pose)
+    t = state.twist
+    t.linear.x, t.linear.y, t.linear.z = linear
+    t.angular.x, t.angular.y, t.angular.z = angular
+    return state
+
+
+def aimed(request):
+    """The same hostile request, aimed at something that exists: the ball, or a box file."""
+    if hasattr(request, 'entity') and not request.entity:
+        request.entity = 'ball'
+    if isinstance(request, srv.SpawnEntity.Request) and not (request.uri or
+                                                             request.resource_string):
+        request.uri, request.allow_renaming = BOX, True
+    return request
+
+
+def test_every_service_answers_every_hostile_request(paused_sim):
+    """Every field of every request, one at a time: NaN, inf, 1e308, integer limits, empty,
+    10 kB and NUL strings, 1000-long lists; entity requests also aimed at the ball."""
+    node = paused_sim
+    for service in list(node.control.services):
+        kind = service.srv_type
+        for request in hostile(kind.Request):
+            for sent in (request, aimed(request)):
+                serve(node, kind, request=sent)
+                if node.state == si.SimulationState.STATE_STOPPED:  # asked for: go on
+                    node.act('play')
+                    node.act('pause')
+                if node.state == si.SimulationState.STATE_NO_WORLD:
+                    ok(serve(node, srv.LoadWorld, uri='miro'))
+    assert 'ball' in still_works(node)
+
+
+def test_numbers_that_would_poison_physics_are_refused(paused_sim):
+    """A NaN twist made every body NaN a step later; a quaternion of 1e308s overflowed to
+    a zero rotation; both left the world answering 'SVD did not converge' for good."""
+    node = paused_sim
+    invalid = srv.SetEntityState.Response.INVALID_POSE
+    for linear, angular in (((math.nan, 0, 0), (0, 0, 0)), ((0, 0, 0), (0, 0, math.inf)),
+                            ((1e308, 0, 0), (0, 0, 0)), ((0, 0, 0), (0, 0, 1e6))):
+        set_ = serve(node, srv.SetEntityState, entity='ball',
+                     state=entity_state(pose(z=0.2), linear, angular))
+        assert set_.result.result == invalid and 'twist' in set_.result.error_message
+    huge = (1e308, 1e308, 0.0, 0.0)
+    ok(serve(node, srv.SetEntityState, entity='ball', state=entity_state(pose(z=0.2, q=huge))))
+    q = ok(serve(node, srv.GetEntityState, entity='ball')).state.pose.orientation
+    assert (q.x, q.y) == pytest.approx((2 ** -0.5, 2 ** -0.5))
+    ok(serve(node, srv.SpawnEntity, name='tilted', uri=MIRO_URDF, initial_pose=pose(q=huge)))
+    node.advance(100)
+    still_works(node)
+
+
+def test_a_pose_in_an_entity_frame_is_checked_in_the_world_frame(paused_sim):
+    node = paused_sim
+    ok(serve(node, srv.SetEntityState, entity='ball', state=entity_state(pose(x=900.0))))
+    beyond = serve(node, srv.SetEntityState, entity='ball',
+                   state=entity_state(pose(x=900.0, frame='ball')))
+    assert beyond.result.result == srv.SetEntityState.Response.INVALID_POSE
+    garbage = serve(node, srv.SetEntityState, entity='ball',
+                    state=entity_state(pose(frame='no_such_frame')))
+    assert garbage.result.result == si.Result.RESULT_NOT_FOUND
+    wall = next(n for n in still_works(node) if n.startswith(('ring', 'wall', 'ground')))
+    static = serve(node, srv.SetEntityState, entity=wall, state=entity_state(pose()))
+    assert static.result.result == FAILED and 'static' in static.result.error_message
+
+
+def test_every_name_get_entities_lists_is_taken(paused_sim):
+    """A world's unnamed walls are listed as '<table>_<k>': a MiRo spawned as one hid it."""
+    node = paused_sim
+    unnamed = next(n for n in still_works(node) if n.startswith(('ring_', 'wall_', 'ground_')))
+    for uri in (MIRO_URDF, BOX):
+        taken = serve(node, srv.SpawnEntity, name=unnamed, uri=uri)
+        assert taken.result.result == srv.SpawnEntity.Response.NAME_NOT_UNIQUE
+
+
+def test_stepping_is_bounded_and_resets_take_known_scopes_only(paused_sim):
+    node = paused_sim
+    for steps in (0, 5001, 2 ** 64 - 1):
+        refused = serve(node, srv.StepSimulation, steps=steps)
+        assert refused.result.result == FAILED
+        assert '1 to 5000 (10 s)' in refused.result.error_message
+    assert node.sim.time == 0.0
+    ok(serve(node, srv.StepSimulation, steps=3))
+    for scope in range(256):
+        reset = serve(node, srv.ResetSimulation, scope=scope)
+        if scope <= 7 or scope == 255:
+            ok(reset)
+        else:  # 8 was read as 0, a whole reset
+            assert reset.result.result == FAILED, scope
+    still_works(node)
+
+
+def test_robots_are_limited_per_request_and_per_world(paused_sim):
+    node = paused_sim
+    one = si.SpawnEntity(allow_renaming=True, entity_resource=si.Resource(uri=MIRO_URDF))
+    many = serve(node, srv.SpawnEntities, spawn_requests=[one] * 10000)
+    assert many.result.result == FAILED and 'at most 64' in many.result.error_message
+    assert len(node.sim.robots) == 1
+    for _ in range(15):
+        ok(serve(node, srv.SpawnEntity, allow_renaming=True, uri=MIRO_URDF))
+    full = serve(node, srv.SpawnEntity, allow_renaming=True, uri=MIRO_URDF)
+    assert full.result.result == FAILED and '16 robots' in full.result.error_message
+    for name in list(node.sim.robots):  # every robot gone, its topics with it
+        ok(serve(node, srv.DeleteEntity, entity=name))
+    assert not node.robots
+    still_works(node)
+    ok(serve(node, srv.SpawnEntity, name='again', uri=MIRO_URDF))
+    assert list(node.robots) == ['again']
+    ok(serve(node, srv.DeleteEntity, entity='ball'))
+    ok(serve(node, srv.ResetSimulation, scope=srv.ResetSimulation.Request.SCOPE_STATE))
+    assert 'ball' not in still_works(node)  # a state reset does not undo a deletion
+    ok(serve(node, srv.ResetSimulation))
+    assert 'ball' in still_works(node)
+
+
+def test_no_world_is_said_by_every_service_until_one_is_loaded(paused_sim):
+    node = paused_sim
+    ok(serve(node, srv.UnloadWorld))
+    incorrect = si.Result.RESULT_INCORRECT_STATE
+    for kind in (srv.GetEntities, srv.GetEntitiesStates, srv.GetEntityState,
+                 srv.SetEntityState, srv.GetEntityInfo, srv.SetEntityInfo, srv.GetEntityBounds,
+                 srv.SpawnEntity, srv.DeleteEntity, srv.StepSimulation, srv.ResetSimulation,
+                 srv.GetNamedPoses):
+        assert serve(node, kind).result.result == incorrect, kind.__name__
+    no_world = srv.GetCurrentWorld.Response.NO_WORLD_LOADED
+    assert serve(node, srv.GetCurrentWorld).result.result == no_world
+    assert serve(node, srv.UnloadWorld).result.result == no_world
+    play = si.SimulationState(state=si.SimulationState.STATE_PLAYING)
+    refused = serve(node, srv.SetSimulationState, state=play)
+    assert refused.result.result == srv.SetSimulationState.Response.STATE_TRANSITION_ERROR
+    ok(serve(node, srv.LoadWorld, uri='package://miro_ball/worlds/football_pitch.toml'))
+    assert {'miro01', 'miro02', 'miro03', 'ball'} <= set(still_works(node))
+
+
+def test_files_that_would_block_or_never_end_are_refused(paused_sim, tmp_path):
+    """A FIFO named .toml blocked the simulator until someone wrote to it."""
+    node = paused_sim
+    fifo = tmp_path / 'fifo.toml'
+    os.mkfifo(fifo)
+    (tmp_path / 'folder.toml').mkdir()
+    text = tmp_path / 'text.toml'
+    text.write_text('x')
+    for uri in (str(fifo), f'file://{fifo}', str(tmp_path / 'folder.toml'), '/dev/zero',
+                'file:///dev/zero', '/' + 'x' * 10000 + '.toml', 'x' * 10000,
+                f'{tmp_path}/\x00.toml', str(tmp_path / 'missing.toml')):
+        loaded = serve(node, srv.LoadWorld, uri=uri)
+        assert loaded.result.result in (srv.LoadWorld.Response.NO_RESOURCE,
+                                        srv.LoadWorld.Response.RESOURCE_PARSE_ERROR), uri
+        assert len(loaded.result.error_message) < 400
+        spawned = serve(node, srv.SpawnEntity, name='thing', uri=uri)
+        assert spawned.result.result in (srv.SpawnEntity.Response.NO_RESOURCE,
+                                         srv.SpawnEntity.Response.UNSUPPORTED_FORMAT), uri
+    for folders in ([str(tmp_path)], ['/proc'], [str(text)], [str(tmp_path / 'none')],
+                    ['\x00'], [''] * 10000):
+        listed = serve(node, srv.GetAvailableWorlds, additional_sources=folders,
+                       continue_on_error=True)
+        assert 'football_pitch' in {w.name for w in ok(listed).worlds}
+    assert ok(serve(node, srv.GetCurrentWorld)).world.name == 'miro'
+    still_works(node)
