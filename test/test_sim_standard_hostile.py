@@ -8,11 +8,18 @@ import math
 import os
 
 import pytest
-from geometry_msgs.msg import PoseStamped
+from action_msgs.msg import GoalStatus
+from geometry_msgs.msg import PoseStamped, TwistStamped
+from nav_msgs.msg import Odometry
+from rclpy.action import ActionClient
 from simulation_interfaces import msg as si
 from simulation_interfaces import srv
+from simulation_interfaces.action import SimulateSteps
 
 from fuzzmsg import hostile
+from miro_ball.miro.interface import RobotTopics
+from miro_sim_bullet.ros.step_action import MAX_GOALS
+from rostools import advance_ticks, Probe, spin_until
 
 OK = si.Result.RESULT_OK
 FAILED = si.Result.RESULT_OPERATION_FAILED
@@ -218,3 +225,77 @@ def test_files_that_would_block_or_never_end_are_refused(paused_sim, tmp_path):
         assert 'football_pitch' in {w.name for w in ok(listed).worlds}
     assert ok(serve(node, srv.GetCurrentWorld)).world.name == 'miro'
     still_works(node)
+
+
+def test_spawn_resources_that_are_wrong_get_their_codes(paused_sim):
+    node = paused_sim
+    code = srv.SpawnEntity.Response
+    box = '[[box]]\nsize = [0.1, 0.1, 0.1]\n'
+    for text, expected in (('<robot', code.RESOURCE_PARSE_ERROR),
+                           ('<robot name="r2"><link name="base"/></robot>',
+                            code.UNSUPPORTED_ASSETS),
+                           ('<html/>', code.UNSUPPORTED_FORMAT),
+                           ('<' + 'x' * 2_000_000, code.RESOURCE_PARSE_ERROR),
+                           ('#' * 2_000_000, code.RESOURCE_PARSE_ERROR),
+                           ('[[box]\n', code.RESOURCE_PARSE_ERROR),
+                           (box + box, code.RESOURCE_PARSE_ERROR),
+                           ('[ball]\nradius = 0.05\n', code.NAME_NOT_UNIQUE)):
+        spawned = serve(node, srv.SpawnEntity, allow_renaming=True, resource_string=text)
+        assert spawned.result.result == expected, (text[:40], spawned.result.error_message)
+    still_works(node)
+
+
+def test_a_robot_deleted_while_its_topics_are_in_use(paused_sim, ros_context, executor):
+    node = paused_sim
+    probe = Probe(ros_context, executor)
+    topics = RobotTopics(next(iter(node.robots)))
+    odom = probe.watch(Odometry, topics.odom)
+    drive = probe.publisher(TwistStamped, topics.cmd_vel)
+    spin_until(executor, lambda: node.robots[topics.name].publisher('odom')
+               .get_subscription_count() > 0)
+    advance_ticks(node, executor, 5)
+    spin_until(executor, lambda: odom)
+    ok(serve(node, srv.DeleteEntity, entity=topics.name))
+    for _ in range(5):  # drain() raises what a callback raised
+        drive.publish(TwistStamped())
+        advance_ticks(node, executor)
+    assert not node.robots
+    still_works(node)
+
+
+def test_simulate_steps_huge_many_and_across_a_world_load(paused_sim, ros_context, executor):
+    """A goal of 2**64-1 steps keeps the simulator answering and is cancelled; goals beyond
+    those waiting are rejected; unload_world ends the goal in hand, a load steps on."""
+    node = paused_sim
+    probe = Probe(ros_context, executor)
+    action = ActionClient(probe.node, SimulateSteps, '/miro_sim/simulate_steps')
+    assert action.wait_for_server(timeout_sec=10)
+
+    def send(steps):
+        sent = action.send_goal_async(SimulateSteps.Goal(steps=steps))
+        spin_until(executor, sent.done)
+        return sent.result()
+
+    endless = send(2 ** 64 - 1)
+    assert endless.accepted
+    spin_until(executor, lambda: node.sim.time > 1.0)  # a second simulated, and on
+    still_works(node)
+    ok(serve(node, srv.LoadWorld, uri='package://miro_ball/worlds/football_pitch.toml'))
+    start = node.sim.time
+    spin_until(executor, lambda: node.sim.time > start + 0.1)
+    cancel = endless.cancel_goal_async()
+    spin_until(executor, cancel.done)
+    ended = endless.get_result_async()
+    spin_until(executor, ended.done)
+    assert ended.result().status == GoalStatus.STATUS_CANCELED
+
+    queued = [send(1_000_000) for _ in range(MAX_GOALS + 3)]
+    assert [g.accepted for g in queued].count(False) >= 3
+    ok(serve(node, srv.UnloadWorld))
+    for goal in (g for g in queued if g.accepted):
+        ended = goal.get_result_async()
+        spin_until(executor, ended.done)
+        assert ended.result().status == GoalStatus.STATUS_ABORTED
+        assert ended.result().result.result.result == FAILED
+    ok(serve(node, srv.LoadWorld, uri='miro'))
+    assert 'ball' in still_works(node)

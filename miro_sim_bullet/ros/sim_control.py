@@ -34,8 +34,9 @@ from miro_sim_bullet.scene.world_file import (Ball, named_poses, parse_world, wo
 
 MAX_SPAWNS = 64  # entities one SpawnEntities request may ask for
 # A StepSimulation answers when its steps are done, and the simulator does nothing else
-# meanwhile: 10 s of simulated time took 0.4 s with one robot, 20 s with 16 (2 cores,
-# 2026-11-26). 2**64-1 steps froze it for good. The action steps in turns, and cancels.
+# meanwhile: 10 s of simulated time took 0.5 s with one robot, 2.1 s with 16 apart, 3 to
+# 12 s with 16 piled on one spot (2 shared cores, 2026-11-26). 2**64-1 steps froze it for
+# good. The simulate_steps action steps any number in turns, and can be cancelled.
 MAX_STEP_SECONDS = 10.0
 RESET_ALL = srv.ResetSimulation.Request.SCOPE_ALL
 _F = si.SimulatorFeatures

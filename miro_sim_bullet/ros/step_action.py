@@ -23,7 +23,10 @@ from miro_sim_bullet.control.codes import Result
 
 ACTION_NODE = 'miro_sim_steps'
 MAX_STEPS_A_TURN = 500  # steps of a goal per turn of the simulator's timer: it stays lively
-MAX_GOALS = 16  # goals waiting their turn; more are rejected
+MAX_GOALS = 16  # goals accepted and not ended; more are rejected
+# Each goal accepted holds a thread until it ends: with 2 threads, two goals left none to
+# answer a third, or a cancel (a goal of 2**64-1 steps could then never be stopped).
+THREADS = MAX_GOALS + 2
 
 
 class Goal:
@@ -48,6 +51,7 @@ class StepAction:
         self.host = host
         self.node = Node(ACTION_NODE, context=context)
         self.waiting = collections.deque()
+        self.held = 0  # goals accepted and not ended, each on a thread of the executor
         self.lock = threading.Lock()
         self.server = ActionServer(
             self.node, SimulateSteps, SimTopics().topic('simulate_steps'),
@@ -57,7 +61,7 @@ class StepAction:
             # Feedback after every step comes in bursts: a deep queue keeps each one for
             # a client whose queue is deep too.
             feedback_pub_qos_profile=QoSProfile(depth=MAX_STEPS_A_TURN))
-        self.executor = MultiThreadedExecutor(num_threads=2, context=context)
+        self.executor = MultiThreadedExecutor(num_threads=THREADS, context=context)
         self.executor.add_node(self.node)
         self.thread = threading.Thread(target=self._spin, name=ACTION_NODE, daemon=True)
         self.thread.start()
@@ -70,14 +74,18 @@ class StepAction:
 
     def _accept(self, request):
         with self.lock:
-            return GoalResponse.REJECT if len(self.waiting) >= MAX_GOALS \
-                else GoalResponse.ACCEPT
+            if self.held >= MAX_GOALS:
+                return GoalResponse.REJECT
+            self.held += 1
+            return GoalResponse.ACCEPT
 
     def _execute(self, handle):
         goal = Goal(handle)
         with self.lock:
             self.waiting.append(goal)
         goal.done.wait()
+        with self.lock:
+            self.held -= 1
         if handle.is_cancel_requested:
             handle.canceled()
         elif goal.result.result.result == Result.OK:
