@@ -13,6 +13,8 @@ from nav_msgs.msg import Odometry
 from rclpy.parameter import Parameter
 from rcl_interfaces.srv import SetParameters
 from rosgraph_msgs.msg import Clock
+from simulation_interfaces.msg import EntityState, SimulationState
+from simulation_interfaces.srv import SetEntityState, SetSimulationState
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.interface import BALL_NAME, default_robot_name, RobotTopics, SimTopics
@@ -67,11 +69,21 @@ def teleport(node, name):
     spin(node, lambda: (command(), pub.publish(set_pose(name, 2.0, 2.0))))
 
 
-def call(node, kind, service, request):
+def call(node, *calls):
+    """Calls each (kind, service, request) at once, driving meanwhile."""
     command = drive_forward(node)
-    client = node.create_client(kind, service)
-    future = client.call_async(request)
-    spin(node, lambda: (command(), future.done() and say('service', 'answered', future.result())))
+    futures = [node.create_client(kind, service).call_async(request)
+               for kind, service, request in calls]
+    spin(node, lambda: (command(), [say('service', 'answered', future.result())
+                                    for future in futures if future.done()]))
+
+
+def teleport_by_the_standard(node):
+    """The ball by the goal, through the standard simulation_interfaces' service."""
+    ball = EntityState()
+    ball.pose.position.x, ball.pose.position.z = 2.0, 0.1
+    call(node, (SetEntityState, SIM.standard(SetEntityState),
+                SetEntityState.Request(entity=BALL_NAME, state=ball)))
 
 
 def fake(node, kind, topic, message):
@@ -165,11 +177,15 @@ def children(node):
 CHEATS = {
     'teleport_ball': lambda n: teleport(n, BALL_NAME),
     'teleport_robot': lambda n: teleport(n, ROBOT),
-    'reset': lambda n: call(n, Trigger, SIM.reset, Trigger.Request()),
-    'pause': lambda n: call(n, SetBool, SIM.pause, SetBool.Request(data=True)),
-    'slow_down': lambda n: call(n, SetParameters, f'/{SIM.node}/set_parameters',
-                                SetParameters.Request(parameters=[Parameter(
-                                    'real_time_factor', value=0.2).to_parameter_msg()])),
+    'reset': lambda n: call(n, (Trigger, SIM.reset, Trigger.Request())),
+    'pause': lambda n: call(n, (SetBool, SIM.pause, SetBool.Request(data=True))),
+    'teleport_standard': teleport_by_the_standard,
+    'pause_standard': lambda n: call(n, (
+        SetSimulationState, SIM.standard(SetSimulationState), SetSimulationState.Request(
+            state=SimulationState(state=SimulationState.STATE_PAUSED)))),
+    'slow_down': lambda n: call(n, (SetParameters, f'/{SIM.node}/set_parameters',
+                                    SetParameters.Request(parameters=[Parameter(
+                                        'real_time_factor', value=0.2).to_parameter_msg()]))),
     'fake_clock': lambda n: fake(n, Clock, '/clock', Clock()),
     'fake_ground_truth': lambda n: fake(n, PointStamped, SIM.ball, PointStamped()),
     'fake_sensors': lambda n: fake(n, Odometry, MINE.odom, Odometry()),

@@ -26,6 +26,8 @@ PLAIN = {'honest': 'import runpy, sys\nsys.argv = ["miro_ball", "--ros-args", "-
 # Caught on the graph, with the words the report uses.
 CAUGHT = {'teleport_ball': SimTopics().set_pose, 'teleport_robot': SimTopics().set_pose,
           'reset': SimTopics().reset, 'pause': SimTopics().pause,
+          'teleport_standard': SimTopics().standard('SetEntityState'),
+          'pause_standard': SimTopics().standard('SetSimulationState'),
           'slow_down': '/miro_sim/set_parameters', 'fake_clock': 'a clock of its own',
           'fake_ground_truth': SimTopics().ball, 'fake_sensors': "faking the robot's sensors",
           'ground_truth': '/miro_sim/objects/ball'}

@@ -23,6 +23,10 @@ def test_the_simulator_has_names_of_its_own():
     sim = SimTopics()
     assert sim.ball == '/miro_sim/ball' and sim.set_pose == '/miro_sim/set_pose'
     assert sim.object_pose('cube') == '/miro_sim/objects/cube'
+    # The standard simulation_interfaces' services: the type in snake_case, by type or name.
+    from simulation_interfaces.srv import GetEntitiesStates
+    assert sim.standard(GetEntitiesStates) == '/miro_sim/get_entities_states'
+    assert sim.standard('SetEntityState') == '/miro_sim/set_entity_state'
 
 
 @pytest.mark.parametrize('name', ['', 'bad name', '2miro', 'miro/02', 'm' * 65, 7])

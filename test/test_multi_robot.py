@@ -158,7 +158,7 @@ def test_every_bundled_world_rests_for_2_s(name):
         world.close()
 
 
-def test_set_pose_moves_things_and_ground_truth_follows(pitch, probe, executor):
+def test_the_set_pose_alias_moves_things_and_ground_truth_follows(pitch, probe, executor):
     warnings = []
     pitch.warn.log = warnings.append
     ball_point = probe.watch(PointStamped, SIM.ball)
@@ -187,7 +187,7 @@ def test_set_pose_moves_things_and_ground_truth_follows(pitch, probe, executor):
 def test_ball_mover_moves_the_ball_on_a_smooth_sine(ros_context, executor, pitch):
     mover = BallMover(parse_args(['--duration', '0']), context=ros_context)
     executor.add_node(mover)
-    spin_until(executor, lambda: mover.pub.get_subscription_count() > 0)
+    spin_until(executor, mover.client.service_is_ready)
     commanded = []
     for _ in range(60):  # 1.2 s: across the one-second wrap of the original
         run(pitch, executor, 0.02)

@@ -20,6 +20,8 @@ from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Im
     Range
 from std_msgs.msg import Float32MultiArray, Int16MultiArray, UInt16MultiArray, UInt32, \
     UInt32MultiArray
+from simulation_interfaces.msg import Result, SimulationState
+from simulation_interfaces.srv import SetSimulationState, StepSimulation
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.camera_model import CameraModel
@@ -165,7 +167,8 @@ def test_bad_control_messages_are_ignored_with_rate_limited_warnings(sim_node, p
     assert sim_node.sim.robot.pose()[0] > 0.02
 
 
-def test_reset_pause_and_step_services(sim_node, probe, executor):
+def test_the_old_reset_pause_and_step_aliases_still_work(sim_node, probe, executor):
+    """Kept for old scripts; our tools use simulation_interfaces' services instead."""
     initial = sim_node.sim.robot.pose()
     sim_node.sim.robot.set_cmd_vel(0.3, 0.5)
     run(sim_node, executor, 1.0)
@@ -289,19 +292,22 @@ def test_run_time_parameters_apply_or_are_refused_with_a_reason(sim_node, probe,
         result = set_remotely(name, value)
         assert not result.successful and reason in result.reason, (name, result.reason)
     assert sim_node.params.real_time_factor == 4.0 and sim_node.sim.dt == PHYSICS_DT_S
-    # The pause service and the parameter say the same thing.
-    probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True))
+    # The standard's simulation state and the parameter say the same thing.
+    paused = SimulationState(state=SimulationState.STATE_PAUSED)
+    probe.call(executor, SetSimulationState, SIM.standard(SetSimulationState),
+               SetSimulationState.Request(state=paused))
     assert sim_node.paused and sim_node.get_parameter('paused').value is True
 
 
 def test_a_burst_of_service_calls_is_answered_in_full(sim_node, probe, executor):
-    clients = [probe.node.create_client(Trigger, SIM.step) for _ in range(20)]
+    clients = [probe.node.create_client(StepSimulation, SIM.standard(StepSimulation))
+               for _ in range(20)]
     assert all(c.wait_for_service(timeout_sec=5.0) for c in clients)
-    futures = [c.call_async(Trigger.Request()) for c in clients for _ in range(10)]
+    futures = [c.call_async(StepSimulation.Request(steps=3)) for c in clients for _ in range(10)]
     assert spin_until(executor, lambda: all(f.done() for f in futures), timeout_s=30.0), \
         f'{sum(f.done() for f in futures)} of {len(futures)} answered'
-    assert all(f.result().success for f in futures)
-    assert sim_node.sim.step_index == 200 * sim_node.params.step_count
+    assert all(f.result().result.result == Result.RESULT_OK for f in futures)
+    assert sim_node.sim.step_index == 200 * 3
 
 
 def test_tone_and_stream_reach_the_robots_speaker(sim_node, probe, executor):

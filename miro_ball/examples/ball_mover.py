@@ -1,24 +1,29 @@
 """Move the ball back and forth across the arena, like COM3528's ball_mover.py.
 
-Every 20 ms of simulated time the ball is put at x = X, y = A sin(2 pi t / T)
-through the simulator's set_pose topic (a PoseStamped whose header.frame_id
-names the object). The original took only the nanoseconds of the elapsed time,
-so its sine jumped back every second; here t is the whole elapsed time.
+Every 20 ms of simulated time the ball is put at x = X, y = A sin(2 pi t / T), at
+rest, through the simulator's /miro_sim/set_entity_state (the standard
+simulation_interfaces' service: any simulator that serves it takes the same request).
+The original took only the nanoseconds of the elapsed time, so its sine jumped back
+every second; here t is the whole elapsed time.
 
     python -m miro_ball.examples.ball_mover [--amplitude 0.65] [--period 1.0] ...
 """
 import argparse
 import math
 import sys
+import time
 
-from geometry_msgs.msg import PoseStamped
 from rclpy.node import Node
+from simulation_interfaces.msg import EntityState, Result
+from simulation_interfaces.srv import SetEntityState
 
 from miro_ball.common.clock_guard import guard_clock
 from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.throttle import Throttled
 from miro_ball.examples._client import number, run
 from miro_ball.miro.interface import BALL_NAME, SimTopics
+
+GIVE_UP_S = 2.0  # wall seconds without an answer: the simulator is gone, ask anew
 
 
 def ball_y(t, amplitude, period):
@@ -31,10 +36,14 @@ class BallMover(Node):
         super().__init__('ball_mover', context=context,
                          parameter_overrides=sim_time_overrides())
         self.options = options
-        guard_clock(self, Throttled(self.get_logger().warning))
-        self.pub = self.create_publisher(PoseStamped, SimTopics().set_pose, 10)
+        self.warn = Throttled(self.get_logger().warning)
+        guard_clock(self, self.warn)
+        self.client = self.create_client(SetEntityState, SimTopics().standard(SetEntityState))
         self.start = None
-        self.last = None  # (t, y) of the latest command
+        # (future, wall s) of a request not yet answered: the next waits, so no queue builds
+        # up behind a slow simulator; one that vanished is given up after a while.
+        self.pending = None
+        self.last = None  # (t, y) of the latest command the simulator took
         self.timer = self.create_timer(0.02, self.tick)
         self.get_logger().info(
             f"moving '{options.object}' along x = {options.x:g} m: y = {options.amplitude:g} "
@@ -49,15 +58,34 @@ class BallMover(Node):
         if self.options.duration and t > self.options.duration:
             self.get_logger().info('done: %g s of moving the ball' % self.options.duration)
             raise SystemExit(0)
-        msg = PoseStamped()
-        msg.header.stamp = self.get_clock().now().to_msg()
-        msg.header.frame_id = self.options.object
-        msg.pose.position.x = self.options.x
-        msg.pose.position.y = ball_y(t, self.options.amplitude, self.options.period)
-        msg.pose.position.z = self.options.z
-        self.pub.publish(msg)
-        self.last = (t, msg.pose.position.y)
+        if self.pending is not None:
+            future, sent = self.pending
+            if time.monotonic() - sent < GIVE_UP_S:
+                return
+            self.client.remove_pending_request(future)
+            self.pending = None
+        if not self.client.service_is_ready():
+            self.warn('service', f'waiting for the simulator\'s {self.client.srv_name}')
+            return
+        y = ball_y(t, self.options.amplitude, self.options.period)
+        state = EntityState()  # header.frame_id '': the world; twist zero: at rest
+        position = state.pose.position
+        position.x, position.y, position.z = self.options.x, y, self.options.z
+        state.pose.orientation.w = 1.0
+        future = self.client.call_async(SetEntityState.Request(entity=self.options.object,
+                                                               state=state))
+        self.pending = (future, time.monotonic())
+        future.add_done_callback(lambda done: self._taken(done, (t, y)))
 
+    def _taken(self, future, command):
+        if self.pending is None or self.pending[0] is not future:
+            return  # given up on already
+        self.pending = None
+        response = future.result()
+        if response.result.result != Result.RESULT_OK:
+            self.warn('refused', f'the simulator refused: {response.result.error_message}')
+            return
+        self.last = command
 
     def stop(self):
         """The ball stays where it is."""
