@@ -299,3 +299,19 @@ def test_simulate_steps_huge_many_and_across_a_world_load(paused_sim, ros_contex
         assert ended.result().result.result.result == FAILED
     ok(serve(node, srv.LoadWorld, uri='miro'))
     assert 'ball' in still_works(node)
+
+
+def test_name_filters_that_backtrack_forever_in_re_answer_at_once(paused_sim):
+    """'(a+)+$' took 2**n steps in Python's re on a name of n a's and a '_': a spawned box
+    named so, then one get_entities, and the simulator hung for good."""
+    node = paused_sim
+    long_name = 'a' * 60 + '_1'
+    ok(serve(node, srv.SpawnEntity, name=long_name, uri=BOX))
+    for pattern, kept in (('(a+)+$', []), ('^(a|aa)*_', [long_name]),
+                          ('a*' * 100 + 'Q', []), ('^(a*)*_[[:digit:]]$', [long_name]),
+                          ('x{1,5000}', None), ('[a-z]{0,900}Q', [])):
+        got = serve(node, srv.GetEntities, filters=si.EntityFilters(filter=pattern))
+        if kept is None:  # an automaton of more than 2000 states: refused
+            assert got.result.result == FAILED and 'too complex' in got.result.error_message
+        else:
+            assert ok(got).entities == kept, pattern

@@ -75,7 +75,7 @@ def _name_test(pattern):
     except ValueError as err:
         raise Refused(Result.OPERATION_FAILED, f'filter {pattern[:60]!r}: not a regular '
                                                f'expression: {err}') from None
-    return lambda name: compiled.search(name) is not None
+    return compiled.search
 
 
 def _categories(categories):

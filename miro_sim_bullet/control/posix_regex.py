@@ -1,4 +1,5 @@
-"""POSIX extended regular expressions (ERE) on Python's re, for the entity name filter.
+"""POSIX extended regular expressions (ERE) for the entity name filter, read by Python's
+re parser and searched by an automaton of our own.
 
 Python's re reads most of an ERE the same way; where it would read one differently this
 module either translates (bracket expressions: POSIX character classes such as
@@ -7,11 +8,19 @@ line (what ERE lacks and re would take as something else: escapes such as \\d or
 (?...) groups, lazy or possessive repetition like *? and *+, collating elements [.x.] and
 equivalence classes [=x=]). Whether a name matches is the same under POSIX's leftmost-
 longest rule and re's leftmost-first one, so a search answers as regexec would.
+
+The search is not re's: re backtracks, and '(a+)+$' on a name of 40 a's and a '_' would
+have taken days (2**40 ways to split the a's), the simulator with it; so would 'a*a*a*...$'.
+Pattern runs the expression as a set of automaton states a character instead: time linear
+in the name's length whatever the pattern.
 """
 import re
 import string
+from re import _constants as sre, _parser  # re's own parse tree: what re would read
 
 MAX_PATTERN = 256  # characters; a filter is a name pattern, not a program
+MAX_STATES = 2000  # of the automaton: 'x{1,1000}' is as big as its thousand x's
+MAX_STEPS = 20000  # (states, character) steps remembered between searches
 
 # The POSIX classes, over ASCII: entity names are ROS names.
 _CLASSES = {
@@ -21,19 +30,121 @@ _CLASSES = {
     'graph': r'\x21-\x7e',
 }
 _REPEATS = '*+?}'
+_REPEAT_OPS = (sre.MAX_REPEAT, sre.MIN_REPEAT, sre.POSSESSIVE_REPEAT)
+_STARTS = (sre.AT_BEGINNING, sre.AT_BEGINNING_STRING)
+_ENDS = (sre.AT_END, sre.AT_END_STRING)
 
 
 def compile_ere(pattern):
-    """The compiled pattern, or ValueError in one line saying why it is refused."""
+    """The Pattern, or ValueError in one line saying why it is refused."""
     if not isinstance(pattern, str):
         raise ValueError('must be a string')
     if len(pattern) > MAX_PATTERN:
         raise ValueError(f'longer than {MAX_PATTERN} characters')
     translated = _translate(pattern)
     try:
-        return re.compile(translated)
+        return Pattern(_parser.parse(translated))
     except (re.error, RecursionError, OverflowError) as err:
         raise ValueError(str(err)) from None
+
+
+class Pattern:
+    """An expression as an automaton (Thompson's construction) over re's parse tree. A
+    state is ('char', test of a character's code, next), ('split', [next, ...]), ('at',
+    start or end, next) or ('match',)."""
+
+    def __init__(self, parsed):
+        self.states = [('match',)]
+        self.start = self._sequence(parsed, 0)
+        self._steps = {}  # (states, character, at the end after it) -> the states after it
+
+    def search(self, text):
+        """Whether the expression matches somewhere in ``text``."""
+        codes = [ord(c) for c in text]
+        now = self._close([self.start], True, not codes)
+        for index, code in enumerate(codes):
+            if 0 in now:
+                return True
+            key = (now, code, index + 1 == len(codes))
+            if key not in self._steps:
+                if len(self._steps) >= MAX_STEPS:
+                    self._steps.clear()
+                moved = [state[2] for state in map(self.states.__getitem__, now)
+                         if state[0] == 'char' and state[1](code)]
+                self._steps[key] = self._close(moved + [self.start], False, key[2])
+            now = self._steps[key]
+        return 0 in now
+
+    def _close(self, roots, at_start, at_end):
+        """The states reached from ``roots`` without reading a character."""
+        seen, stack = set(), list(roots)
+        while stack:
+            index = stack.pop()
+            if index in seen:
+                continue
+            seen.add(index)
+            state = self.states[index]
+            if state[0] == 'split':
+                stack.extend(state[1])
+            elif state[0] == 'at' and (at_start if state[1] in _STARTS else at_end):
+                stack.append(state[2])
+        return frozenset(seen)
+
+    def _add(self, state):
+        if len(self.states) >= MAX_STATES:
+            raise ValueError(f'too complex (more than {MAX_STATES} automaton states)')
+        self.states.append(state)
+        return len(self.states) - 1
+
+    def _sequence(self, items, then):
+        """The first state of ``items`` (re's parse of a sequence) followed by ``then``."""
+        for op, value in reversed(list(items)):
+            then = self._item(op, value, then)
+        return then
+
+    def _item(self, op, value, then):
+        if op in (sre.LITERAL, sre.NOT_LITERAL, sre.ANY, sre.IN):
+            return self._add(('char', _test(op, value), then))
+        if op == sre.SUBPATTERN:
+            return self._sequence(value[-1], then)
+        if op == sre.BRANCH:
+            return self._add(('split', [self._sequence(branch, then) for branch in value[1]]))
+        if op == sre.AT and value in _STARTS + _ENDS:
+            return self._add(('at', value, then))
+        if op in _REPEAT_OPS:
+            low, high, body = value
+            if high == sre.MAXREPEAT:  # a loop: the body again, or on
+                tail = self._add(('split', []))
+                self.states[tail][1].extend([self._sequence(body, tail), then])
+            else:  # high - low optional copies, each of which may skip to the end
+                tail = then
+                for _ in range(high - low):
+                    tail = self._add(('split', [self._sequence(body, tail), then]))
+            for _ in range(low):
+                tail = self._sequence(body, tail)
+            return tail
+        raise ValueError(f'{str(op).lower()} is not supported')
+
+
+def _test(op, value):
+    """A test of a character's code for one of re's character items."""
+    if op == sre.LITERAL:
+        return value.__eq__
+    if op == sre.NOT_LITERAL:
+        return value.__ne__
+    if op == sre.ANY:
+        return ord('\n').__ne__
+    negate, singles, ranges = False, set(), []
+    for kind, item in value:
+        if kind == sre.NEGATE:
+            negate = True
+        elif kind == sre.LITERAL:
+            singles.add(item)
+        elif kind == sre.RANGE:
+            ranges.append(item)
+        else:
+            raise ValueError(f'{str(kind).lower()} in brackets is not supported')
+    return lambda code: (code in singles or any(a <= code <= b for a, b in ranges)) != negate
 
 
 def _translate(pattern):
