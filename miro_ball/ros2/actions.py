@@ -5,12 +5,17 @@ send_goal prints what ros2's does, line for line, quirks kept (a message's YAML 
 title's next line indented and its other lines are not), so what reads ros2's output reads
 ours; it exits 0 once the server has answered, whatever the goal's status (as ros2 does).
 """
+import time
+import uuid
+
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
 from rclpy.action.graph import (get_action_client_names_and_types_by_node,
                                 get_action_names_and_types,
                                 get_action_server_names_and_types_by_node)
 from rclpy.node import NodeNameNonExistentError
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from unique_identifier_msgs.msg import UUID
 
 from miro_ball.ros2 import convert
 from miro_ball.ros2.graph import CliError
@@ -19,9 +24,7 @@ from miro_ball.ros2.verbs import absolute, interface_class, print_listing
 STATUS = {GoalStatus.STATUS_ACCEPTED: 'ACCEPTED', GoalStatus.STATUS_EXECUTING: 'EXECUTING',
           GoalStatus.STATUS_CANCELING: 'CANCELING', GoalStatus.STATUS_SUCCEEDED: 'SUCCEEDED',
           GoalStatus.STATUS_CANCELED: 'CANCELED', GoalStatus.STATUS_ABORTED: 'ABORTED'}
-
-
-FEEDBACK_LAG_S = 0.1  # wall seconds send_goal -f listens on after the result
+FEEDBACK_QUIET_S = 0.1  # wall seconds of no feedback after which -f takes it all printed
 
 
 def action_class(type_name):
@@ -73,8 +76,33 @@ def action_info(args, graph):
     return 0
 
 
-def _print_feedback(message):
-    print(f'Feedback:\n    {_yaml(message.feedback)}', flush=True)
+class FeedbackPrinter:
+    """Prints each feedback of one goal, from a subscription of its own to the action's
+    feedback topic: rclpy's client forgets a goal's feedback once its result is in, and
+    the result can overtake the feedback still queued (the simulator steps and sends
+    hundreds at once; 784 of 1000 were printed). Every message is kept until printed."""
+
+    def __init__(self, graph, cls, action, goal_id):
+        self.goal_id = goal_id
+        self.last = time.monotonic()
+        self.subscription = graph.node.create_subscription(
+            cls.Impl.FeedbackMessage, f'{action}/_action/feedback', self._heard,
+            QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
+
+    def ready(self):
+        """Whether the server's feedback publisher is matched: the first feedback of a
+        goal sent before then was lost."""
+        return self.subscription.get_publisher_count() > 0
+
+    def _heard(self, message):
+        if bytes(message.goal_id.uuid) == self.goal_id:
+            print(f'Feedback:\n    {_yaml(message.feedback)}', flush=True)
+            self.last = time.monotonic()
+
+    def drain(self, graph):
+        """Print the feedback still queued or on its way once the result is in."""
+        while time.monotonic() - self.last < FEEDBACK_QUIET_S:
+            graph.spin(0.01)
 
 
 def action_send_goal(args, graph):
@@ -82,12 +110,14 @@ def action_send_goal(args, graph):
     cls = action_class(args.type)
     goal = convert.fill(cls.Goal(), convert.parse_yaml(args.goal))
     client = ActionClient(graph.node, cls, action)
+    goal_id = uuid.uuid4().bytes  # chosen here, to know the goal's feedback from others'
+    feedback = FeedbackPrinter(graph, cls, action, goal_id) if args.feedback else None
     print('Waiting for an action server to become available...', flush=True)
-    if not graph.wait(client.server_is_ready):
+    if not graph.wait(lambda: client.server_is_ready() and (not feedback or feedback.ready())):
         raise CliError(f'no action server {action} on ROS domain {graph.domain} (the '
                        'actions: python -m miro_ball.ros2 action list)')
     print(f'Sending goal:\n     {_yaml(goal)}', flush=True)
-    sent = client.send_goal_async(goal, _print_feedback if args.feedback else None)
+    sent = client.send_goal_async(goal, goal_uuid=UUID(uuid=list(goal_id)))
     if not graph.wait(sent.done):
         raise CliError(f'{action} did not answer the goal')
     handle = sent.result()
@@ -101,9 +131,8 @@ def action_send_goal(args, graph):
             graph.spin(0.05)
     except KeyboardInterrupt:
         _cancel(graph, action, handle, result)
-    # The last feedback and the result come by different ways (a topic, a service) and the
-    # result can come first: a moment's more listening prints the feedback still on its way.
-    graph.spin(FEEDBACK_LAG_S if args.feedback else 0.0)
+    if feedback:
+        feedback.drain(graph)
     answer = result.result()
     print(f'Result:\n    {_yaml(answer.result)}')
     print(f'Goal finished with status: {STATUS.get(answer.status, "UNKNOWN")}')
