@@ -315,3 +315,21 @@ def test_name_filters_that_backtrack_forever_in_re_answer_at_once(paused_sim):
             assert got.result.result == FAILED and 'too complex' in got.result.error_message
         else:
             assert ok(got).entities == kept, pattern
+
+
+def test_deleting_statics_renames_nothing_and_the_ground_stays(paused_sim):
+    """Unnamed walls were numbered as they came: deleting 'ring_3' made 'ring_4' the next
+    'ring_3' (a second delete took another wall); deleting the ground broke every later
+    get_entities (KeyError) for good."""
+    node = paused_sim
+    before = still_works(node)
+    ok(serve(node, srv.DeleteEntity, entity='ring_3'))
+    again = serve(node, srv.DeleteEntity, entity='ring_3')
+    assert again.result.result == si.Result.RESULT_NOT_FOUND
+    expected = [name for name in before if name != 'ring_3']
+    assert still_works(node) == expected
+    ok(serve(node, srv.ResetSimulation, scope=srv.ResetSimulation.Request.SCOPE_STATE))
+    assert still_works(node) == expected  # rebuilt without it, the others keep their names
+    ground = serve(node, srv.DeleteEntity, entity='ground_0')
+    assert ground.result.result == FAILED and 'ground' in ground.result.error_message
+    assert still_works(node) == expected

@@ -99,10 +99,34 @@ class SimWorld:
         for spec in world.robots:
             self._add_robot(spec)
         self._filter_collisions()
+        self.unnamed = self._name_unnamed()
         self._pictures()  # last, so that the other bodies keep their ids
         self._new_acoustics()
         self.generation += 1
         self._built = pb.saveState(**kw)
+
+    def _name_unnamed(self):
+        """{body id: '<table>_<k>'} of the ground and the unnamed static shapes: the k-th of
+        its world-file table in the world as loaded, so that neither a deletion nor a
+        rebuild renames another (deleting 'wall_3' twice deleted two walls)."""
+        loaded = {'ground': [None]}  # the ground is 'ground_0'
+        for shape in self.loaded.shapes:
+            if not shape.name and shape.mass <= 0:
+                loaded.setdefault(_table(shape), []).append(shape)
+        looked = dict.fromkeys(loaded, 0)  # where the next of each table is looked for
+        names = {}
+        for body, shape in self.shape_of.items():
+            label, kind = self.body_labels[body]
+            if kind != 'static' or shape.name:
+                continue
+            candidates = loaded.setdefault(label, [])
+            index = looked.setdefault(label, 0)
+            if label != 'ground':
+                while index < len(candidates) and candidates[index] != shape:
+                    index += 1
+            names[body] = f'{label}_{index}'
+            looked[label] = index + 1
+        return names
 
     def _add_ball(self, ball):
         self.ball_id = self._shape(Shape(
@@ -235,13 +259,8 @@ class SimWorld:
         (the k-th of a world-file table: 'wall_3', 'ring_0', 'ground_0')."""
         named = {**{name: robot.body_id for name, robot in self.robots.items()},
                  **self.objects, **self.statics}
-        counts = {}
-        for body, (label, kind) in self.body_labels.items():
-            if kind == 'static' and body not in self.statics.values():
-                index = counts[label] = counts.get(label, -1) + 1
-                name = f'{label}_{index}'
-                if name not in named:
-                    named[name] = body
+        for body, name in self.unnamed.items():
+            named.setdefault(name, body)
         return named
 
     def body_state(self, body):
@@ -301,7 +320,7 @@ class SimWorld:
 
     def remove(self, name):
         """Take the entity ``name`` (entities()) out of the world; KeyError if there is
-        none."""
+        none, ValueError for the ground."""
         kw = self._kw()
         world = self.description
         if name in self.robots:
@@ -321,9 +340,12 @@ class SimWorld:
             world = replace(world, ball=None)
         else:
             body = self.entities()[name]
+            shapes = list(world.shapes)
+            if self.shape_of[body] not in shapes:  # checked first: a failure changes nothing
+                raise ValueError(f'{name} is the ground: it cannot be deleted')
             self.objects.pop(name, None)
             self.statics.pop(name, None)
-            shapes = list(world.shapes)
+            self.unnamed.pop(body, None)
             shapes.remove(self.shape_of.pop(body))
             pb.removeBody(body, **kw)
             del self.body_labels[body]

@@ -351,7 +351,10 @@ class ControlInterface:
     def _delete(self, request, response):
         self._need_world()
         self.entity(request.entity)
-        self.sim.remove(request.entity)
+        try:
+            self.sim.remove(request.entity)
+        except ValueError as err:  # the ground
+            raise Refused(Result.OPERATION_FAILED, str(err)) from None
         self.info.pop(request.entity, None)
         self.host.world_changed()
         response.result = _result()
