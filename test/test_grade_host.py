@@ -55,7 +55,7 @@ def episode(node, steps=1500, started=lambda t: None, each_tick=lambda: None):
     judges; (the judge, where the ball ended). started(t) when judging starts, each_tick()
     after each platform tick."""
     sim = node.sim
-    node.reset()
+    node.reset(0)  # the whole world as loaded
     place(sim, NAME, ROBOT, BALL)
     judge = Judge(sim.time)
     started(sim.time)

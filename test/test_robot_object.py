@@ -118,7 +118,7 @@ def test_sleep_counts_simulated_time_across_a_reset_of_the_world(sim):
     def reset_once():
         if sim.node.sim.time > 2.0 and not reset:
             reset.append(sim.node.sim.time)
-            sim.node.reset()
+            sim.node.reset(0)  # the whole world as loaded
 
     def script(miro):
         miro.sleep(1.5)

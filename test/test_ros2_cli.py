@@ -141,9 +141,9 @@ def test_params_and_services_of_the_simulator(paused_sim, executor):
     assert code == 1 and 'Setting parameter failed' in out  # read at start only: said so
     paused_sim.robots[T.name].robot.set_cmd_vel(0.3, 0.0)
     advance_until(paused_sim, executor, lambda: paused_sim.sim.robots[T.name].pose()[0] > 0.05)
-    code, out, _ = ros2(['service', 'call', f'{SIM}/reset', 'std_srvs/srv/Trigger'],
-                        paused_sim, executor)
-    assert code == 0 and 'success=True' in out.split('response:')[1]
+    code, out, _ = ros2(['service', 'call', f'{SIM}/reset_simulation',
+                         'simulation_interfaces/srv/ResetSimulation'], paused_sim, executor)
+    assert code == 0 and 'Result(result=1,' in out.split('response:')[1]  # RESULT_OK
     assert abs(paused_sim.sim.robots[T.name].pose()[0]) < 0.01  # back where it started
 
 

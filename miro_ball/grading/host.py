@@ -180,7 +180,7 @@ class Host:
         out.mkdir(parents=True, exist_ok=True)
         node, sim = self.node, self.node.sim
         node.pause(True)
-        node.reset()
+        node.reset(0)  # the whole world as loaded (ResetSimulation.SCOPE_DEFAULT)
         place(sim, self.args.robot, spec['robot'], spec['ball'])
         node.advance(1)  # the placed world's first readings go out before anyone listens
         self.judge = None  # until the clock starts

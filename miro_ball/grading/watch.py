@@ -3,8 +3,9 @@
 A graded command may use its robot's interface (subscribe to the sensors, publish the
 controls) and anything of its own. It cheats when it publishes /clock or on a topic
 the robot publishes (faking what MiRo senses or when), publishes on another robot's
-interface, uses the simulator's own topics or services (ground truth, set_pose,
-reset, pause, step, its parameters), whether or not the graded simulator offers them.
+interface, uses the simulator's own topics or services (ground truth, the standard
+simulation_interfaces' services, the older set_pose, reset, pause and step, its
+parameters), whether or not the graded simulator offers them.
 ``breaches`` says so in words for a list of endpoints: plain Python. ``GraphWatch``
 lists the endpoints of a node's ROS graph that are not the host's own.
 """

@@ -29,7 +29,7 @@ WORLD_FRAME = 'world'  # the simulator's frame (ground truth, the scene)
 TOUCH_PARTS = ('head', 'body')
 # What a row's {placeholder} stands for (the IMUs are in the same two parts as the pads).
 PLACEHOLDERS = {'eye': EYES, 'part': TOUCH_PARTS}
-BALL_NAME = 'ball'  # the simulator's name of the ball, for set_pose and its ground truth
+BALL_NAME = 'ball'  # the simulator's name (entity) of the ball, for its state and ground truth
 MAX_NAME_LENGTH = 64
 # A ROS name token: what may stand between two slashes of a topic name.
 _TOKEN = re.compile(r'[A-Za-z][A-Za-z0-9_]*\Z')
