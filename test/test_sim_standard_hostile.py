@@ -11,6 +11,7 @@ import pytest
 from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
+from sensor_msgs.msg import CompressedImage
 from rclpy.action import ActionClient
 from simulation_interfaces import msg as si
 from simulation_interfaces import srv
@@ -333,3 +334,22 @@ def test_deleting_statics_renames_nothing_and_the_ground_stays(paused_sim):
     ground = serve(node, srv.DeleteEntity, entity='ground_0')
     assert ground.result.result == FAILED and 'ground' in ground.result.error_message
     assert still_works(node) == expected
+
+
+def test_a_robot_deleted_while_its_images_are_in_flight(make_sim, ros_context, executor):
+    """Running free, the eyes of an instant are drawn while physics steps on; a robot deleted
+    then had them published on its ended topics: InvalidHandle in the simulator's turn."""
+    node = make_sim(real_time_factor=0.0)
+    probe = Probe(ros_context, executor)
+    topics = RobotTopics(next(iter(node.robots)))
+    images = probe.watch(CompressedImage, topics.eye_compressed('caml'))
+    spin_until(executor, lambda: node.robots[topics.name].wanted_eyes())
+    play = si.SimulationState(state=si.SimulationState.STATE_PLAYING)
+    ok(serve(node, srv.SetSimulationState, state=play))
+    spin_until(executor, lambda: len(images) >= 2 and node.eyes.pending)
+    ok(serve(node, srv.DeleteEntity, entity=topics.name))
+    start = node.sim.time
+    spin_until(executor, lambda: node.sim.time > start + 0.5)  # raises what a turn raised
+    pause = si.SimulationState(state=si.SimulationState.STATE_PAUSED)
+    ok(serve(node, srv.SetSimulationState, state=pause))
+    still_works(node)

@@ -288,6 +288,9 @@ class SimNode(Node):
     def world_changed(self):
         """Robots or objects came or went: their interfaces follow."""
         if set(self.robots) != set(self.sim.robots):
+            # Images drawn while the world ran go out first: a deleted robot's, published
+            # once its topics had ended, raised InvalidHandle in the simulator's next turn.
+            self._publish_eyes(wait=True)
             self._sync_robots()
             self._make_tf()
         if self.sim_interface is not None:
