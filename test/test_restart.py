@@ -6,28 +6,30 @@ ground truth, the commands and /clock. Every assertion is on simulated time;
 wall-clock limits only guard against a hang.
 """
 import os
-import re
 import signal
 
 import pytest
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
+from simulation_interfaces.msg import Result, SimulationState
+from simulation_interfaces.srv import GetEntityState, SetSimulationState, StepSimulation
 from std_msgs.msg import Float32MultiArray
-from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.common.isolation import isolated_env
 from miro_ball.run.monitor import Monitor
 from miro_ball.run.nodes import controller_command, sim_command
 from miro_ball.run.processes import Processes
-from miro_ball.miro.interface import default_robot_name, RobotTopics, SimTopics
+from miro_ball.miro.interface import BALL_NAME, default_robot_name, RobotTopics, SimTopics
 from miro_sim_bullet.physics.robot import CMD_TIMEOUT_S
+from miro_sim_bullet.physics.world import PHYSICS_DT_S
 from rostools import drain, poll, Probe, spin_until
 
 ROBOT = default_robot_name()
 TOPICS = RobotTopics(ROBOT)
 SIM = SimTopics()
 KICK_WITHIN_S = 30.0  # simulated seconds from a controller's first command to the kick
-TICK_S = 0.02  # the platform's tick (and one ~/step with the default step_count)
+TICK_S = 0.02  # the platform's tick, a step of the simulator here
+TICK_STEPS = round(TICK_S / PHYSICS_DT_S)
 HANG_GUARD_S = 120.0
 # Once the wheels stop, the body rocks on its rear slider for up to ~0.15 s.
 SETTLE_S = 0.3
@@ -71,18 +73,35 @@ def watch_until_kicked(executor, probe, what):
 
 def step_until(executor, probe, predicate, max_steps=500):
     """Step the paused simulator a platform tick at a time until predicate() holds."""
-    client = probe.node.create_client(Trigger, SIM.step)
+    client = probe.node.create_client(StepSimulation, SIM.standard(StepSimulation))
     assert client.wait_for_service(timeout_sec=HANG_GUARD_S), 'no simulator'
     for _ in range(max_steps):
-        future = client.call_async(Trigger.Request())
+        future = client.call_async(StepSimulation.Request(steps=TICK_STEPS))
         # An answer can be lost while the service's reply path is still being matched:
         # then this tick is asked for again.
         executor.spin_until_future_complete(future, timeout_sec=2.0)
-        assert future.result() is None or future.result().success, future.result().message
+        result = future.result() and future.result().result
+        assert result is None or result.result == Result.RESULT_OK, result.error_message
         # Time for the controller to answer this tick; the limit only bounds each try.
         if poll(executor, predicate, timeout_s=0.2):
             return
     pytest.fail(f'nothing after {max_steps} ticks')
+
+
+def set_paused(executor, probe, paused):
+    wanted = SimulationState.STATE_PAUSED if paused else SimulationState.STATE_PLAYING
+    answer = probe.call(executor, SetSimulationState, SIM.standard(SetSimulationState),
+                        SetSimulationState.Request(state=SimulationState(state=wanted)))
+    assert answer.result.result in (Result.RESULT_OK,
+                                    SetSimulationState.Response.ALREADY_IN_TARGET_STATE), \
+        answer.result.error_message
+
+
+def sim_now(executor, probe):
+    """Simulated time, as the simulator stamps an entity's state."""
+    stamp = probe.call(executor, GetEntityState, SIM.standard(GetEntityState),
+                       GetEntityState.Request(entity=BALL_NAME)).state.header.stamp
+    return seconds(stamp)
 
 
 def test_controller_starts_over_and_kicks_after_the_simulator_is_killed(
@@ -100,7 +119,7 @@ def test_controller_starts_over_and_kicks_after_the_simulator_is_killed(
     commands = probe.watch(TwistStamped, TOPICS.cmd_vel)
     step_until(executor, probe, lambda: any(
         seconds(c.header.stamp) < killed_at for c in commands))
-    assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=False)).success
+    set_paused(executor, probe, False)
     watch_until_kicked(executor, probe, 'restarted simulator')
     controller.send_signal(signal.SIGINT)
     assert controller.wait(timeout=HANG_GUARD_S) == 0
@@ -120,13 +139,12 @@ def test_wheels_stop_after_the_command_timeout_when_the_controller_is_killed(
     step_until(executor, probe, lambda: wheels and any(wheels[-1].data))
     # Paused, the simulator takes whatever command is still on its way at this very
     # instant: so no command can reach it later than the pause.
-    assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True)).success
+    set_paused(executor, probe, True)
     controller.kill()
     controller.wait()
     assert not monitor.judge.kicked, 'kicked before it was killed: nothing left to test'
-    stepped = probe.call(executor, Trigger, SIM.step, Trigger.Request())
-    paused_at = float(re.search(r'time ([0-9.]+) s', stepped.message).group(1)) - TICK_S
-    assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=False)).success
+    paused_at = sim_now(executor, probe)
+    set_paused(executor, probe, False)
     assert spin_until(executor, lambda: odometry and seconds(
         odometry[-1].header.stamp) > paused_at + 2 * CMD_TIMEOUT_S, HANG_GUARD_S)
     speeds = [(seconds(m.header.stamp), max(abs(m.twist.twist.linear.x),
