@@ -131,5 +131,7 @@ class StepAction:
             while self.waiting:
                 self.waiting.popleft().end(Result.OPERATION_FAILED, 'the simulator stopped')
         self.executor.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
         self.thread.join(timeout=1.0)
+        # The server holds its node: destroyed first, or the node stays on the graph.
+        self.server.destroy()
+        self.node.destroy_node()
