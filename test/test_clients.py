@@ -336,3 +336,19 @@ def test_a_client_waiting_for_the_simulator_says_what_for_and_ends_on_ctrl_c():
     assert f"no robot '{T.name}' on ROS domain {domain}" in notice, lines
     assert 'no robot is there (is the simulator running' in notice
     assert proc.returncode == 0 and 'Traceback' not in output, output
+
+
+# As in an install built without a compiler: no simulation_interfaces to import.
+WITHOUT_STANDARD = "import sys, runpy; sys.modules['simulation_interfaces'] = None; "
+
+
+@pytest.mark.parametrize('module,args', [('miro_ball.examples.ball_mover', []),
+                                         ('miro_ball.lab', ['--no-video'])])
+def test_without_simulation_interfaces_a_tool_that_needs_it_says_so_in_one_line(module, args):
+    done = subprocess.run(
+        [sys.executable, '-c', WITHOUT_STANDARD + f'sys.argv = {[module, *args]!r}; '
+         f'runpy.run_module({module!r}, run_name="__main__")'],
+        capture_output=True, text=True, timeout=60)
+    last = done.stderr.strip().splitlines()[-1]
+    assert done.returncode == 2 and 'Traceback' not in done.stderr, done.stderr
+    assert 'no simulation_interfaces' in last and 'build_interfaces' in last

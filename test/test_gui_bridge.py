@@ -2,6 +2,8 @@
 for which page, and its deadman."""
 import dataclasses
 import json
+import subprocess
+import sys
 import time
 
 import pytest
@@ -296,6 +298,25 @@ def test_the_state_says_the_eyes_field_of_view_and_no_simulator(bridge, ros_cont
     publisher.publish(info)
     assert spin_until(executor, lambda: json.loads(bridge.state(1))['eye_fov_deg'])
     assert json.loads(bridge.state(1))['eye_fov_deg'] == pytest.approx([121.2, 63.6], abs=0.1)
+
+
+def test_without_simulation_interfaces_the_simulator_buttons_say_what_is_missing():
+    """As in an install built without a compiler: the pages still work; the simulator's
+    buttons and a drag say why they do nothing."""
+    code = ("import sys; sys.modules['simulation_interfaces'] = None\n"
+            'import rclpy\n'
+            'from miro_ball.gui.sim_link import SimLink\n'
+            'rclpy.init()\n'
+            "said = []\n"
+            "link = SimLink(rclpy.create_node('gui_probe'), said.append, print)\n"
+            "link.call('pause'); link.call('step'); link.place('ball', 0.0, 0.0)\n"
+            "print('\\n'.join(said))\n")
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0, done.stderr
+    said = done.stdout.splitlines()
+    assert [line.split(':')[0] for line in said] == ['pause', 'step', 'place']
+    assert all('no simulation_interfaces' in line for line in said), said
 
 
 def test_the_real_time_factor_is_set_on_the_simulator_and_read_back(

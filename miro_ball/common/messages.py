@@ -8,6 +8,10 @@ from miro_ball.miro.interface import frame_id
 
 # A type name as rosidl makes them: a package, msg, a CamelCase name.
 _TYPE_NAME = re.compile(r'([a-z][a-z0-9_]*)/msg/([A-Z][A-Za-z0-9]*)\Z')
+# Our tools drive the simulator through the standard simulator interfaces; an install built
+# without a compiler has none (the simulator then serves only the older aliases).
+NO_STANDARD = ('no simulation_interfaces in this install (python -m miro_ball.build_interfaces '
+               'builds it)')
 
 
 def message_class(type_name):
@@ -23,6 +27,11 @@ def message_class(type_name):
         return getattr(importlib.import_module(f'{match[1]}.msg'), match[2])
     except Exception:  # noqa: BLE001 -- whatever a broken package raises, it is no type here
         raise ValueError(f'no ROS message type {type_name!r}') from None
+
+
+def has_standard():
+    """Whether simulation_interfaces is installed (found, not imported)."""
+    return _interface_package('simulation_interfaces')
 
 
 def _interface_package(package):

@@ -14,10 +14,9 @@ import sys
 import time
 
 from rclpy.node import Node
-from simulation_interfaces.msg import EntityState, Result
-from simulation_interfaces.srv import SetEntityState
 
 from miro_ball.common.clock_guard import guard_clock
+from miro_ball.common.messages import has_standard, NO_STANDARD
 from miro_ball.common.sim_time import sim_time_overrides
 from miro_ball.common.throttle import Throttled
 from miro_ball.examples._client import number, run
@@ -33,6 +32,11 @@ def ball_y(t, amplitude, period):
 
 class BallMover(Node):
     def __init__(self, options, context=None):
+        if not has_standard():
+            raise ValueError('the ball is moved through the standard simulator services: '
+                             + NO_STANDARD)
+        from simulation_interfaces.srv import SetEntityState
+
         super().__init__('ball_mover', context=context,
                          parameter_overrides=sim_time_overrides())
         self.options = options
@@ -50,6 +54,9 @@ class BallMover(Node):
             f"sin(2 pi t / {options.period:g} s), on the simulator's /clock")
 
     def tick(self):
+        from simulation_interfaces.msg import EntityState
+        from simulation_interfaces.srv import SetEntityState
+
         now = self.get_clock().now().nanoseconds * 1e-9
         if now == 0.0:
             return  # no /clock yet
@@ -78,6 +85,8 @@ class BallMover(Node):
         future.add_done_callback(lambda done: self._taken(done, (t, y)))
 
     def _taken(self, future, command):
+        from simulation_interfaces.msg import Result
+
         if self.pending is None or self.pending[0] is not future:
             return  # given up on already
         self.pending = None

@@ -11,16 +11,27 @@ from geometry_msgs.msg import Accel, Twist
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rosgraph_msgs.msg import Clock
-from simulation_interfaces.msg import Result, SimulationState
-from simulation_interfaces.srv import (GetEntityState, GetSimulationState, ResetSimulation,
-                                       SetEntityState, SetSimulationState, StepSimulation)
 from std_msgs.msg import String, UInt16
 
 from miro_ball.common.clock_watch import clock_publishers, ClockWatch, shared_domain_line
+from miro_ball.common.messages import NO_STANDARD
 from miro_ball.common.qos import profile
 from miro_ball.common.stamps import seconds
 from miro_ball.common.throttle import Throttled
 from miro_ball.miro.interface import CLOCK, CONTROL_QOS, SimTopics
+
+try:  # built at set-up; without it the pages still see and drive, and say what is missing
+    from simulation_interfaces.msg import Result, SimulationState
+    from simulation_interfaces.srv import (GetEntityState, GetSimulationState, ResetSimulation,
+                                           SetEntityState, SetSimulationState, StepSimulation)
+    STANDARD = (GetSimulationState, SetSimulationState, StepSimulation, ResetSimulation,
+                GetEntityState, SetEntityState)
+except ModuleNotFoundError as missing:
+    if not (missing.name or '').startswith('simulation_interfaces'):
+        raise
+    STANDARD = ()  # every use asks _ready() first, which says what is missing
+    GetEntityState = GetSimulationState = ResetSimulation = SetEntityState = None
+    SetSimulationState = StepSimulation = None
 
 RTF_PARAMETER = 'real_time_factor'
 PAUSED_PARAMETER = 'paused'
@@ -52,13 +63,13 @@ class SimLink:
         self._pubs = {}
         self._sounds = 0  # placed from the pages so far (their names' numbers)
         node.create_subscription(Clock, CLOCK, self._on_clock, 10)
-        self.clients = {kind: node.create_client(kind, self.topics.standard(kind)) for kind in (
-            GetSimulationState, SetSimulationState, StepSimulation, ResetSimulation,
-            GetEntityState, SetEntityState)}
-        self.clients.update({'set_parameters': node.create_client(
-                            SetParameters, self.topics.topic('set_parameters')),
-                        'get_parameters': node.create_client(
-                            GetParameters, self.topics.topic('get_parameters'))})
+        self.clients = {kind: node.create_client(kind, self.topics.standard(kind))
+                        for kind in STANDARD}
+        self.clients.update({
+            'set_parameters': node.create_client(SetParameters,
+                                                 self.topics.topic('set_parameters')),
+            'get_parameters': node.create_client(GetParameters,
+                                                 self.topics.topic('get_parameters'))})
 
     def state(self):
         """What the pages show of the simulator; and the status line if two simulators'
@@ -74,9 +85,9 @@ class SimLink:
             paused = rtf == 0.0
         else:
             paused = bool(self.started_paused)
-        sim = {'present': self.clients[GetSimulationState].service_is_ready(),
-               'time': self.time,
-               'rtf': rtf, 'paused': paused}
+        present = self.clients[STANDARD[0] if STANDARD else 'get_parameters']
+        sim = {'present': present.service_is_ready(), 'time': self.time, 'rtf': rtf,
+               'paused': paused}
         status = (shared_domain_line(clock_publishers(self.node),
                                      self.node.context.get_domain_id())
                   if contested else None)
@@ -121,6 +132,8 @@ class SimLink:
     # -- services -------------------------------------------------------------------------------
     def call(self, action):
         """pause, resume, step or reset; the answer goes to the status line."""
+        if not self._ready(action):  # this install has the standard
+            return
         if action == 'step' and self.step_count is None:
             # How far the simulator's step goes is its own parameter: asked for first.
             if self._ready(action, StepSimulation, 'get_parameters'):
@@ -148,7 +161,11 @@ class SimLink:
         self._call(action, kind, kind.Request(**fields), done)
 
     def _ready(self, what, *kinds):
-        """Whether the simulator serves each of ``kinds``; if not, the status line says so."""
+        """Whether this install has the standard and the simulator serves each of ``kinds``;
+        if not, the status line says why."""
+        if not STANDARD:
+            self.report(f'{what}: {NO_STANDARD}')
+            return False
         if all(self.clients[kind].service_is_ready() for kind in kinds):
             return True
         self.report(f'{what}: no simulator')

@@ -45,7 +45,6 @@ class Referee:
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.parameter import Parameter
-        from simulation_interfaces.srv import SetSimulationState
 
         self.node = rclpy.create_node(name, context=context, parameter_overrides=[
             Parameter('use_sim_time', value=True)])
@@ -56,8 +55,7 @@ class Referee:
         self.monitor = Monitor(self.node, robots, on_eye=video.eye if video else None,
                                on_overhead=self._on_overhead if video else None,
                                debug_frames=debug_frames or video is not None)
-        self._set_state = self.node.create_client(
-            SetSimulationState, SimTopics().standard(SetSimulationState))
+        self._set_state = None  # made when first asked for (an in-process rig needs none)
         self.start_time = None  # simulated s when the clock was started
 
     @property
@@ -86,13 +84,24 @@ class Referee:
             self.executor.spin_once(timeout_sec=0.02)
         return True
 
+    def _state_client(self):
+        """The simulator's set_simulation_state, or RunError if this install has none."""
+        if self._set_state is None:
+            from miro_ball.common.messages import has_standard, NO_STANDARD
+            if not has_standard():
+                raise RunError(NO_STANDARD)
+            from simulation_interfaces.srv import SetSimulationState
+            self._set_state = self.node.create_client(
+                SetSimulationState, SimTopics().standard(SetSimulationState))
+        return self._set_state
+
     def set_state(self, state):
         """The simulator into simulation_interfaces' SimulationState ``state`` (or there
         already), or RunError saying why not."""
         from simulation_interfaces.msg import Result, SimulationState
         from simulation_interfaces.srv import SetSimulationState
 
-        future = self._set_state.call_async(
+        future = self._state_client().call_async(
             SetSimulationState.Request(state=SimulationState(state=state)))
         if not self.spin_until(future.done, SERVICE_TIMEOUT_S):
             raise RunError(f'the simulator did not answer {self._set_state.srv_name}')
@@ -105,7 +114,7 @@ class Referee:
     # -- before the run --------------------------------------------------------------------------
     def simulator_ready(self):
         """Its set_simulation_state answers and its ground truth reaches us."""
-        return self._set_state.service_is_ready() and not unmatched(self.monitor.truth)
+        return self._state_client().service_is_ready() and not unmatched(self.monitor.truth)
 
     def waiting_for(self, controllers=(), recorder=None):
         """What the run still waits for before its clock may start, in words ([]: nothing):
