@@ -13,7 +13,7 @@ import time
 import rclpy
 
 from miro_ball.controller.names import NODE_NAME as CONTROLLER
-from miro_ball.miro.interface import EYES
+from miro_ball.miro.interface import EYES, SIM_ACTION_NODE_NAME, SIM_NODE_NAME
 from miro_ball.run.referee import ros_domain
 from miro_sim_bullet.ros.params import SimParams
 from miro_sim_bullet.scene.world_file import load_world
@@ -93,9 +93,10 @@ def test_every_node_of_the_football_lab_run_has_a_name_of_its_own(tmp_path):
     try:
         domain = int(run.line(r'ROS domain \d+').split('ROS domain ')[1].split(';')[0])
         controllers = {f'/{robot}/{CONTROLLER}' for robot in robots}
-        names = node_names(domain, controllers | {'/miro_sim', '/miro_lab'})
+        ours = controllers | {f'/{SIM_NODE_NAME}', f'/{SIM_ACTION_NODE_NAME}', '/miro_lab'}
+        names = node_names(domain, ours)
         assert len(names) == len(set(names)), sorted(names)
-        assert sorted(names) == sorted(controllers | {'/miro_sim', '/miro_lab'})
+        assert sorted(names) == sorted(ours)
         # Ctrl+C once the simulated time runs.
         while float(PROGRESS.search(run.line(PROGRESS.pattern)).group(1)) == 0.0:
             pass

@@ -25,6 +25,9 @@ CLOCK = '/clock'
 EYES = ('caml', 'camr')  # index 0 is the left eye, as the MDK's CAM_L
 EYE_SIDE = {'caml': +1, 'camr': -1}  # +1 left, -1 right: the sign of the eye's y offset
 SIM_NODE_NAME = 'miro_sim'
+# The simulator's second node: it serves the standard's simulate_steps action (an action
+# server cannot live on the simulator's EventsExecutor: miro_sim_bullet.ros.step_action).
+SIM_ACTION_NODE_NAME = f'{SIM_NODE_NAME}_steps'
 WORLD_FRAME = 'world'  # the simulator's frame (ground truth, the scene)
 TOUCH_PARTS = ('head', 'body')
 # What a row's {placeholder} stands for (the IMUs are in the same two parts as the pads).

@@ -19,7 +19,7 @@ from geometry_msgs.msg import Vector3
 from simulation_interfaces import msg as si
 from simulation_interfaces import srv
 
-from miro_ball.miro.interface import BALL_NAME
+from miro_ball.miro.interface import BALL_NAME, SimTopics
 from miro_ball.miro.rotations import yaw_of, yaw_quaternion
 from miro_sim_bullet.control import codes
 from miro_sim_bullet.control.codes import EntityCategory, Refused, Result
@@ -29,6 +29,7 @@ from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, RobotSpa
                                               SPAWN_FORMATS, spawnables)
 from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.ros import convert
+from miro_sim_bullet.ros.sim_interface import SERVICE_QOS
 from miro_sim_bullet.scene.world_file import (Ball, named_poses, parse_world, world_catalogue,
                                               WorldError, load_world)
 
@@ -88,8 +89,7 @@ class ControlInterface:
             srv.GetSpawnables: self._spawnables, srv.GetAvailableWorlds: self._worlds,
             srv.GetCurrentWorld: self._current_world, srv.LoadWorld: self._load_world,
             srv.UnloadWorld: self._unload_world}
-        from miro_sim_bullet.ros.sim_interface import SERVICE_QOS
-        self.services = [ros.service(kind, service_name(kind), self._guarded(handler),
+        self.services = [ros.service(kind, SimTopics().standard(kind), self._guarded(handler),
                                      qos_profile=SERVICE_QOS)
                          for kind, handler in handlers.items()]
 
@@ -440,13 +440,6 @@ class ControlInterface:
         self.host.unload()
         self.forget()
         response.result = _result()
-
-
-def service_name(kind):
-    """/miro_sim/<the type in snake_case>: where implementers of the standard serve it."""
-    from miro_ball.miro.interface import SimTopics
-    snake = ''.join('_' + c.lower() if c.isupper() else c for c in kind.__name__).lstrip('_')
-    return SimTopics().topic(snake)
 
 
 def _half_height(shape):

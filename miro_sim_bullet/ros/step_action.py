@@ -18,10 +18,9 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile
 from simulation_interfaces.action import SimulateSteps
 
-from miro_ball.miro.interface import SimTopics
+from miro_ball.miro.interface import SIM_ACTION_NODE_NAME, SimTopics
 from miro_sim_bullet.control.codes import Result
 
-ACTION_NODE = 'miro_sim_steps'
 MAX_STEPS_A_TURN = 500  # steps of a goal per turn of the simulator's timer: it stays lively
 MAX_GOALS = 16  # goals accepted and not ended; more are rejected
 # Each goal accepted holds a thread until it ends: with 2 threads, two goals left none to
@@ -49,7 +48,7 @@ class StepAction:
 
     def __init__(self, host, context):
         self.host = host
-        self.node = Node(ACTION_NODE, context=context)
+        self.node = Node(SIM_ACTION_NODE_NAME, context=context)
         self.waiting = collections.deque()
         self.held = 0  # goals accepted and not ended, each on a thread of the executor
         self.lock = threading.Lock()
@@ -63,7 +62,8 @@ class StepAction:
             feedback_pub_qos_profile=QoSProfile(depth=MAX_STEPS_A_TURN))
         self.executor = MultiThreadedExecutor(num_threads=THREADS, context=context)
         self.executor.add_node(self.node)
-        self.thread = threading.Thread(target=self._spin, name=ACTION_NODE, daemon=True)
+        self.thread = threading.Thread(target=self._spin, name=SIM_ACTION_NODE_NAME,
+                                       daemon=True)
         self.thread.start()
 
     def _spin(self):
