@@ -14,7 +14,6 @@ from pathlib import Path
 
 from miro_ball.common.isolation import isolated_env, private_domain
 from miro_ball.common.lifecycle import end_process
-from miro_ball.common.messages import has_standard, NO_STANDARD
 from miro_ball.common.shm import SharedMemoryJanitor
 from miro_ball.common.stopping import StopRequest
 from miro_ball.recording.node import NODE_NAME as RECORDER
@@ -193,9 +192,6 @@ def parse_args(argv):
         parser.error('--limit must be in (0, 1e6] and --real-time-factor in [0, 1000]')
     if args.record and Path(args.record).exists():
         parser.error(f'--record: {args.record} exists already')
-    if not has_standard():  # the clock is started through it
-        parser.error('the lab run starts the clock through the standard simulator services: '
-                     + NO_STANDARD)
     return args, parser
 
 

@@ -342,8 +342,7 @@ def test_a_client_waiting_for_the_simulator_says_what_for_and_ends_on_ctrl_c():
 WITHOUT_STANDARD = "import sys, runpy; sys.modules['simulation_interfaces'] = None; "
 
 
-@pytest.mark.parametrize('module,args', [('miro_ball.examples.ball_mover', []),
-                                         ('miro_ball.lab', ['--no-video'])])
+@pytest.mark.parametrize('module,args', [('miro_ball.examples.ball_mover', [])])
 def test_without_simulation_interfaces_a_tool_that_needs_it_says_so_in_one_line(module, args):
     done = subprocess.run(
         [sys.executable, '-c', WITHOUT_STANDARD + f'sys.argv = {[module, *args]!r}; '

@@ -9,6 +9,7 @@ reported 0.0 s simulated while the robots were already at the ball.
 import time
 from contextlib import contextmanager
 
+from miro_ball.common.messages import has_standard
 from miro_ball.controller.names import NODE_NAME as CONTROLLER
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics
 from miro_ball.run.monitor import Monitor, unmatched
@@ -85,35 +86,44 @@ class Referee:
         return True
 
     def _state_client(self):
-        """The simulator's set_simulation_state, or RunError if this install has none."""
+        """The simulator's set_simulation_state; in an install built without
+        simulation_interfaces (no compiler), its older ~/pause alias, which std_srvs has."""
         if self._set_state is None:
-            from miro_ball.common.messages import has_standard, NO_STANDARD
-            if not has_standard():
-                raise RunError(NO_STANDARD)
-            from simulation_interfaces.srv import SetSimulationState
-            self._set_state = self.node.create_client(
-                SetSimulationState, SimTopics().standard(SetSimulationState))
+            if has_standard():
+                from simulation_interfaces.srv import SetSimulationState
+                self._set_state = self.node.create_client(
+                    SetSimulationState, SimTopics().standard(SetSimulationState))
+            else:
+                from std_srvs.srv import SetBool
+                self._set_state = self.node.create_client(SetBool, SimTopics().pause)
         return self._set_state
 
-    def set_state(self, state):
-        """The simulator into simulation_interfaces' SimulationState ``state`` (or there
-        already), or RunError saying why not."""
-        from simulation_interfaces.msg import Result, SimulationState
-        from simulation_interfaces.srv import SetSimulationState
-
-        future = self._state_client().call_async(
-            SetSimulationState.Request(state=SimulationState(state=state)))
+    def play(self):
+        """The simulator playing (or so already), or RunError saying why not."""
+        client = self._state_client()
+        if client.srv_type.__name__ == 'SetBool':
+            request = client.srv_type.Request(data=False)
+        else:
+            from simulation_interfaces.msg import SimulationState
+            request = client.srv_type.Request(
+                state=SimulationState(state=SimulationState.STATE_PLAYING))
+        future = client.call_async(request)
         if not self.spin_until(future.done, SERVICE_TIMEOUT_S):
-            raise RunError(f'the simulator did not answer {self._set_state.srv_name}')
-        result = future.result().result
-        if result.result not in (Result.RESULT_OK,
-                                 SetSimulationState.Response.ALREADY_IN_TARGET_STATE):
-            raise RunError(f'the simulator refused {self._set_state.srv_name}: '
-                           f'{result.error_message}')
+            raise RunError(f'the simulator did not answer {client.srv_name}')
+        answer = future.result()
+        if hasattr(answer, 'success'):
+            refused = None if answer.success else answer.message
+        else:
+            from simulation_interfaces.msg import Result
+            from simulation_interfaces.srv import SetSimulationState
+            played = (Result.RESULT_OK, SetSimulationState.Response.ALREADY_IN_TARGET_STATE)
+            refused = None if answer.result.result in played else answer.result.error_message
+        if refused is not None:
+            raise RunError(f'the simulator refused {client.srv_name}: {refused}')
 
     # -- before the run --------------------------------------------------------------------------
     def simulator_ready(self):
-        """Its set_simulation_state answers and its ground truth reaches us."""
+        """Its state service answers and its ground truth reaches us."""
         return self._state_client().service_is_ready() and not unmatched(self.monitor.truth)
 
     def waiting_for(self, controllers=(), recorder=None):
@@ -142,11 +152,9 @@ class Referee:
 
     def start_clock(self):
         """The run starts now: judged from here (Monitor.restart), the simulator resumed."""
-        from simulation_interfaces.msg import SimulationState
-
         self.monitor.restart()
         self.start_time = self.monitor.sim_time
-        self.set_state(SimulationState.STATE_PLAYING)
+        self.play()
 
     def close(self):
         if self.own_executor:
