@@ -353,3 +353,20 @@ def test_a_robot_deleted_while_its_images_are_in_flight(make_sim, ros_context, e
     pause = si.SimulationState(state=si.SimulationState.STATE_PAUSED)
     ok(serve(node, srv.SetSimulationState, state=pause))
     still_works(node)
+
+
+def test_movable_bodies_are_not_spawned_inside_each_other(paused_sim):
+    """64 boxes spawned on one spot took 15 s of physics for 50 steps; 2,500 never ended."""
+    node = paused_sim
+    where = pose(x=1.0, y=1.0)
+    one = si.SpawnEntity(allow_renaming=True, entity_resource=si.Resource(uri=BOX),
+                         initial_pose=where)
+    spawned = serve(node, srv.SpawnEntities, spawn_requests=[one] * 64)
+    codes = [r.result.result for r in spawned.results]
+    assert codes[0] == OK and set(codes[1:]) == {srv.SpawnEntity.Response.INVALID_POSE}
+    assert 'inside box1' in spawned.results[1].result.error_message
+    on_top = pose(x=1.0, y=1.0, z=0.3)
+    ok(serve(node, srv.SpawnEntity, name='stacked', uri=BOX, initial_pose=on_top))
+    ball = serve(node, srv.SpawnEntity, resource_string='[ball]\nradius = 0.05\n')
+    assert ball.result.result == srv.SpawnEntity.Response.NAME_NOT_UNIQUE
+    still_works(node)

@@ -7,6 +7,7 @@ cylinder from one table in the world file's TOML syntax (the bundled models in
 worlds/models/, or a text of one's own).
 """
 import importlib.resources
+import math
 import re
 from dataclasses import dataclass, replace
 from functools import cache
@@ -28,6 +29,7 @@ SPAWNABLE_MIRO = PACKAGE_URI + 'robots/miro.urdf'  # written from the body model
 MODELS = 'models'  # worlds/models/: the bundled spawnable shapes
 MIRO_DESCRIPTION = 'MiRo-E, with its whole ROS interface under its name'
 MAX_RESOURCE_BYTES = max(MAX_URDF_BYTES, MAX_FILE_BYTES)
+TOUCH_M = 0.01  # bodies this close only touch: one may be spawned on another
 _PACKAGE = re.compile(r'[A-Za-z][A-Za-z0-9_]*')  # a ROS package's name
 
 
@@ -120,6 +122,23 @@ def body_bounds(body):
     if body.kind == 'box':
         return entity_bounds('box', body.size)
     return entity_bounds('cylinder', (body.radius, body.length))
+
+
+def reach(body, centre, yaw):
+    """(low, high) corners of the box round a world_file Shape or Ball at ``centre`` turned
+    by ``yaw``, a centimetre smaller on every side: bodies that only touch do not reach
+    into each other."""
+    if isinstance(body, Ball) or body.kind == 'sphere':
+        half = (body.radius,) * 3
+    elif body.kind == 'cylinder':
+        half = (body.radius, body.radius, body.length / 2)
+    else:
+        c, s = abs(math.cos(yaw)), abs(math.sin(yaw))
+        sx, sy, sz = body.size
+        half = ((c * sx + s * sy) / 2, (s * sx + c * sy) / 2, sz / 2)
+    half = [max(0.0, h - TOUCH_M) for h in half]
+    return (tuple(p - h for p, h in zip(centre, half)),
+            tuple(p + h for p, h in zip(centre, half)))
 
 
 # -- the resource -----------------------------------------------------------------------

@@ -309,6 +309,13 @@ class SimWorld:
         self._added(shape.name, replace(self.description,
                                         shapes=(*self.description.shapes, shape)))
 
+    def movers_within(self, low, high):
+        """Names of the movable objects (the ball among them) whose bounding boxes reach
+        into the box from corner ``low`` to corner ``high``."""
+        found = pb.getOverlappingObjects(low, high, **self._kw()) or ()
+        bodies = {body for body, _ in found}
+        return sorted(name for name, body in self.objects.items() if body in bodies)
+
     def _check_free(self, name):
         if not name or name in self.names():
             raise ValueError(f'the name {name!r} is taken or empty')

@@ -25,7 +25,7 @@ from miro_sim_bullet.control import codes
 from miro_sim_bullet.control.codes import EntityCategory, Refused, Result
 from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter
 from miro_sim_bullet.control.poses import check_pose, check_twist, in_world, WORLD_FRAMES
-from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, RobotSpawn,
+from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, reach, RobotSpawn,
                                               SPAWN_FORMATS, spawnables)
 from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.ros import convert
@@ -332,12 +332,17 @@ class ControlInterface:
             if isinstance(spawn, RobotSpawn):
                 sim.spawn_robot(spawn.name, x, y, yaw_of(*orientation), floor=z)
             elif isinstance(spawn.body, Ball):
-                sim.spawn_ball(spawn.body, x, y, max(z, spawn.body.radius + spawn.body.floor))
+                centre = (x, y, max(z, spawn.body.radius + spawn.body.floor))
+                self._check_room(spawn, centre, 0.0)
+                sim.spawn_ball(spawn.body, *centre)
             else:
                 shape = spawn.body
                 lowest = (sim.description.ground_height or 0.0) + _half_height(shape)
-                sim.spawn_shape(dataclasses.replace(shape, position=(x, y, max(z, lowest)),
-                                                    yaw=yaw_of(*orientation)))
+                shape = dataclasses.replace(shape, position=(x, y, max(z, lowest)),
+                                            yaw=yaw_of(*orientation))
+                if shape.mass > 0:
+                    self._check_room(spawn, shape.position, shape.yaw)
+                sim.spawn_shape(shape)
         except ValueError as err:  # the world is full
             raise Refused(Result.OPERATION_FAILED, str(err)) from None
         if not isinstance(spawn, RobotSpawn) and (spawn.description or spawn.tags):
@@ -347,6 +352,15 @@ class ControlInterface:
                 tags=spawn.tags or base.tags)
         self.host.world_changed()
         return spawn.name
+
+    def _check_room(self, spawn, centre, yaw):
+        """Refused INVALID_POSE if a movable body spawned there would be inside another:
+        64 boxes spawned on one spot took 15 s of physics for 50 steps, 2,500 forever."""
+        inside = self.sim.movers_within(*reach(spawn.body, centre, yaw))
+        if inside:
+            raise Refused(codes.SpawnResult.INVALID_POSE,
+                          f'{spawn.name} there would be inside {", ".join(inside[:3])}: '
+                          'spawn it elsewhere (or on top)')
 
     def _delete(self, request, response):
         self._need_world()
