@@ -20,6 +20,7 @@ from simulation_interfaces.action import SimulateSteps
 from fuzzmsg import hostile
 from miro_ball.miro.interface import RobotTopics
 from miro_sim_bullet.ros.step_action import MAX_GOALS
+from miro_sim_bullet.scene.world_file import MAX_SHAPES, Shape
 from rostools import advance_ticks, Probe, spin_until
 
 OK = si.Result.RESULT_OK
@@ -370,3 +371,14 @@ def test_movable_bodies_are_not_spawned_inside_each_other(paused_sim):
     ball = serve(node, srv.SpawnEntity, resource_string='[ball]\nradius = 0.05\n')
     assert ball.result.result == srv.SpawnEntity.Response.NAME_NOT_UNIQUE
     still_works(node)
+
+
+def test_shapes_are_limited_per_world(paused_sim):
+    """64 a request, but requests without end: as many shapes as a world file may hold."""
+    node = paused_sim
+    for i in range(MAX_SHAPES - len(node.sim.description.shapes) - 1):
+        node.sim.spawn_shape(Shape(kind='box', position=(i % 45 * 0.3 - 6, i // 45 * 0.3 - 6,
+                                                         0.05), size=(0.1,) * 3, name=f'b{i}'))
+    ok(serve(node, srv.SpawnEntity, allow_renaming=True, uri=BOX, initial_pose=pose(z=3.0)))
+    full = serve(node, srv.SpawnEntity, allow_renaming=True, uri=BOX, initial_pose=pose(z=4.0))
+    assert full.result.result == FAILED and '2000 shapes' in full.result.error_message

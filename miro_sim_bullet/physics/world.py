@@ -15,8 +15,8 @@ from miro_sim_bullet.acoustics.hearing import Acoustics
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.robot import MiroRobot
 from miro_sim_bullet.physics.sensors import GRAVITY
-from miro_sim_bullet.scene.world_file import (BALL_NAME, MAX_ROBOTS, PICTURE_UV, RobotSpec,
-                                              Shape, World, load_world)
+from miro_sim_bullet.scene.world_file import (BALL_NAME, MAX_ROBOTS, MAX_SHAPES, PICTURE_UV,
+                                              RobotSpec, Shape, World, load_world)
 
 # Collision groups. Bit 0 stays in every mask because Bullet's ray tests carry group 1.
 # Static bodies skip each other (a wall panel touching the floor is work for nothing);
@@ -298,7 +298,10 @@ class SimWorld:
         return robot
 
     def spawn_shape(self, shape):
-        """A named box, sphere or cylinder (world_file.Shape; mass 0 = static)."""
+        """A named box, sphere or cylinder (world_file.Shape; mass 0 = static); ValueError
+        if the world has MAX_SHAPES already (a world file's limit too)."""
+        if len(self.description.shapes) >= MAX_SHAPES:
+            raise ValueError(f'the world has {MAX_SHAPES} shapes, the most it can hold')
         self._check_free(shape.name)
         body = self._add_shape(shape)
         if shape.mass > 0:
