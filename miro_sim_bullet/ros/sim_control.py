@@ -159,11 +159,11 @@ class ControlInterface:
             raise Refused(Result.INCORRECT_STATE, 'no world is loaded: load_world first')
 
     # -- entities -----------------------------------------------------------------------------
-    def entity(self, name):
+    def entity(self, name, bodies=None):
         """The Entity ``name`` is (its info), or Refused NOT_FOUND (INCORRECT_STATE with
-        no world)."""
+        no world). ``bodies``: sim.entities(), when the caller has it already."""
         self._need_world()
-        bodies = self.sim.entities()
+        bodies = self.sim.entities() if bodies is None else bodies
         if name not in bodies:
             shown = ', '.join(sorted(bodies)[:12]) + (', ...' if len(bodies) > 12 else '')
             raise Refused(Result.NOT_FOUND, f'no entity {name[:80]!r}: there are {shown}')
@@ -182,31 +182,34 @@ class ControlInterface:
         return Entity(name, category, f'a {shape.kind} ({shape.source})',
                       tuple(dict.fromkeys((shape.kind, table))))
 
-    def pose(self, name):
+    def pose(self, name, bodies=None):
         """(position, orientation) of an entity in the world frame; a robot's is its
         FOOT frame: the point on its floor under the axle, turned to its heading."""
         sim = self.sim
         if name in sim.robots:
             x, y, z, yaw = sim.robots[name].ground_truth()
             return (x, y, z), yaw_quaternion(yaw)
-        return sim.body_state(sim.entities()[name])[:2]
+        return sim.body_state((sim.entities() if bodies is None else bodies)[name])[:2]
 
     def _filtered(self, filters):
+        """([names the filters keep], sim.entities())"""
         self._need_world()
         keep = entity_filter(filters.filter, [c.category for c in filters.categories],
                              list(filters.tags.tags), filters.tags.filter_mode,
                              (filters.bounds.type,
                               [(p.x, p.y, p.z) for p in filters.bounds.points]))
-        return [name for name in self.sim.entities()
-                if keep(self.entity(name), self.pose(name)[0])]
+        # The entities once a request, not once an entity: a world of 2000 shapes.
+        bodies = self.sim.entities()
+        return [name for name in bodies
+                if keep(self.entity(name, bodies), self.pose(name, bodies)[0])], bodies
 
     def _get_entities(self, request, response):
-        response.entities = self._filtered(request.filters)
+        response.entities = self._filtered(request.filters)[0]
         response.result = _result()
 
     def _get_entities_states(self, request, response):
-        response.entities = self._filtered(request.filters)
-        response.states = [self.state_of(name) for name in response.entities]
+        response.entities, bodies = self._filtered(request.filters)
+        response.states = [self.state_of(name, bodies) for name in response.entities]
         response.result = _result()
 
     def _get_entity_state(self, request, response):
@@ -214,11 +217,12 @@ class ControlInterface:
         response.state = self.state_of(request.entity)
         response.result = _result()
 
-    def state_of(self, name):
+    def state_of(self, name, bodies=None):
         """EntityState of an entity now, ground truth in the world frame: its pose, its
         base's velocity and the mean acceleration over the last platform tick."""
-        position, orientation = self.pose(name)
-        _, _, linear, angular = self.sim.body_state(self.sim.entities()[name])
+        bodies = self.sim.entities() if bodies is None else bodies
+        position, orientation = self.pose(name, bodies)
+        _, _, linear, angular = self.sim.body_state(bodies[name])
         stamped = convert.pose(position, orientation, convert.stamp(self.sim.time))
         state = si.EntityState(header=stamped.header, pose=stamped.pose)
         state.twist.linear, state.twist.angular = _vector(linear), _vector(angular)
