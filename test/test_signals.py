@@ -176,6 +176,7 @@ OWN_LIFECYCLE = {
     # and stop their children (run/processes.py).
     'miro_ball/lab.py': 'the main job',
     'miro_ball/grade.py': 'the grader',
+    'miro_ball/launch/__main__.py': 'the launcher (test_launch: one Ctrl+C ends every process)',
 }
 
 

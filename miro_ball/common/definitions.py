@@ -67,8 +67,14 @@ def typestore():
 
 def ros2msg(type_name):
     """A type's full definition as bags and Foxglove carry it (dependencies appended);
-    KeyError if the type is unknown."""
-    return typestore().generate_msgdef(type_name, ros_version=2)[0]
+    KeyError if the type is unknown (or one it uses is: an action's feedback message, which
+    no .msg file defines)."""
+    from rosbags.typesys.base import TypesysError
+
+    try:
+        return typestore().generate_msgdef(type_name, ros_version=2)[0]
+    except TypesysError as err:
+        raise KeyError(type_name) from err
 
 
 def register_own_types(typestore):
