@@ -1,13 +1,9 @@
 """The lab run as a user runs it: every node of the run has a name of its own, and the run is
 watched from its first instant (the simulator waits, paused, for the controllers and
 its own observer)."""
-import os
-import queue
 import re
 import signal
-import subprocess
 import sys
-import threading
 import time
 
 import rclpy
@@ -17,6 +13,7 @@ from miro_ball.miro.interface import EYES, SIM_ACTION_NODE_NAME, SIM_NODE_NAME
 from miro_ball.run.referee import ros_domain
 from miro_sim_bullet.ros.params import SimParams
 from miro_sim_bullet.scene.world_file import load_world
+from program import Program
 from rostools import run_command
 
 HANG_GUARD_S = 180.0
@@ -24,48 +21,6 @@ FOOTBALL = 'football_pitch'  # three robots: miro01, miro02, miro03
 FRAMES_PER_ROBOT_S = SimParams().camera_rate * len(EYES)
 PROGRESS = re.compile(r'^  t = +([0-9.]+) s simulated, ball moved [0-9.]+ m, (\d+) frames',
                       re.M)
-
-
-class LabRun:
-    """The lab run as a process of its own; its output read line by line as it comes."""
-
-    def __init__(self, *args):
-        self.proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.lab', *args],
-                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                     text=True, start_new_session=True)
-        self.lines, self.output = queue.Queue(), []
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self):
-        for line in self.proc.stdout:
-            self.lines.put(line)
-        self.lines.put(None)
-
-    def line(self, pattern):
-        """The first line from now on that matches pattern (a hang guard only)."""
-        deadline = time.monotonic() + HANG_GUARD_S
-        while time.monotonic() < deadline:
-            try:
-                line = self.lines.get(timeout=1.0)
-            except queue.Empty:
-                continue
-            assert line is not None, 'the lab run ended:\n' + ''.join(self.output)
-            self.output.append(line)
-            if re.search(pattern, line):
-                return line
-        raise AssertionError('hung:\n' + ''.join(self.output))
-
-    def finish(self):
-        """Its exit code and whole output, once it ended."""
-        try:
-            self.proc.wait(timeout=HANG_GUARD_S)
-        finally:
-            if self.proc.poll() is None:
-                os.killpg(self.proc.pid, signal.SIGKILL)
-                self.proc.wait()
-        while (line := self.lines.get(timeout=HANG_GUARD_S)) is not None:
-            self.output.append(line)
-        return self.proc.returncode, ''.join(self.output)
 
 
 def node_names(domain, wanted):
@@ -88,17 +43,17 @@ def test_every_node_of_the_football_lab_run_has_a_name_of_its_own(tmp_path):
     robots = [spec.name for spec in load_world(FOOTBALL).robots]
     # A quarter of real time: the Ctrl+C below comes at the first progress line after the
     # start (2 s of wall time), long before a kick ends the run (at real time, once, it came first).
-    run = LabRun('--world', FOOTBALL, '--no-video', '--limit', '60', '--real-time-factor',
-                '0.25', '--out', str(tmp_path))
+    run = Program('miro_ball.lab', '--world', FOOTBALL, '--no-video', '--limit', '60', '--real-time-factor',
+                  '0.25', '--out', str(tmp_path), guard_s=HANG_GUARD_S)
     try:
-        domain = int(run.line(r'ROS domain \d+').split('ROS domain ')[1].split(';')[0])
+        domain = int(run.line('ROS domain ').split('ROS domain ')[1].split(';')[0])
         controllers = {f'/{robot}/{CONTROLLER}' for robot in robots}
         ours = controllers | {f'/{SIM_NODE_NAME}', f'/{SIM_ACTION_NODE_NAME}', '/miro_lab'}
         names = node_names(domain, ours)
         assert len(names) == len(set(names)), sorted(names)
         assert sorted(names) == sorted(ours)
         # Ctrl+C once the simulated time runs.
-        while float(PROGRESS.search(run.line(PROGRESS.pattern)).group(1)) == 0.0:
+        while float(PROGRESS.search(run.line('  t = ')).group(1)) == 0.0:
             pass
     finally:
         run.proc.send_signal(signal.SIGINT)

@@ -1,11 +1,8 @@
 """python -m miro_ball.launch as a user runs it: the football pitch comes up from one command
 (the simulator, a controller per robot, the GUI), a robot kicks, and one Ctrl+C ends every
 process; a process that ends stops the others, unless its file says respawn."""
-import queue
 import signal
-import subprocess
 import sys
-import threading
 import time
 import urllib.request
 
@@ -14,60 +11,26 @@ from geometry_msgs.msg import PointStamped
 from miro_ball.common import proc_tree
 from miro_ball.controller.names import NODE_NAME as CONTROLLER
 from miro_ball.miro.interface import SimTopics
-from rostools import Probe, kill_if_running, spin_until
+from program import Program
+from rostools import Probe, spin_until
 
-UP_GUARD_S = 120.0  # hang guards only
-STOP_GUARD_S = 10.0
+UP_GUARD_S = 120.0  # a hang guard only
 ROBOTS = ('miro01', 'miro02', 'miro03')  # the football pitch's
 
 
-class Launch:
+class Launch(Program):
     """python -m miro_ball.launch ... in a session of its own, its output read as it comes."""
 
     def __init__(self, *args):
-        self.proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.launch', *args],
-                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                     text=True, start_new_session=True)
-        self.lines, self.output = queue.Queue(), []
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self):
-        for line in self.proc.stdout:
-            self.lines.put(line)
-        self.lines.put(None)
-
-    def line(self, text):
-        """The first line from now on that holds text."""
-        deadline = time.monotonic() + UP_GUARD_S
-        while time.monotonic() < deadline:
-            try:
-                line = self.lines.get(timeout=0.5)
-            except queue.Empty:
-                continue
-            assert line is not None, 'the launch ended:\n' + ''.join(self.output)
-            self.output.append(line)
-            if text in line:
-                return line
-        raise AssertionError(f'no {text!r}:\n' + ''.join(self.output))
+        super().__init__('miro_ball.launch', *args, guard_s=UP_GUARD_S)
 
     def ctrl_c(self):
         """One SIGINT; (exit code, seconds to exit, the descendants left, its whole output)."""
         children = proc_tree.descendants(self.proc.pid)
         sent = time.monotonic()
         self.proc.send_signal(signal.SIGINT)
-        return self.finish(sent, children)
-
-    def finish(self, since=None, children=()):
-        since = since or time.monotonic()
-        try:
-            self.proc.wait(timeout=STOP_GUARD_S)
-        finally:
-            kill_if_running(self.proc)
-        seconds = time.monotonic() - since
-        while (line := self.lines.get(timeout=STOP_GUARD_S)) is not None:
-            self.output.append(line)
-        return self.proc.returncode, seconds, proc_tree.wait_gone(children, 0), \
-            ''.join(self.output)
+        code, output = self.finish()
+        return code, time.monotonic() - sent, proc_tree.wait_gone(children, 0), output
 
 
 def test_football_comes_up_from_one_command_a_robot_kicks_and_one_ctrl_c_ends_it_all(
@@ -119,7 +82,7 @@ sys.exit(3)
 """)
     launch = Launch(launch_file(tmp_path, f'''<executable name="waiter" cmd="{waiter}"/>
                                             <executable name="quitter" cmd="{quitter}"/>'''))
-    code, _, _, output = launch.finish()
+    code, output = launch.finish()
     assert code == 1, output
     assert '[quitter] bye\n[launch] quitter exited with code 3; stopping the others\n' in output
     assert output.endswith('[waiter] stopped by Ctrl+C\n[launch] ended\n'), output
