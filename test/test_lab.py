@@ -43,8 +43,8 @@ def test_every_node_of_the_football_lab_run_has_a_name_of_its_own(tmp_path):
     robots = [spec.name for spec in load_world(FOOTBALL).robots]
     # A quarter of real time: the Ctrl+C below comes at the first progress line after the
     # start (2 s of wall time), long before a kick ends the run (at real time, once, it came first).
-    run = Program('miro_ball.lab', '--world', FOOTBALL, '--no-video', '--limit', '60', '--real-time-factor',
-                  '0.25', '--out', str(tmp_path), guard_s=HANG_GUARD_S)
+    run = Program('miro_ball.lab', '--world', FOOTBALL, '--no-video', '--limit', '60',
+                  '--real-time-factor', '0.25', '--out', str(tmp_path), guard_s=HANG_GUARD_S)
     try:
         domain = int(run.line('ROS domain ').split('ROS domain ')[1].split(';')[0])
         controllers = {f'/{robot}/{CONTROLLER}' for robot in robots}

@@ -1,9 +1,11 @@
 """The simulator's own ROS interface under /miro_sim/ (SimTopics), beside each robot's.
 
 Ground truth of every movable object and robot in the 'world' frame, the overhead
-view, set_pose, the sounds played and stopped, and the reset, pause and step services. What these do to time (a
-reset starts the schedule over, a step advances it) belongs to the node that paces
-the world, so the services call the functions it hands in.
+view, the sounds played and stopped, and the older set_pose topic and reset, pause and
+step services: thin aliases of the standard's set_entity_state, reset_simulation,
+set_simulation_state and step_simulation (sim_control), kept for old scripts. What these
+do to time (a reset starts the schedule over, a step advances it) belongs to the node that
+paces the world, so the services call the functions it hands in.
 """
 from geometry_msgs.msg import PointStamped, PoseStamped
 from rclpy.clock import Clock, ClockType
