@@ -266,8 +266,11 @@ class SimWorld:
     def body_state(self, body):
         """(position, orientation xyzw, linear velocity, angular velocity) of a body's base
         in the world frame."""
-        kw = self._kw()
-        return (*pb.getBasePositionAndOrientation(body, **kw), *pb.getBaseVelocity(body, **kw))
+        return (*pb.getBasePositionAndOrientation(body, **self._kw()), *self.body_velocity(body))
+
+    def body_velocity(self, body):
+        """(linear, angular) velocity of a body's base in the world frame."""
+        return pb.getBaseVelocity(body, **self._kw())
 
     def set_body_velocity(self, body, linear, angular):
         pb.resetBaseVelocity(body, linear, angular, **self._kw())

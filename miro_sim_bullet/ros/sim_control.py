@@ -239,7 +239,7 @@ class ControlInterface:
         sim = self.sim
         bodies = {**{name: robot.body_id for name, robot in sim.robots.items()},
                   **sim.objects}
-        self._velocity = {name: ((sim.time, *sim.body_state(body)[2:]),
+        self._velocity = {name: ((sim.time, *sim.body_velocity(body)),
                                  self._velocity.get(name, (None,))[0])
                           for name, body in bodies.items()}
 
