@@ -66,10 +66,11 @@ def _result(code=Result.OK, message=''):
 class ControlInterface:
     """The services of the standard, made with ros (Endpoints) for ``host``, the node:
     it has ``sim`` (the SimWorld), ``state`` (codes.SimulationState), ``robot_name`` (for
-    a world's unnamed robot), ``world_folders`` (more worlds to list) and the acts
-    act(action) ('play', 'pause', 'stop', 'quit'), step(n) -> (done, message),
-    reset(scope), world_changed() and load(world) / unload(). warn(kind, message) is a
-    rate-limited warning, errors(text) logs a failure of ours (with its traceback)."""
+    a world's unnamed robot), ``world_uri`` (of the world loaded), ``sound_folders`` (where
+    a world's sound files may come from), said(kind, text) (a rate-limited info line) and
+    the acts act(action) ('play', 'pause', 'stop', 'quit'), step(n) -> (done, message),
+    reset(scope), world_changed() and load(world, uri) / unload(). warn(kind, message) is
+    a rate-limited warning, errors(text) logs a failure of ours (with its traceback)."""
 
     def __init__(self, ros, host, warn, errors):
         self.host, self._warn, self._errors = host, warn, errors
@@ -355,6 +356,9 @@ class ControlInterface:
                 base, description=spawn.description or base.description,
                 tags=spawn.tags or base.tags)
         self.host.world_changed()
+        what = 'MiRo-E' if isinstance(spawn, RobotSpawn) else 'the ball' \
+            if isinstance(spawn.body, Ball) else f'a {spawn.body.kind}'
+        self.host.said('spawn', f'spawned {spawn.name} ({what}) at ({x:.3f}, {y:.3f}, {z:.3f})')
         return spawn.name
 
     def _check_room(self, spawn, centre, yaw):
@@ -375,6 +379,7 @@ class ControlInterface:
             raise Refused(Result.OPERATION_FAILED, str(err)) from None
         self.info.pop(request.entity, None)
         self.host.world_changed()
+        self.host.said('delete', f'deleted {request.entity}')
         response.result = _result()
 
     def forget(self):
