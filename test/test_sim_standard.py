@@ -169,7 +169,9 @@ def test_a_spawned_miro_drives_on_its_own_topics(sim):
 
 def test_a_box_is_spawned_and_deleted_and_the_ball_moved(sim):
     _, client = sim
-    ok(client.call(srv.SpawnEntity, name='crate',
+    beside = PoseStamped()  # not where MiRo stands: a body is not spawned inside another
+    beside.pose.position.x = beside.pose.position.y = 0.5
+    ok(client.call(srv.SpawnEntity, name='crate', initial_pose=beside,
                    uri='package://miro_ball/worlds/models/box.toml'))
     assert 'crate' in names(client)
     ok(client.call(srv.DeleteEntity, entity='crate'))

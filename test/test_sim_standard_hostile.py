@@ -115,7 +115,8 @@ def test_numbers_that_would_poison_physics_are_refused(paused_sim):
     ok(serve(node, srv.SetEntityState, entity='ball', state=entity_state(pose(z=0.2, q=huge))))
     q = ok(serve(node, srv.GetEntityState, entity='ball')).state.pose.orientation
     assert (q.x, q.y) == pytest.approx((2 ** -0.5, 2 ** -0.5))
-    ok(serve(node, srv.SpawnEntity, name='tilted', uri=MIRO_URDF, initial_pose=pose(q=huge)))
+    ok(serve(node, srv.SpawnEntity, name='tilted', uri=MIRO_URDF,
+             initial_pose=pose(x=-0.6, y=0.6, q=huge)))
     node.advance(100)
     still_works(node)
 
@@ -166,9 +167,11 @@ def test_robots_are_limited_per_request_and_per_world(paused_sim):
     many = serve(node, srv.SpawnEntities, spawn_requests=[one] * 10000)
     assert many.result.result == FAILED and 'at most 64' in many.result.error_message
     assert len(node.sim.robots) == 1
-    for _ in range(15):
-        ok(serve(node, srv.SpawnEntity, allow_renaming=True, uri=MIRO_URDF))
-    full = serve(node, srv.SpawnEntity, allow_renaming=True, uri=MIRO_URDF)
+    for k in range(15):  # half a metre apart: a MiRo is not spawned inside another
+        ok(serve(node, srv.SpawnEntity, allow_renaming=True, uri=MIRO_URDF,
+                 initial_pose=pose(x=-2.0 + 0.5 * (k % 5), y=1.0 + 0.5 * (k // 5))))
+    full = serve(node, srv.SpawnEntity, allow_renaming=True, uri=MIRO_URDF,
+                 initial_pose=pose(x=-2.0, y=-1.0))
     assert full.result.result == FAILED and '16 robots' in full.result.error_message
     for name in list(node.sim.robots):  # every robot gone, its topics with it
         ok(serve(node, srv.DeleteEntity, entity=name))
@@ -308,7 +311,7 @@ def test_name_filters_that_backtrack_forever_in_re_answer_at_once(paused_sim):
     named so, then one get_entities, and the simulator hung for good."""
     node = paused_sim
     long_name = 'a' * 60 + '_1'
-    ok(serve(node, srv.SpawnEntity, name=long_name, uri=BOX))
+    ok(serve(node, srv.SpawnEntity, name=long_name, uri=BOX, initial_pose=pose(x=1.0, y=1.0)))
     for pattern, kept in (('(a+)+$', []), ('^(a|aa)*_', [long_name]),
                           ('a*' * 100 + 'Q', []), ('^(a*)*_[[:digit:]]$', [long_name]),
                           ('x{1,5000}', None), ('[a-z]{0,900}Q', [])):
@@ -370,6 +373,20 @@ def test_movable_bodies_are_not_spawned_inside_each_other(paused_sim):
     ok(serve(node, srv.SpawnEntity, name='stacked', uri=BOX, initial_pose=on_top))
     ball = serve(node, srv.SpawnEntity, resource_string='[ball]\nradius = 0.05\n')
     assert ball.result.result == srv.SpawnEntity.Response.NAME_NOT_UNIQUE
+    still_works(node)
+
+
+def test_a_miro_is_not_spawned_inside_another_or_a_box_inside_a_miro(paused_sim):
+    """A MiRo spawned on the one at the origin (no pose given) threw both across the room."""
+    node = paused_sim
+    robot = next(iter(node.robots))
+    on_it = serve(node, srv.SpawnEntity, name='miro_b', uri=MIRO_URDF)
+    assert on_it.result.result == srv.SpawnEntity.Response.INVALID_POSE
+    assert f'inside {robot}' in on_it.result.error_message
+    box = serve(node, srv.SpawnEntity, name='crate', uri=BOX)
+    assert box.result.result == srv.SpawnEntity.Response.INVALID_POSE
+    ok(serve(node, srv.SpawnEntity, name='miro_b', uri=MIRO_URDF,
+                    initial_pose=pose(x=-0.6, y=0.6)))
     still_works(node)
 
 

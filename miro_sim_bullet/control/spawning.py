@@ -19,7 +19,7 @@ import miro_ball
 from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_ball.miro.urdf import MAX_URDF_BYTES, urdf
 from miro_sim_bullet.control.codes import Refused, SpawnResult
-from miro_sim_bullet.control.entities import entity_bounds
+from miro_sim_bullet.control.entities import entity_bounds, ROBOT_BOX
 from miro_sim_bullet.scene.world_file import (Ball, BUNDLED_URI, load_entity, MAX_FILE_BYTES,
                                               WorldError)
 
@@ -122,6 +122,19 @@ def body_bounds(body):
     if body.kind == 'box':
         return entity_bounds('box', body.size)
     return entity_bounds('cylinder', (body.radius, body.length))
+
+
+def robot_reach(foot, yaw):
+    """(low, high) corners of the box round a MiRo standing at ``foot`` (the point on its
+    floor under the axle) turned by ``yaw``, a centimetre smaller on every side."""
+    (top, bottom), c, s = ROBOT_BOX, math.cos(yaw), math.sin(yaw)
+    corners = [(foot[0] + c * x - s * y, foot[1] + s * x + c * y)
+               for x in (bottom[0], top[0]) for y in (bottom[1], top[1])]
+    low = (min(p[0] for p in corners) + TOUCH_M, min(p[1] for p in corners) + TOUCH_M,
+           foot[2] + bottom[2] + TOUCH_M)
+    high = (max(p[0] for p in corners) - TOUCH_M, max(p[1] for p in corners) - TOUCH_M,
+            foot[2] + top[2] - TOUCH_M)
+    return low, high
 
 
 def reach(body, centre, yaw):

@@ -316,11 +316,12 @@ class SimWorld:
                                         shapes=(*self.description.shapes, shape)))
 
     def movers_within(self, low, high):
-        """Names of the movable objects (the ball among them) whose bounding boxes reach
-        into the box from corner ``low`` to corner ``high``."""
+        """Names of the movable objects (the ball among them) and robots whose bounding
+        boxes reach into the box from corner ``low`` to corner ``high``."""
         found = pb.getOverlappingObjects(low, high, **self._kw()) or ()
         bodies = {body for body, _ in found}
-        return sorted(name for name, body in self.objects.items() if body in bodies)
+        movers = {**self.objects, **{name: r.body_id for name, r in self.robots.items()}}
+        return sorted(name for name, body in movers.items() if body in bodies)
 
     def _check_free(self, name):
         if not name or name in self.names():

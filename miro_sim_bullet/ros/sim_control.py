@@ -25,8 +25,8 @@ from miro_sim_bullet.control import codes
 from miro_sim_bullet.control.codes import EntityCategory, Refused, Result
 from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter
 from miro_sim_bullet.control.poses import check_pose, check_twist, in_world, WORLD_FRAMES
-from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, reach, RobotSpawn,
-                                              SPAWN_FORMATS, spawnables)
+from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, reach, robot_reach,
+                                              RobotSpawn, SPAWN_FORMATS, spawnables)
 from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.sim_interface import SERVICE_QOS
@@ -335,10 +335,11 @@ class ControlInterface:
                                                   codes.SpawnResult.INVALID_POSE)
         try:
             if isinstance(spawn, RobotSpawn):
+                self._check_room(spawn.name, robot_reach((x, y, z), yaw_of(*orientation)))
                 sim.spawn_robot(spawn.name, x, y, yaw_of(*orientation), floor=z)
             elif isinstance(spawn.body, Ball):
                 centre = (x, y, max(z, spawn.body.radius + spawn.body.floor))
-                self._check_room(spawn, centre, 0.0)
+                self._check_room(spawn.name, reach(spawn.body, centre, 0.0))
                 sim.spawn_ball(spawn.body, *centre)
             else:
                 shape = spawn.body
@@ -346,7 +347,7 @@ class ControlInterface:
                 shape = dataclasses.replace(shape, position=(x, y, max(z, lowest)),
                                             yaw=yaw_of(*orientation))
                 if shape.mass > 0:
-                    self._check_room(spawn, shape.position, shape.yaw)
+                    self._check_room(spawn.name, reach(shape, shape.position, shape.yaw))
                 sim.spawn_shape(shape)
         except ValueError as err:  # the world is full
             raise Refused(Result.OPERATION_FAILED, str(err)) from None
@@ -361,13 +362,14 @@ class ControlInterface:
         self.host.said('spawn', f'spawned {spawn.name} ({what}) at ({x:.3f}, {y:.3f}, {z:.3f})')
         return spawn.name
 
-    def _check_room(self, spawn, centre, yaw):
-        """Refused INVALID_POSE if a movable body spawned there would be inside another:
-        64 boxes spawned on one spot took 15 s of physics for 50 steps, 2,500 forever."""
-        inside = self.sim.movers_within(*reach(spawn.body, centre, yaw))
+    def _check_room(self, name, box):
+        """Refused INVALID_POSE if a movable body or robot spawned into ``box`` (low, high
+        corners) would be inside a movable object or robot: 64 boxes spawned on one spot
+        took 15 s of physics for 50 steps, 2,500 forever; a MiRo on a MiRo threw both."""
+        inside = self.sim.movers_within(*box)
         if inside:
             raise Refused(codes.SpawnResult.INVALID_POSE,
-                          f'{spawn.name} there would be inside {", ".join(inside[:3])}: '
+                          f'{name} there would be inside {", ".join(inside[:3])}: '
                           'spawn it elsewhere (or on top)')
 
     def _delete(self, request, response):
