@@ -59,8 +59,9 @@ class Client:
 
 @pytest.fixture(scope='module')
 def sim():
+    # Named on the command line, as a launch file names it.
     proc = subprocess.Popen([sys.executable, '-m', 'miro_sim_bullet', '--robot', 'miro',
-                             '--ros-args', '-p', 'paused:=true'],
+                             '--ros-args', '-r', '__node:=miro_sim', '-p', 'paused:=true'],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     client = Client()
     try:
@@ -91,6 +92,18 @@ def test_features_name_everything_the_client_uses(sim):
                    F.AVAILABLE_WORLDS, F.ENTITY_CATEGORIES, F.SPAWNING_ENTITIES):
         assert needed in features
     assert 'urdf' in client.call(srv.GetSimulatorFeatures).features.spawn_formats
+
+
+def test_the_simulators_two_nodes_have_names_of_their_own(sim):
+    _, client = sim  # the action's node kept its name under `-r __node:=miro_sim`
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
+        names = [f'{ns.rstrip("/")}/{name}'
+                 for name, ns in client.node.get_node_names_and_namespaces()]
+        if '/miro_sim_steps' in names:
+            break
+        client.executor.spin_once(timeout_sec=0.1)
+    assert names.count('/miro_sim') == 1 and names.count('/miro_sim_steps') == 1, names
 
 
 def test_pause_step_by_service_and_by_action(sim):

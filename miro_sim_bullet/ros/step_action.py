@@ -48,7 +48,10 @@ class StepAction:
 
     def __init__(self, host, context):
         self.host = host
-        self.node = Node(SIM_ACTION_NODE_NAME, context=context)
+        # Not the command line's remaps: `-r __node:=miro_sim` (what a launch file's node
+        # name becomes) would name this node miro_sim too.
+        self.node = Node(SIM_ACTION_NODE_NAME, context=context, use_global_arguments=False,
+                         start_parameter_services=False)
         self.waiting = collections.deque()
         self.held = 0  # goals accepted and not ended, each on a thread of the executor
         self.lock = threading.Lock()
