@@ -75,6 +75,15 @@ def test_raw_eye_images_only_when_asked_for_or_named():
     assert not Selection([ROBOT.odom]).leaves_out_raw(raw)  # not selected anyway: no word
 
 
+def test_hidden_topics_only_when_named():
+    # An action's internals: ros2 bag record -a leaves them out too (the simulator's
+    # simulate_steps feedback, a type the bag could not even describe).
+    feedback = '/miro_sim/simulate_steps/_action/feedback'
+    assert not Selection().wants(feedback) and not Selection(['/miro_sim/*']).wants(feedback)
+    assert Selection([feedback]).wants(feedback)
+    assert Selection().wants(SimTopics().ball)
+
+
 def test_stamps_come_from_the_first_field_when_it_is_a_time():
     assert has_stamp(TYPES, 'nav_msgs/msg/Odometry') and has_stamp(TYPES, 'rosgraph_msgs/msg/Clock')
     assert not has_stamp(TYPES, 'std_msgs/msg/Float32MultiArray')

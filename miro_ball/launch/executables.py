@@ -44,6 +44,9 @@ def command(process, scripts=console_scripts, python=sys.executable):
         raise LaunchError(f'{process.source}: {process.exec} is {found[process.exec]!r}, not '
                           'module:function')
     # As its console script would: the program's name in sys.argv[0] (its --help says it).
-    start = (f'import sys; from {module} import {function}; sys.argv[0] = {process.exec!r}; '
+    # A Ctrl+C while it still imports (the launch stopped at once: another process failed)
+    # ends it quietly; the program's own handling of Ctrl+C takes over once it runs.
+    start = ('import signal, sys; signal.signal(signal.SIGINT, lambda *_: sys.exit(130)); '
+             f'from {module} import {function}; sys.argv[0] = {process.exec!r}; '
              f'sys.exit({function}())')
     return [python, '-c', start, *process.args, *ros_args(process)]

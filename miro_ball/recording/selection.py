@@ -4,7 +4,8 @@ Topic selection: an argument with a slash (or a wildcard) is a topic name or an
 fnmatch pattern ('/<robot>/sensors/*'); a bare name is a robot, which selects every
 topic under /<name>/ (robot_description and joint_states among them), the simulator's
 ground truth of that robot and /tf and /tf_static (which hold every robot's frames), so
-the bag draws MiRo in Foxglove. Nothing named selects everything. The robots' raw eye images are left out unless asked
+the bag draws MiRo in Foxglove. Nothing named selects everything but hidden topics (an
+action's internals, as ros2 bag leaves them out). The robots' raw eye images are left out unless asked
 for (raw_images) or named as topics: they are the JPEG frames again, uncompressed
 (about 20 MB/s a robot), and the simulator renders them only for a subscriber.
 
@@ -57,7 +58,11 @@ class Selection:
         return self._matches(topic) and self._raw_left_out(topic)
 
     def _matches(self, topic):
-        return (any(fnmatch.fnmatchcase(topic, p) for p in self.include)
+        # Hidden topics (a part starting with '_': an action's goal status and feedback)
+        # only when named, as `ros2 bag record -a` leaves them out.
+        hidden = any(part.startswith('_') for part in topic.split('/'))
+        return ((not hidden or topic in self.named)
+                and any(fnmatch.fnmatchcase(topic, p) for p in self.include)
                 and not any(fnmatch.fnmatchcase(topic, p) for p in self.exclude))
 
     def _raw_left_out(self, topic):
