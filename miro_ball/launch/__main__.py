@@ -43,7 +43,7 @@ def build_parser():
                     '(exit code 1), unless the file says respawn. The subset of the format it '
                     'runs is in docs/launch.md.',
         epilog=bundled_help())
-    parser.add_argument('file', metavar='FILE_OR_NAME',
+    parser.add_argument('file', metavar='FILE_OR_NAME', nargs='?',
                         help='a launch file, or the name of one of miro_ball\'s (football)')
     parser.add_argument('assignments', nargs='*', metavar='name:=value',
                         help='values of the file\'s arguments')
@@ -65,6 +65,8 @@ def given(assignments, parser):
 def main(argv=None):
     parser = build_parser()
     options = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    if options.file is None:  # argparse would say name:=value is required too: it is not
+        parser.error('give a launch file or the name of one')
     try:
         path = find(options.file)
         plan = make_plan(path, given(options.assignments, parser), share_folder, os.environ)

@@ -313,13 +313,15 @@ class SimNode(Node):
         finally:
             self.loading = False
         self.pause(True)
-        self.get_logger().info(f'world {world.source} loaded; robots '
-                               f'{", ".join(self.robots) or "none"}; paused')
+        if uri or world.robots:  # not unload()'s empty world
+            self.get_logger().info(f'world {world.source} loaded; robots '
+                                   f'{", ".join(self.robots) or "none"}; paused')
 
     def unload(self):
         """No world: nothing in it, nothing to step, until load()."""
         self.load(World(name='', source='(no world)', robots=()), '')
         self.no_world = True
+        self.get_logger().info('world unloaded: no world until load_world')
 
     def pause(self, paused):
         """Pause or run; whether paused now. Through the parameter, so that it always says

@@ -20,9 +20,11 @@ class SimParams:
     real_time_factor: float = field(
         default=1.0, metadata={'help': 'simulated seconds per wall second; 0 = as fast as possible',
                                'range': (0.0, 1000.0)})
-    paused: bool = field(default=False, metadata={'help': 'start paused (use ~/pause, ~/step)'})
+    paused: bool = field(default=False, metadata={
+        'help': 'start paused (then set_simulation_state, step_simulation)'})
     step_count: int = field(
-        default=10, metadata={'help': 'physics steps per ~/step call (10 = one 20 ms tick at 2 ms)',
+        default=10, metadata={'help': 'physics steps per ~/step call, the older alias of '
+                                      'step_simulation (10 = one 20 ms tick at 2 ms)',
                               'range': (1, 100000)})
     physics_dt: float = field(default=PHYSICS_DT_S, metadata={'help': 'physics step, s',
                                                               'range': (0.0001, 0.02)})
