@@ -40,7 +40,7 @@ def entity_filter(pattern, categories, tags, tag_mode, bounds):
     """
     name_test = _name_test(pattern)
     wanted = _categories(categories)
-    tag_test = _tag_test(tags, tag_mode)
+    tag_test = tag_filter(tags, tag_mode)
     inside = _bounds_test(bounds)
 
     def keep(entity, position):
@@ -87,7 +87,9 @@ def _categories(categories):
     return set(categories)
 
 
-def _tag_test(tags, mode):
+def tag_filter(tags, mode):
+    """A test ``keep(tags)`` of a TagsFilter (named poses and worlds are filtered so too);
+    Refused for a mode that does not exist."""
     if mode not in (TagsFilter.ANY, TagsFilter.ALL):
         raise Refused(Result.OPERATION_FAILED, f'unknown tags filter mode {mode!r}: '
                                                f'{TagsFilter.ANY} (any) or {TagsFilter.ALL} (all)')

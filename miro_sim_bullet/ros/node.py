@@ -277,13 +277,18 @@ class SimNode(Node):
                 self.sim.reset_state()
             if bits & 0b001:
                 self.sim.reset_time()
+        self._rebuilt(keep_time=not bits & 0b001 and bits not in (0, 0b111))
+        self.said('reset', f'world reset (scope {scope})')
+
+    def _rebuilt(self, keep_time):
+        """The world was reset or another loaded: what was said of the one before goes, the
+        interfaces follow its entities, the schedule its time."""
         if self.sim_interface is not None:
             self.sim_interface.forget_touches()
         if self.control is not None:
             self.control.forget()
         self.world_changed()
-        self._restart_schedule(keep_time=not bits & 0b001 and bits not in (0, 0b111))
-        self.said('reset', f'world reset (scope {scope})')
+        self._restart_schedule(keep_time=keep_time)
 
     def world_changed(self):
         """Robots or objects came or went: their interfaces follow."""
@@ -304,10 +309,10 @@ class SimNode(Node):
             self._publish_eyes(wait=True)
             self.eyes.close()
             self.cameras.close()
-            self.sim.load(world)
+            self.sim.load(world)  # built once, here
             self._make_cameras()
             self.world_uri, self.no_world = uri, False
-            self.reset(0)
+            self._rebuilt(keep_time=False)
             if self.sim_interface is not None:
                 self.sim_interface.world_loaded(self.cameras)
         finally:

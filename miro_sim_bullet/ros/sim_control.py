@@ -23,7 +23,7 @@ from miro_ball.miro.interface import BALL_NAME, SimTopics
 from miro_ball.miro.rotations import yaw_of, yaw_quaternion
 from miro_sim_bullet.control import codes
 from miro_sim_bullet.control.codes import EntityCategory, Refused, Result
-from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter
+from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter, tag_filter
 from miro_sim_bullet.control.poses import check_pose, check_twist, in_world, WORLD_FRAMES
 from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, reach, robot_reach,
                                               RobotSpawn, SPAWN_FORMATS, spawnables)
@@ -392,10 +392,9 @@ class ControlInterface:
     # -- named poses, spawnables, worlds ------------------------------------------------------
     def _named_poses(self, request, response):
         self._need_world()
-        keep = entity_filter('', [], list(request.tags.tags), request.tags.filter_mode,
-                             (codes.Bounds.EMPTY, []))
+        keep = tag_filter(list(request.tags.tags), request.tags.filter_mode)
         for pose in named_poses(self.sim.description, self.host.robot_name):
-            if keep(Entity(pose.name, EntityCategory.OBJECT, tags=pose.tags), pose.position):
+            if keep(pose.tags):
                 msg = si.NamedPose(name=pose.name, description=pose.description,
                                    tags=list(pose.tags))
                 msg.pose = convert.pose(pose.position, yaw_quaternion(pose.yaw),
@@ -421,11 +420,9 @@ class ControlInterface:
         worlds, problems = world_catalogue(list(request.additional_sources))
         if problems and not request.continue_on_error:
             raise Refused(Result.OPERATION_FAILED, problems[0])
-        keep = entity_filter('', [], list(request.filter.tags), request.filter.filter_mode,
-                             (codes.Bounds.EMPTY, []))
+        keep = tag_filter(list(request.filter.tags), request.filter.filter_mode)
         response.worlds = [_world_resource(name, uri, description, tags)
-                           for name, uri, description, tags in worlds
-                           if keep(Entity(name, EntityCategory.OBJECT, tags=tags), ())]
+                           for name, uri, description, tags in worlds if keep(tags)]
         response.result = _result(Result.OK, '; '.join(problems)[:2000])
 
     def _current_world(self, request, response):
@@ -455,7 +452,6 @@ class ControlInterface:
             raise Refused(code.NO_RESOURCE if unknown else code.RESOURCE_PARSE_ERROR,
                           f'{err} (the current world stays loaded)') from None
         self.host.load(world, uri)
-        self.forget()
         response.world = _world_resource(world.name, uri, world.description, world.tags)
         response.result = _result()
 
@@ -463,7 +459,6 @@ class ControlInterface:
         if self.host.state == codes.SimulationState.NO_WORLD:
             raise Refused(srv.UnloadWorld.Response.NO_WORLD_LOADED, 'no world is loaded')
         self.host.unload()
-        self.forget()
         response.result = _result()
 
 
