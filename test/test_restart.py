@@ -90,8 +90,12 @@ def step_until(executor, probe, predicate, max_steps=500):
 
 def set_paused(executor, probe, paused):
     wanted = SimulationState.STATE_PAUSED if paused else SimulationState.STATE_PLAYING
-    answer = probe.call(executor, SetSimulationState, SIM.standard(SetSimulationState),
-                        SetSimulationState.Request(state=SimulationState(state=wanted)))
+    for _ in range(3):  # a fresh client's first answer can be lost, as step_until's
+        answer = probe.call(executor, SetSimulationState, SIM.standard(SetSimulationState),
+                            SetSimulationState.Request(state=SimulationState(state=wanted)))
+        if answer is not None:
+            break
+    assert answer is not None, 'the simulator did not answer set_simulation_state'
     assert answer.result.result in (Result.RESULT_OK,
                                     SetSimulationState.Response.ALREADY_IN_TARGET_STATE), \
         answer.result.error_message

@@ -22,6 +22,7 @@ from miro_ball.miro.interface import SIM_ACTION_NODE_NAME, SimTopics
 from miro_sim_bullet.control.codes import Result
 
 MAX_STEPS_A_TURN = 500  # steps of a goal per turn of the simulator's timer: it stays lively
+CLOSE_WAIT_S = 5.0  # wall seconds close() waits for the action's thread (a guard)
 MAX_GOALS = 16  # goals accepted and not ended; more are rejected
 # Each goal accepted holds a thread until it ends: with 2 threads, two goals left none to
 # answer a third, or a cancel (a goal of 2**64-1 steps could then never be stopped).
@@ -133,8 +134,10 @@ class StepAction:
         with self.lock:
             while self.waiting:
                 self.waiting.popleft().end(Result.OPERATION_FAILED, 'the simulator stopped')
-        self.executor.shutdown(timeout_sec=1.0)
-        self.thread.join(timeout=1.0)
+        # The goals' callbacks return at once now; on a busy machine that took over a
+        # second, and a server left behind stayed on the graph.
+        self.executor.shutdown(timeout_sec=CLOSE_WAIT_S)
+        self.thread.join(timeout=CLOSE_WAIT_S)
         # The server holds its node: destroyed first, or the node stays on the graph.
         self.server.destroy()
         self.node.destroy_node()
