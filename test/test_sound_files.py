@@ -249,7 +249,7 @@ def test_a_file_plays_at_40_khz_as_the_whole_file_resampled_at_once(allowed, loo
 def test_a_file_swapped_after_the_checks_is_refused_not_waited_on(allowed, outside,
                                                                    swapped_in):
     """A FIFO renamed over a checked file blocked the simulator's open for ever."""
-    from miro_sim_bullet.scene.sounds import open_regular
+    from miro_ball.common.files import open_regular
 
     path = allowed[0] / 'race.wav'
     if swapped_in == 'fifo':

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from miro_ball.miro.constants import MIC_SAMPLE_RATE_HZ
-from miro_sim_bullet.scene.sounds import open_regular
+from miro_ball.common.files import open_regular
 
 MAX_BYTES = 200_000_000  # every sound file's samples alive at once: 35 minutes of sound
 BLOCK_FRAMES = 1 << 16  # read and mixed down this many frames at a time

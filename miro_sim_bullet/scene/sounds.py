@@ -15,10 +15,11 @@ every other mistake in a world file.
 """
 import importlib.resources
 import math
-import os
 import stat
 from dataclasses import dataclass
 from pathlib import Path
+
+from miro_ball.common.files import allowed_path, folders_parameter, open_regular
 
 KINDS = ('file', 'tone', 'noise')
 MAX_SOUNDS = 32
@@ -115,24 +116,7 @@ def bundled_sound(name):
 def sound_folders(text):
     """The sound_folders parameter (folders separated by ':', as PATH) as resolved Paths;
     ValueError in one line for one that is no folder."""
-    folders = []
-    for entry in filter(None, text.split(os.pathsep)):
-        path = Path(entry).expanduser()
-        if not path.is_dir():
-            raise ValueError(f'parameter sound_folders: {entry!r} is not a folder'[:200])
-        folders.append(path.resolve())
-    return tuple(folders)
-
-
-def open_regular(path):
-    """A binary file object of ``path`` if it is a regular file; OSError else. Opened without
-    waiting and not through a link, then looked at: a FIFO or a link swapped in after the
-    checks (renamed over the file between a check and the read) is refused, never waited on."""
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW)
-    if not stat.S_ISREG(os.fstat(fd).st_mode):
-        os.close(fd)
-        raise OSError(f'{Path(path).name!r} is not a regular file')
-    return os.fdopen(fd, 'rb')
+    return folders_parameter('sound_folders', text)
 
 
 def _sound_file(parser, where, value):
@@ -165,26 +149,21 @@ def _sound_file(parser, where, value):
 def _allowed_sound(parser, where, value):
     """value as a regular file in one of the allowed folders (bundled sounds first, then
     the world file's folder, then sound_folders; a relative path is looked for in each)."""
-    folders = [_bundled_folder(), *parser.sound_roots()]
-    candidates = [Path(value)] if Path(value).is_absolute() else \
-        [folder / value for folder in folders]
-    for candidate in candidates:
-        try:
-            path = candidate.resolve()
-            if not any(path.is_relative_to(folder) for folder in folders):
-                continue
-            found = path.stat()
-        except (OSError, RuntimeError, ValueError):  # missing, a link loop, too long a name
-            continue
-        if not stat.S_ISREG(found.st_mode):
-            parser.fail(where, f'{value!r} is not a regular file (a FIFO, device or folder is '
-                               'never opened)'[:200])
-        if found.st_size > MAX_SOUND_FILE_BYTES:
-            parser.fail(where, f'{value!r} is larger than {MAX_SOUND_FILE_BYTES} bytes')
-        return path
-    parser.fail(where, f'no sound file {value!r} in the allowed folders: a bundled sound '
-                       f'({", ".join(bundled_sounds())}), a file beside the world file, or in '
-                       "the simulator's sound_folders"[:300])
+    path = allowed_path(value, [_bundled_folder(), *parser.sound_roots()])
+    try:
+        found = path and path.stat()
+    except OSError:  # gone since
+        found = None
+    if not found:
+        parser.fail(where, f'no sound file {value!r} in the allowed folders: a bundled sound '
+                           f'({", ".join(bundled_sounds())}), a file beside the world file, or in '
+                           "the simulator's sound_folders"[:300])
+    if not stat.S_ISREG(found.st_mode):
+        parser.fail(where, f'{value!r} is not a regular file (a FIFO, device or folder is '
+                           'never opened)'[:200])
+    if found.st_size > MAX_SOUND_FILE_BYTES:
+        parser.fail(where, f'{value!r} is larger than {MAX_SOUND_FILE_BYTES} bytes')
+    return path
 
 
 def _bundled_folder():

@@ -1,0 +1,71 @@
+"""Files named from outside (a request, a topic, a launch file, an environment variable): which
+may be read, and reading them without being held.
+
+- ``allowed_path``: a name resolved (``~``, links, ``..``) and kept only when it lies in one of
+  the allowed folders. A caller refuses everything else with one line that names its rule and
+  the name it was given, the same line whether the file is absent, unreadable or elsewhere: it
+  never says whether a file outside exists, nor what it holds.
+- ``open_regular``: opened without waiting and not through a link, then looked at: a FIFO, a
+  device or a folder is refused, never waited on (a FIFO held a program until someone wrote to
+  it, deaf to Ctrl+C), and so is one swapped in between a check and the read.
+- ``folders_parameter``: a ':'-separated list of folders given at start (as PATH), checked.
+"""
+import os
+import stat
+from pathlib import Path
+
+MAX_PATH = 4096  # characters of a name (Linux's PATH_MAX)
+MAX_FOLDERS = 16  # in a parameter or a request
+
+
+class FileRefused(OSError):
+    """A file that is not read; str() is one line."""
+
+
+def open_regular(path):
+    """A binary file object of ``path`` if it is a regular file; OSError else."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW)
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise FileRefused(f'{Path(path).name!r} is not a regular file')
+    return os.fdopen(fd, 'rb')
+
+
+def read_regular(path, limit):
+    """The first ``limit`` + 1 bytes of a regular file (enough to tell it is too big)."""
+    with open_regular(path) as file:
+        return file.read(limit + 1)
+
+
+def allowed_path(value, folders):
+    """The resolved Path that ``value`` names inside one of ``folders`` (resolved Paths), or
+    None. An absolute name (or ``~``) is taken as it is; a relative one is looked for in each
+    folder in turn. Whatever the name, the path returned lies in a folder once every link
+    and '..' is resolved, and something is there (not necessarily a regular file)."""
+    if not isinstance(value, str) or not value or '\0' in value or len(value) > MAX_PATH:
+        return None
+    name = Path(value).expanduser() if value.startswith('~') else Path(value)
+    candidates = [name] if name.is_absolute() else [folder / name for folder in folders]
+    for candidate in candidates:
+        try:
+            path = candidate.resolve()
+            if any(path.is_relative_to(folder) for folder in folders) and path.exists():
+                return path
+        except (OSError, RuntimeError, ValueError):  # a link loop, too long a name, ...
+            continue
+    return None
+
+
+def folders_parameter(name, text):
+    """The folders of parameter ``name`` (separated by ':', as PATH) as resolved Paths, each
+    once; ValueError in one line for one that is no folder, or for too many."""
+    folders = []
+    for entry in filter(None, text.split(os.pathsep)):
+        path = Path(entry).expanduser()
+        if not path.is_dir():
+            raise ValueError(f'parameter {name}: {entry!r} is not a folder'[:200])
+        folders.append(path.resolve())
+    folders = list(dict.fromkeys(folders))
+    if len(folders) > MAX_FOLDERS:
+        raise ValueError(f'parameter {name}: {len(folders)} folders; at most {MAX_FOLDERS}')
+    return tuple(folders)
