@@ -1,6 +1,7 @@
 """The learning environments: Gymnasium's checks, seeded determinism, the contract's spaces,
 a controller of the contract running in an environment unchanged, and docs/learning.md's
 examples, run as written."""
+import math
 import re
 from pathlib import Path
 
@@ -190,6 +191,135 @@ def test_an_action_of_the_contract_is_a_step_too():
     env.step(Action(head=(0.0, 0.3, 0.5, 0.0)))
     assert env.rig.sim.robot.kin_targets[2] == pytest.approx(0.5)
     env.close()
+
+
+def sound(obs):
+    """Every number of the observation finite."""
+    return all(np.isfinite(value).all() for value in obs.values())
+
+
+def a_sound_episode(env, seed, steps=5):
+    """A few steps standing still from reset(seed): MiRo stands on the floor, nothing is
+    NaN, nobody falls."""
+    obs, _ = env.reset(seed=seed)
+    assert sound(obs) and env.unwrapped.rig.sim.robot.height() > 0.03
+    for _ in range(steps):
+        obs, reward, terminated, truncated, info = env.step({'wheels': np.zeros(2)})
+        assert sound(obs) and np.isfinite(reward) and not terminated, info
+
+
+def test_a_nan_in_an_action_is_refused_and_the_next_episodes_are_sound():
+    """One NaN head target gave a NaN reward, and every later episode began with MiRo sunk
+    into the floor and ended as a fall on its first step, whatever the seed."""
+    env = MiroEnv(KickBall(), eyes=None, detectors=())
+    env.reset(seed=1)
+    targets = list(env.rig.sim.robot.kin_targets)
+    with pytest.raises(ValueError, match=r"^action part 'head' \[nan, 0.0, 0.0\] is not "
+                                         r'finite; its space is Box\(') as refused:
+        env.step({'head': np.array([np.nan, 0.0, 0.0], np.float32), 'wheels': np.zeros(2)})
+    assert '\n' not in str(refused.value)
+    assert env.rig.sim.robot.kin_targets == targets  # refused whole: nothing moved
+    for seed in (1, 2, 3):
+        a_sound_episode(env, seed)
+    with pytest.raises(ValueError, match='^action head: need 4 finite positions'):
+        env.step(Action(head=(0.0, 0.5, math.inf, 0.0)))  # the contract's Action too
+    env.close()
+
+
+@pytest.mark.parametrize('part, value, problem', [
+    ('head', [5.0, 0.0, 0.0], 'is outside its space Box'),
+    ('cosmetic', [2.0] * 6, 'is outside its space Box'),
+    ('cosmetic', [20.0] * 6, 'is outside its space Box'),
+    ('illum', np.zeros((2, 3), np.uint8), r'has shape \(2, 3\); its space is Box\(0, 255'),
+    ('illum', np.full((6, 3), 12.5), 'is not whole numbers'),
+    ('wheels', [0.1, -np.inf], 'is not finite'),
+    ('tone', [440.0], r'has shape \(1,\)'),
+    ('wheel', [0.1, 0.1], r"no action part 'wheel' \(parts: cosmetic, head, illum"),
+], ids=['head-5', 'cosmetic-2', 'cosmetic-20', 'illum-2-rows', 'illum-halves', 'wheels-inf',
+        'tone-short', 'unknown-part'])
+def test_an_action_outside_its_space_is_refused_naming_the_part(part, value, problem):
+    env = MiroEnv(KickBall(), eyes=None, detectors=())
+    env.reset(seed=1)
+    robot = env.rig.sim.robot
+    before = (list(robot.kin_targets), list(robot.cosmetic), list(robot.illum))
+    with pytest.raises(ValueError, match=problem) as refused:
+        env.step({part: value})
+    assert f"'{part}'" in str(refused.value) and '\n' not in str(refused.value)
+    assert (robot.kin_targets, robot.cosmetic, robot.illum) == before
+    env.step({'head': [0.5, 0.3, 0.0]})  # and the environment goes on
+    assert robot.kin_targets[2] == pytest.approx(0.3)
+    env.close()
+
+
+def test_the_k_bandit_refuses_an_expression_that_is_not_one():
+    """step(-1) showed the last expression, step(1.7) the second: both without a word."""
+    env = gymnasium.make('miro_ball/KBandit-v0', trials=3)
+    env.reset(seed=1)
+    for action in (-1, 1.7, 4, np.nan):
+        with pytest.raises(ValueError, match=r'^expression .* is outside its space '
+                                             r'Discrete\(4\)$'):
+            env.step(action)
+    _, reward, *_ = env.step(np.int64(2))
+    assert reward in (-1.0, 1.0)
+    env.close()
+
+
+def test_a_nan_that_reaches_the_rig_is_dropped_and_the_physics_stays_finite():
+    """The rig is the environments' door to the physics: what the robot's control topics
+    ignore (a NaN, a wrong length) it drops too, whoever calls it."""
+    env = MiroEnv(KickBall(), eyes=None, detectors=())
+    env.reset(seed=1)
+    rig, robot = env.rig, env.rig.sim.robot
+    targets, cosmetic = list(robot.kin_targets), list(robot.cosmetic)
+    refused = rig.act(env.robot, Action(head=(0.0, np.nan, 0.0, 0.0), wheels=(np.nan, 0.1),
+                                        cosmetic=(0.5,) * 5, tone=(440, 100, np.nan),
+                                        illum=(0xFFFFFFFF,) * 6))
+    assert sorted(refused) == ['cosmetic', 'head', 'tone', 'wheels']
+    assert (robot.kin_targets, robot.cosmetic, robot.wheel_cmd) == (targets, cosmetic,
+                                                                    (0.0, 0.0))
+    assert robot.illum == [0xFFFFFFFF] * 6  # the sound part is taken
+    for _ in range(10):
+        rig.tick()
+    assert rig.sim.finite() and sound(env._observation())
+    env.close()
+
+
+def test_a_world_holding_a_non_finite_value_is_rebuilt_at_reset():
+    """A snapshot restored over a NaN did not mend it: MiRo sank into the floor at every
+    reset after."""
+    from miro_sim_bullet.bullet import pybullet as pb
+
+    env = MiroEnv(KickBall(), eyes=None, detectors=())
+    env.reset(seed=1)
+    sim = env.rig.sim
+    pb.resetJointState(sim.robot.body_id, 1, np.nan, physicsClientId=sim.client)
+    env.rig.tick()  # the NaN spreads through the solver
+    assert not sim.finite()
+    built = sim.generation
+    a_sound_episode(env, 2)
+    assert sim.generation == built + 1 and sim.finite()
+    a_sound_episode(env, 3)
+    assert sim.generation == built + 1  # a sound world is rewound, not rebuilt
+    env.close()
+
+
+@pytest.mark.parametrize('make', [
+    lambda: MiroEnv(KickBall(), eyes=None, detectors=(), render_mode='rgb_array'),
+    lambda: gymnasium.make('miro_ball/KBandit-v0', trials=3),
+    lambda: gymnasium.make('miro_ball/TMaze-v0', eyes=None, detectors=()),
+], ids=['KickBall', 'KBandit', 'TMaze'])
+def test_an_environment_used_after_close_says_it_is_closed(make):
+    """It raised PyBullet's 'Not connected to physics server.' (step, render) or a
+    TypeError (reset)."""
+    env = make()
+    env.reset(seed=1)
+    action = env.action_space.sample()
+    env.close()
+    env.close()  # a second close is no error
+    for use in (lambda: env.step(action), lambda: env.reset(seed=2), env.render,
+                env.unwrapped.percepts):
+        with pytest.raises(RuntimeError, match='^the environment is closed$'):
+            use()
 
 
 EXAMPLES = re.findall(r'^```python\n(.*?)^```$', LEARNING_MD.read_text(), re.M | re.S)

@@ -13,7 +13,6 @@ import random
 
 import gymnasium as gym
 
-from miro_ball.controller.contract import Action
 from miro_ball.learn import spaces
 from miro_ball.learn.rig import WorldRig
 from miro_ball.learn.tasks import play, Task
@@ -68,13 +67,10 @@ class MiroEnv(gym.Env):
         return self._observation(), self.task.info()
 
     def step(self, action):
-        """A step with an action of action_space (or the contract's Action itself)."""
-        if not isinstance(action, Action):
-            action = spaces.to_action(action, self.frame_skip)
-        return self.step_action(action)
-
-    def step_action(self, action):
-        """step() with the contract's Action (a part left None: the robot keeps the last)."""
+        """A step with an action of action_space (or the contract's Action itself); one
+        outside its space, or not finite, is refused (ValueError naming the part) before
+        anything moves."""
+        action = spaces.contract_action(action, self.action_space, self.frame_skip)
         self.rig.act(self.robot, action)
         terminated = play(self.rig, self.task, self.frame_skip)
         self.rig.look()
@@ -82,7 +78,12 @@ class MiroEnv(gym.Env):
         return (self._observation(), float(self.task.reward(self.rig)), terminated, truncated,
                 self.task.info())
 
+    def step_action(self, action):
+        """step() with the contract's Action (a part left None: the robot keeps the last)."""
+        return self.step(action)
+
     def render(self):
+        self.rig.check_open()
         return self.rig.overhead() if self.render_mode == 'rgb_array' else None
 
     def close(self):

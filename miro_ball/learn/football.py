@@ -32,7 +32,6 @@ import random
 from pettingzoo import ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec
 
-from miro_ball.controller.contract import Action
 from miro_ball.learn import spaces
 from miro_ball.learn.rig import WorldRig
 from miro_ball.learn.tasks import (APPROACH_WEIGHT, FALL_PENALTY, KICK_REWARD, KickBall,
@@ -194,14 +193,22 @@ class FootballEnv(ParallelEnv):
 
     def step(self, actions):
         """One step: each agent's action (of its action space, or a contract Action); an
-        agent left out keeps what it was last told."""
+        agent left out keeps what it was last told. An action outside its space, or not
+        finite, is refused (ValueError naming the agent and the part) before anything
+        moves."""
+        self.rig.check_open()
         if not self.agents:
             return {}, {}, {}, {}, {}
+        checked = {}
         for agent, action in actions.items():
             if agent in self.agents:
-                if not isinstance(action, Action):
-                    action = spaces.to_action(action, self.frame_skip)
-                self.rig.act(agent, action)
+                try:
+                    checked[agent] = spaces.contract_action(action, self._action_spaces[agent],
+                                                            self.frame_skip)
+                except ValueError as err:
+                    raise ValueError(f'{agent}: {err}') from None
+        for agent, action in checked.items():
+            self.rig.act(agent, action)
         task = self.task
         terminated = play(self.rig, task, self.frame_skip)
         self.rig.look()
@@ -217,6 +224,7 @@ class FootballEnv(ParallelEnv):
         return result
 
     def render(self):
+        self.rig.check_open()
         return self.rig.overhead() if self.render_mode == 'rgb_array' else None
 
     def close(self):

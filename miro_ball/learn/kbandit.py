@@ -15,6 +15,7 @@ import gymnasium as gym
 from gymnasium import spaces
 
 from miro_ball.controller.contract import Action
+from miro_ball.learn.spaces import check_action
 from miro_ball.learn.tasks import Task
 from miro_ball.miro.constants import COSMETIC_CALIB
 from miro_ball.miro.touch import TOUCH_PADS
@@ -93,4 +94,5 @@ class Expressions(gym.ActionWrapper):
         self.action_space = spaces.Discrete(len(EXPRESSIONS))
 
     def action(self, action):
+        check_action(self.action_space, action, 'expression')  # -1 would be the last one
         return EXPRESSIONS[int(action)]

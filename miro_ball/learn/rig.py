@@ -8,16 +8,19 @@ taken here from the robot's own tick (its ``sensors``), and an Action reaches th
 the simulator's control topics hand it over, so that what is learnt here behaves the same
 there. A snapshot of the built world makes a reset cheap: restored, never rebuilt.
 """
-import math
+import dataclasses
+import logging
 
 import numpy as np
 
+from miro_ball.common.throttle import Throttled
 from miro_ball.controller.contract import Eye, Percepts
 from miro_ball.controller.detection import DetectionParams
 from miro_ball.controller.detectors import make_detectors
 from miro_ball.miro.camera_model import CameraModel, PINHOLE
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM
 from miro_ball.miro.hearing import locate
+from miro_ball.learn.action_checks import refusals
 from miro_ball.miro.kinematics import clamp_wheel_speeds, wheel_speed2cmd_vel
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
@@ -46,14 +49,23 @@ class WorldRig:
         self.found = {}  # robot -> (left, right) {detector: result} in those images
         self.heard = {}  # robot -> the latest MicBlock
         self._detectors = {}
+        self._warn = Throttled(logging.getLogger(__name__).warning)
 
     # -- time ---------------------------------------------------------------------------------
     @property
     def t(self):
         return self.sim.time
 
+    def check_open(self):
+        """RuntimeError once closed (PyBullet's own error says only 'Not connected to
+        physics server', or a TypeError)."""
+        if self.sim.client is None:
+            raise RuntimeError('the environment is closed')
+
     def restore(self):
-        """The world as it was built: bodies, robots' platforms, time; no rebuild."""
+        """The world as it was built: bodies, robots' platforms, time; no rebuild (but of a
+        world holding a non-finite value: SimWorld.rewind)."""
+        self.check_open()
         self.sim.rewind()
         self.images.clear()
         self.found.clear()
@@ -64,6 +76,7 @@ class WorldRig:
     def tick(self, observe=None):
         """One platform tick (its physics steps); ``observe(sim)`` after each physics step
         (a judge sees every contact, however brief)."""
+        self.check_open()
         sim = self.sim
         listening = sim.robots if self.hears else ()
         for _ in range(sim.ticks_per_platform_tick):
@@ -78,6 +91,7 @@ class WorldRig:
     def look(self):
         """Draw every robot's eyes now (one pass for all) and run their detectors, once a
         frame: the motion detector compares each frame with its eye's previous one."""
+        self.check_open()
         if self.camera is None:
             return
         requests = [(robot, side) for robot in self.sim.robots.values() for side in SIDES]
@@ -91,6 +105,7 @@ class WorldRig:
                 for image, detectors in zip(images, self._detectors[name]))
 
     def _cameras(self):
+        self.check_open()
         if self.cameras is None:
             self.cameras = Cameras(self.sim, self.renderer, log=lambda _: None)
         return self.cameras
@@ -110,6 +125,7 @@ class WorldRig:
     def percepts(self, name):
         """Robot ``name``'s Percepts now: its latest tick's readings, its eyes' images and
         the detectors' results in them (as the latest look() made them)."""
+        self.check_open()
         robot = self.sim.robots[name]
         sensors = robot.sensors
         images = self.images.get(name, (None, None))
@@ -125,24 +141,35 @@ class WorldRig:
 
     def act(self, name, action):
         """Hand robot ``name`` each part of ``action`` that is set, as its control topics do
-        (wheels through the MDK's cmd_vel formula, as the controller host sends them)."""
+        (wheels through the MDK's cmd_vel formula, as the controller host sends them). A
+        part they would ignore (a wrong length, a non-finite number: action_checks) is
+        dropped with a rate-limited warning, the robot keeping what it was told before;
+        returns {part: why} of those dropped."""
+        self.check_open()
         robot = self.sim.robots[name]
+        refused = refusals(action)
+        for part, why in refused.items():
+            self._warn(part, f'{name}: action {part} ignored: {why}')
+        action = dataclasses.replace(action, **dict.fromkeys(refused))
         if action.wheels is not None:
-            left, right = (float(v) if math.isfinite(v) else 0.0 for v in action.wheels)
+            left, right = (float(v) for v in action.wheels)
             robot.set_cmd_vel(*wheel_speed2cmd_vel(clamp_wheel_speeds(left, right)))
         if action.head is not None:
             robot.set_kinematic_targets([float(v) for v in action.head])
         if action.cosmetic is not None:
             robot.set_cosmetic([float(v) for v in action.cosmetic])
-        if action.illum is not None and list(action.illum) != robot.illum:
+        if action.illum is not None and [int(v) for v in action.illum] != robot.illum:
             robot.set_illum([int(v) for v in action.illum])
         if action.tone is not None:
-            robot.play_tone(*action.tone)
+            robot.play_tone(*(int(v) for v in action.tone))
         if action.stream is not None:
             robot.stream(np.asarray(action.stream, np.int16))
+        return refused
 
     def close(self):
+        """Free the world and the renderers; a second close() does nothing."""
         if self.cameras is not None:
             self.cameras.close()
+            self.cameras = None
         self.sim.close()
 

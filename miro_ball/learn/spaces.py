@@ -16,6 +16,10 @@ Observation (every array float32 unless said):
 Action: ``wheels`` (2,) m/s within +-0.4; ``head`` (3,) lift, yaw, pitch targets within
 MiRo's ranges (the tilt is fixed: the contract's fourth value is always MiRo's); ``cosmetic`` (6,) 0..1; ``illum`` (6, 3) uint8 RGB of the six LEDs;
 ``tone`` (2,) frequency Hz and volume 0..255 (volume 0: no tone), sounding for the step.
+
+Every environment's step takes its action through ``contract_action``: a part outside its
+space (or not finite) is refused with a ValueError naming the part and the space, before
+anything moves, as a learner expects of a Gymnasium environment.
 """
 import math
 
@@ -23,6 +27,7 @@ import numpy as np
 from gymnasium import spaces
 
 from miro_ball.controller.contract import Action
+from miro_ball.learn.action_checks import refusals, said
 from miro_ball.miro.constants import (JOINT_LIMITS_RAD, MIC_BLOCK_SAMPLES, TILT_RAD,
                                       TONE_FREQUENCY_RANGE_HZ, TONE_VOLUME_MAX,
                                       WHEEL_MAX_SPEED_M_PER_S)
@@ -140,3 +145,63 @@ def to_action(act, ticks=1):
             for r, g, b in np.clip(illum, 0, 255).astype(int)),
         tone=None if tone is None or float(tone[1]) <= 0 else (
             int(tone[0]), int(tone[1]), int(ticks)))
+
+
+def _shown(array):
+    return str(array.tolist())  # one line, whatever the shape
+
+
+def check_part(name, space, value):
+    """ValueError naming ``name`` and ``space`` (a Box) unless ``value`` is in it: its
+    shape, finite, within the bounds (a value rounded to the space's float type may touch
+    them), whole numbers for a whole-number space."""
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f'{name} is not numbers; its space is {space}') from None
+    if array.shape != space.shape:
+        raise ValueError(f'{name} has shape {array.shape}; its space is {space}')
+    if not np.isfinite(array).all():
+        raise ValueError(f'{name} {_shown(array)} is not finite; its space is {space}')
+    if np.issubdtype(space.dtype, np.integer):
+        if (array != np.floor(array)).any():
+            raise ValueError(f'{name} {_shown(array)} is not whole numbers; its space is '
+                             f'{space}')
+        within = array
+    else:
+        with np.errstate(over='ignore'):  # a float32 space: beyond its range is inf
+            within = array.astype(space.dtype)
+    if (within < space.low).any() or (within > space.high).any():
+        raise ValueError(f'{name} {_shown(array)} is outside its space {space}')
+
+
+def check_action(space, action, name='action'):
+    """ValueError (one line, naming the part and its space) unless ``action`` is one of
+    ``space``: a Dict's action may leave parts out (None: the robot keeps what it was
+    told), another space's must be contained."""
+    if not isinstance(space, spaces.Dict):
+        if not space.contains(action):
+            raise ValueError(f'{name} {action!r} is outside its space {space}')
+        return
+    if not hasattr(action, 'items'):
+        raise ValueError(f'an action is a dict of parts ({", ".join(space.spaces)}) or a '
+                         f'contract Action, got {type(action).__name__}')
+    for part, value in action.items():
+        if part not in space.spaces:
+            raise ValueError(f'no action part {part!r} (parts: {", ".join(space.spaces)})')
+        if value is not None:
+            check_part(f'action part {part!r}', space[part], value)
+
+
+def contract_action(action, space, ticks=1):
+    """The contract's Action an environment's step takes: ``action`` of ``space`` (a Dict
+    of parts, checked by check_action) or a contract Action, whose parts must be what the
+    robot's control topics take (action_checks: ValueError otherwise; values out of
+    MiRo's ranges are clamped, as there)."""
+    if isinstance(action, Action):
+        refused = refusals(action)
+        if refused:
+            raise ValueError(said(refused))
+        return action
+    check_action(space, action)
+    return to_action(action, ticks)

@@ -9,6 +9,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from miro_ball.common.checks import finite
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       KIN_CALIB_RAD, PLATFORM_TICK_S, TILT_RAD,
@@ -120,9 +121,15 @@ class MiroRobot:
         self._sense()
 
     # -- commands ---------------------------------------------------------------------------
+    # Each command below is clamped to MiRo's ranges, and one holding a non-finite number is
+    # refused whole (the robot keeps what it was told before): a clamp of min and max lets
+    # NaN through, and one NaN target sank MiRo into the floor for good, a rewind later too.
+    # The doors (the ROS handlers, the learning rig) refuse such commands first, and say so.
     def set_cmd_vel(self, linear, angular):
         """Wheel speeds by MiRo's formula, each clamped to the wheels' +-0.4 m/s;
-        returns True when a wheel had to be clamped."""
+        returns True when a wheel had to be clamped. Non-finite: refused (False)."""
+        if not finite(linear, angular):
+            return False
         wanted = cmd_vel2wheel_speed(linear, angular)
         self.wheel_cmd = clamp_wheel_speeds(*wanted)
         self.last_cmd_time = self.clock()
@@ -130,14 +137,18 @@ class MiroRobot:
         return any(abs(w - c) > 1e-6 for w, c in zip(wanted, self.wheel_cmd))
 
     def set_kinematic_targets(self, positions):
-        """Targets [tilt, lift, yaw, pitch] clamped to MiRo's ranges; returns them."""
-        self.kin_targets = [min(max(p, lo), hi) for p, (lo, hi) in
-                            zip(positions, JOINT_LIMITS_RAD)]
-        self._apply_joint_motors()
+        """Targets [tilt, lift, yaw, pitch] clamped to MiRo's ranges; returns the targets
+        in force (the old ones when ``positions`` is refused: not 4 finite numbers)."""
+        if len(positions) == len(JOINT_LIMITS_RAD) and finite(*positions):
+            self.kin_targets = [min(max(p, lo), hi) for p, (lo, hi) in
+                                zip(positions, JOINT_LIMITS_RAD)]
+            self._apply_joint_motors()
         return tuple(self.kin_targets)
 
     def set_cosmetic(self, values):
-        self.cosmetic = [min(max(v, 0.0), 1.0) for v in values]
+        """Six cosmetic targets clamped to 0..1 (refused unless 6 finite numbers)."""
+        if len(values) == len(self.cosmetic) and finite(*values):
+            self.cosmetic = [min(max(v, 0.0), 1.0) for v in values]
 
     def set_illum(self, argb):
         """Six 0xAARRGGBB LEDs, shown as the colour of the body patches."""
@@ -145,7 +156,10 @@ class MiroRobot:
         self.model.show_illum(self.illum)
 
     def play_tone(self, frequency, volume, ticks):
-        """control/tone: [frequency Hz, volume 0..255, duration in platform ticks]."""
+        """control/tone: [frequency Hz, volume 0..255, duration in platform ticks]; a
+        non-finite one is refused (the tone playing, if any, is returned)."""
+        if not finite(frequency, volume, ticks):
+            return self.speaker.tone
         return self.speaker.play_tone(frequency, volume, ticks, self.clock())
 
     def stream(self, samples):

@@ -385,8 +385,11 @@ class SimWorld:
         """Back to the state right after the build without building anew (a learning
         environment's reset: about 50 times cheaper than reset()): PyBullet's snapshot of
         the built bodies restored, time from zero, each robot's platform and the world's
-        sound started again. Body ids stay, so renderers keep what they read."""
-        if self._built is None:  # bodies were added or removed since the snapshot
+        sound started again. Body ids stay, so renderers keep what they read. A world that
+        holds a non-finite value is built anew instead: a NaN that reached the physics
+        spoils more than the state a snapshot restores (MiRo sank into the floor at every
+        rewind after one NaN head target)."""
+        if self._built is None or not self.finite():  # None: bodies were added or removed
             self._build()
             return
         pb.restoreState(self._built, **self._kw())
@@ -397,6 +400,19 @@ class SimWorld:
         for robot in self.robots.values():
             robot.start()
         self._new_acoustics()
+
+    def finite(self):
+        """Whether the pose, velocity and joints of everything that moves are finite."""
+        kw = self._kw()
+        for body in (*self.objects.values(), *(r.body_id for r in self.robots.values())):
+            parts = [*pb.getBasePositionAndOrientation(body, **kw),
+                     *pb.getBaseVelocity(body, **kw)]
+            joints = pb.getNumJoints(body, **kw)
+            if joints:  # each one's position and velocity
+                parts += [state[:2] for state in pb.getJointStates(body, range(joints), **kw)]
+            if not all(math.isfinite(value) for part in parts for value in part):
+                return False
+        return True
 
     def close(self):
         if self.client is not None and pb.isConnected(self.client):
