@@ -1,6 +1,9 @@
 """The pure logic behind the standard simulation_interfaces services: result codes, entity
 filters, spawn requests, state transitions, and the world file's tags, poses and catalogue."""
 import math
+import os
+import re
+from importlib.resources import files
 
 import pytest
 from hypothesis import given, settings, strategies as st
@@ -14,7 +17,8 @@ from miro_sim_bullet.control.spawning import (parse_spawn, resolve_uri, RobotSpa
                                               ShapeSpawn, SPAWNABLE_MIRO, spawnables)
 from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.scene.world_file import (Ball, bundled_worlds, load_world, named_poses,
-                                              world_catalogue, WorldError)
+                                              parse_world, world_catalogue, WorldCache,
+                                              WorldError)
 
 BOX_URI = 'package://miro_ball/worlds/models/box.toml'
 BALL_URI = 'package://miro_ball/worlds/models/ball.toml'
@@ -134,14 +138,14 @@ def test_entity_bounds_are_the_standards_shapes_round_the_origin():
 
 
 # -- spawning ---------------------------------------------------------------------------
-def spawn(name='', renaming=False, uri='', text='', namespace='', taken=()):
-    return parse_spawn(name, renaming, uri, text, namespace, set(taken))
+def spawn(name='', renaming=False, uri='', text='', namespace='', taken=(), folders=()):
+    return parse_spawn(name, renaming, uri, text, namespace, set(taken), folders)
 
 
 def spawn_code(**request):
     return refused(spawn, *[request.get(k, d) for k, d in (
         ('name', ''), ('renaming', False), ('uri', ''), ('text', ''), ('namespace', ''),
-        ('taken', ()))]).code
+        ('taken', ()), ('folders', ()))]).code
 
 
 def test_our_urdf_spawns_a_miro_by_text_or_uri():
@@ -224,11 +228,14 @@ def test_a_missing_file_or_package_is_no_resource(tmp_path):
 def test_a_file_of_ones_own_spawns_and_a_huge_one_is_refused(tmp_path):
     mine = tmp_path / 'crate.toml'
     mine.write_text('description = "my crate"\n[box]\nsize = [0.3, 0.3, 0.3]\nmass = 1.0\n')
-    made = spawn('crate', uri=f'file://{mine}')
+    folders = (tmp_path.resolve(),)  # the simulator's world_folders
+    made = spawn('crate', uri=f'file://{mine}', folders=folders)
     assert (made.description, made.body.size) == ('my crate', (0.3, 0.3, 0.3))
-    assert spawn('crate', uri=str(mine)).name == 'crate'
+    assert spawn('crate', uri=str(mine), folders=folders).name == 'crate'
+    assert spawn_code(name='crate', uri=str(mine)) == SpawnResult.NO_RESOURCE  # not allowed
     mine.write_text('# ' + 'x' * 2_000_000)
-    assert spawn_code(name='crate', uri=str(mine)) == SpawnResult.RESOURCE_PARSE_ERROR
+    assert spawn_code(name='crate', uri=str(mine), folders=folders) == \
+        SpawnResult.RESOURCE_PARSE_ERROR
 
 
 def test_the_uri_is_used_when_both_uri_and_text_are_given():
@@ -348,16 +355,127 @@ def test_every_bundled_world_has_a_description_and_tags():
 
 
 def test_the_catalogue_lists_bundled_worlds_and_a_folders_good_files(tmp_path):
+    allowed = (tmp_path.resolve(),)
     write(tmp_path, 'description = "mine"\ntags = ["x"]\n', 'good.toml')
     write(tmp_path, '[ball]\nradius = -1\n', 'bad.toml')
     write(tmp_path, 'not a world', 'notes.txt')
-    worlds, problems = world_catalogue([str(tmp_path), str(tmp_path / 'none')])
+    worlds, problems = world_catalogue([str(tmp_path), str(tmp_path / 'none')], allowed)
     by_name = {name: (uri, description, tags) for name, uri, description, tags in worlds}
     assert set(bundled_worlds()) | {'good'} == set(by_name)
     assert by_name['good'] == (str(tmp_path / 'good.toml'), 'mine', ('x',))
     assert by_name['miro'][0] == 'package://miro_ball/worlds/miro.toml'
     assert load_world(by_name['miro'][0]).name == 'miro'  # the uri loads
-    assert len(problems) == 2 and 'bad.toml' in problems[0] and 'none' in problems[1]
+    assert len(problems) == 2 and 'not a folder' in problems[0] and 'bad.toml' in problems[1]
+
+
+SECRET = 'AKIA-PLANTED-SECRET'
+
+
+@pytest.fixture
+def private(tmp_path):
+    """(a folder the simulator was started with, a folder it was not) with world files and
+    config files holding SECRET in both."""
+    allowed, elsewhere = tmp_path / 'worlds', tmp_path / 'private'
+    for folder in (allowed, elsewhere):
+        folder.mkdir()
+        write(folder, f'description = "{SECRET}"\n', 'world.toml')
+        write(folder, f'[ball]\nradius = "{SECRET}"\n', 'config.toml')
+    return allowed.resolve(), elsewhere
+
+
+def test_the_catalogue_lists_only_the_allowed_folders_and_never_quotes_another(private):
+    allowed, elsewhere = private
+    spelt = [str(elsewhere), f'{elsewhere}/', f'{allowed}/../private', f'file://{elsewhere}',
+             '/etc', '~', str(allowed / '..')]
+    worlds, problems = world_catalogue(spelt, (allowed,))
+    assert set(bundled_worlds()) == {name for name, *_ in worlds}
+    assert len(problems) == len(spelt) and SECRET not in ' '.join(problems)
+    assert all('not a folder the simulator may list' in line for line in problems)
+    (elsewhere / 'link').symlink_to(allowed)  # a link into an allowed folder is that folder
+    worlds, problems = world_catalogue([str(allowed), f'{allowed}//./', str(elsewhere / 'link'),
+                                        f'{allowed}/../worlds'], (allowed,))
+    assert [name for name, *_ in worlds].count('world') == 1 and len(problems) == 1
+
+
+def test_the_catalogue_refuses_too_many_sources_and_reads_within_its_time(tmp_path):
+    """2,187 spellings of one folder held the simulator for 71 s; a folder of many worlds
+    is read a part at a time, each part within the budget, and what was read is kept."""
+    with pytest.raises(ValueError, match='at most 16 sources'):
+        world_catalogue(['worlds/'] * 17)
+    with pytest.raises(ValueError, match='at most 16 sources'):
+        world_catalogue(['x' * 5000])
+    for k in range(30):
+        write(tmp_path, f'description = "w{k}"\n', f'w{k:02}.toml')
+    ticks = iter(range(10**6))
+    clock = lambda: next(ticks) * 0.1  # every look at the clock: 0.1 s later
+    cache, read = WorldCache(), set()
+    for _ in range(30):
+        worlds, problems = world_catalogue([str(tmp_path)], (tmp_path.resolve(),),
+                                           cache=cache, budget_s=1.0, clock=clock)
+        read |= {name for name, *_ in worlds if name.startswith('w')}
+        if not problems:
+            break
+        assert problems == [problems[0]] and 'not read within 1 s' in problems[0]
+    assert len(read) == 30 and not problems
+
+
+def test_a_world_a_client_names_is_bundled_or_in_the_allowed_folders(private):
+    allowed, elsewhere = private
+    assert load_world(str(allowed / 'world.toml'), (), (allowed,)).description == SECRET
+    assert load_world('world.toml', (), (allowed,)).description == SECRET  # relative: looked for
+    assert load_world('den', (), (allowed,)).name == 'den'
+    lines = set()
+    for name in ('world.toml', 'config.toml', 'missing.toml', 'folder.toml'):
+        (elsewhere / 'folder.toml').mkdir(exist_ok=True)
+        for spelt in (str(elsewhere / name), f'file://{elsewhere}/{name}',
+                      f'{allowed}/../private/{name}'):
+            with pytest.raises(WorldError) as err:
+                load_world(spelt, (), (allowed,))
+            assert SECRET not in str(err.value)
+            lines.add(re.sub("'.*?' in", "'NAME' in", str(err.value), count=1))
+    assert lines == {"no world file 'NAME' in the allowed folders: a bundled world ("
+                     f"{', '.join(bundled_worlds())}), or a .toml file in a folder the "
+                     'simulator was started with (its world_folders parameter)'}
+    (allowed / 'pipe.toml').unlink(missing_ok=True)
+    os.mkfifo(allowed / 'pipe.toml')
+    with pytest.raises(WorldError, match='no world file'):
+        load_world(str(allowed / 'pipe.toml'), (), (allowed,))
+
+
+def test_a_picture_is_bundled_beside_the_world_or_in_the_allowed_folders(private):
+    allowed, elsewhere = private
+    picture = allowed / 'mine.png'
+    picture.write_bytes((files('miro_sim_bullet.worlds') / 'pictures' / 'face_photo.png')
+                        .read_bytes())
+    (elsewhere / 'secret.png').write_bytes(picture.read_bytes())
+    (elsewhere / 'notes.png').write_text(SECRET)
+    box = '[[box]]\nsize = [1, 1, 1]\npicture = "{}"\n'
+    assert parse_world(box.format(picture), 'resource_string', (), (allowed,)).pictures
+    assert parse_world(box.format('face_photo.png'), 'resource_string').pictures
+    lines = set()
+    for name in ('secret.png', 'notes.png', 'missing.png'):
+        for spelt in (str(elsewhere / name), f'{allowed}/../private/{name}'):
+            with pytest.raises(WorldError) as err:
+                parse_world(box.format(spelt), 'resource_string', (), (allowed,))
+            lines.add(re.sub("'.*?' in", "'NAME' in", str(err.value), count=1))
+    assert len(lines) == 1 and SECRET not in lines.pop()
+    with pytest.raises(WorldError, match='no picture'):  # a world's own folder, not others'
+        load_world(write(allowed, box.format(elsewhere / 'secret.png'), 'framed.toml'))
+
+
+def test_a_model_a_client_names_is_in_its_package_or_in_the_allowed_folders(private):
+    allowed, elsewhere = private
+    write(allowed, '[[box]]\nsize = [0.1, 0.1, 0.1]\n', 'crate.toml')
+    assert 'size' in resolve_uri(str(allowed / 'crate.toml'), (allowed,))[0]
+    assert 'size' in resolve_uri(f'file://{allowed}/crate.toml', (allowed,))[0]
+    lines = set()
+    for uri in (str(elsewhere / 'config.toml'), str(elsewhere / 'missing.toml'),
+                f'{allowed}/../private/config.toml', 'package://miro_ball/../../etc/x.toml',
+                'package://miro_ball//etc/x.toml', 'package://miro_ball/worlds/../../x.toml'):
+        caught = refused(resolve_uri, uri, (allowed,))
+        assert caught.code == SpawnResult.NO_RESOURCE and SECRET not in str(caught)
+        lines.add(re.sub("'.*?':", "'NAME':", str(caught), count=1))
+    assert len(lines) == 1, lines
 
 
 def test_a_bundled_worlds_uri_resolves_and_a_models_is_no_world():

@@ -10,10 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from miro_ball.common.files import folders_parameter
 from miro_sim_bullet.acoustics.hearing import Acoustics
 from miro_sim_bullet.acoustics.loading import SoundLoads
 from miro_sim_bullet.acoustics.sound_files import SoundBank, SoundFileError
-from miro_sim_bullet.scene.sounds import MAX_SOUNDS, sound_folders, Sound
+from miro_sim_bullet.scene.sounds import MAX_SOUNDS, Sound
 from miro_sim_bullet.scene.world_file import load_sounds, load_world, WorldError
 
 
@@ -71,7 +72,7 @@ def outside(tmp_path):
 def allowed(tmp_path):
     folder = tmp_path / 'sounds'
     folder.mkdir()
-    return sound_folders(str(folder))
+    return folders_parameter('sound_folders', str(folder))
 
 
 def test_a_request_plays_bundled_sounds_and_files_of_the_allowed_folders(allowed):
@@ -129,13 +130,13 @@ def test_a_world_file_takes_sounds_beside_it_and_refuses_them_elsewhere(tmp_path
     toml.write_text(f'[[sound]]\nfile = "{outside}"\n')
     with pytest.raises(WorldError, match='no sound file'):
         load_world(str(toml))
-    assert load_world(str(toml), sound_folders(str(outside.parent))).sounds
+    assert load_world(str(toml), folders_parameter('sound_folders', str(outside.parent))).sounds
 
 
 def test_the_sound_folders_parameter_must_name_folders():
     with pytest.raises(ValueError, match="parameter sound_folders: '/no/such' is not a folder"):
-        sound_folders('/no/such')
-    assert sound_folders('') == ()
+        folders_parameter('sound_folders', '/no/such')
+    assert folders_parameter('sound_folders', '') == ()
 
 
 def test_a_file_of_nan_samples_is_refused_not_played_as_silence(allowed):

@@ -16,6 +16,7 @@ from urllib.parse import unquote
 from xml.etree import ElementTree
 
 import miro_ball
+from miro_ball.common.files import allowed_path, FileRefused, read_regular
 from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_ball.miro.urdf import MAX_URDF_BYTES, urdf
 from miro_sim_bullet.control.codes import Refused, SpawnResult
@@ -31,6 +32,11 @@ MIRO_DESCRIPTION = 'MiRo-E, with its whole ROS interface under its name'
 MAX_RESOURCE_BYTES = max(MAX_URDF_BYTES, MAX_FILE_BYTES)
 TOUCH_M = 0.01  # bodies this close only touch: one may be spawned on another
 _PACKAGE = re.compile(r'[A-Za-z][A-Za-z0-9_]*')  # a ROS package's name
+# What a uri may name (docs/limits.md), said whenever one breaks it, whether a file is there
+# or not, readable or not.
+RESOURCE_RULE = ('no such file in the allowed folders: a file inside a package '
+                 '(package://PACKAGE/PATH), or in a folder the simulator was started with (its '
+                 'world_folders parameter)')
 
 
 @dataclass(frozen=True)
@@ -50,23 +56,28 @@ class ShapeSpawn:
     tags: tuple = ()
 
 
-def resolve_uri(uri):
+def resolve_uri(uri, world_folders=()):
     """(text, source) of a resource: SPAWNABLE_MIRO (MiRo's URDF, from the body model),
     package://miro_ball/worlds/... (the bundled worlds and models, wherever installed),
     package://miro_ball/<path> (the installed share/miro_ball, or the checkout),
-    package://<other>/<path> (with ament_index, in a ROS 2 install), file:///path or an
-    absolute path. Refused: NO_RESOURCE when there is no such file, RESOURCE_PARSE_ERROR
-    when it is too big or no UTF-8 text."""
+    package://<other>/<path> (with ament_index, in a ROS 2 install), each inside its
+    package once links are resolved; file:///path or an absolute path in one of
+    ``world_folders`` (resolved Paths: the simulator's parameter). Refused: NO_RESOURCE in
+    one line naming that rule for anything else (whether or not a file is there, readable
+    or not), RESOURCE_PARSE_ERROR when it is too big or no UTF-8 text."""
     if uri == SPAWNABLE_MIRO:
         return urdf(), uri
-    return _read_text(_locate(uri), uri)
+    try:
+        return _read_text(_locate(uri, world_folders), uri)
+    except OSError:
+        raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: {RESOURCE_RULE}') from None
 
 
 def parse_spawn(name, allow_renaming, uri, resource_string, namespace, taken,
-                resolve=resolve_uri):
+                world_folders=()):
     """RobotSpawn or ShapeSpawn for a request, or Refused. ``taken``: the names in use
-    (with 'ball' when the world has its ball); ``resolve``: uri -> (text, source), by
-    default resolve_uri.
+    (with 'ball' when the world has its ball); ``world_folders``: where a file a uri names
+    may be (resolve_uri).
 
     - The resource is ``uri`` when given (Resource.msg: the string is only used when the
       uri is empty), else ``resource_string``; both empty: NO_RESOURCE.
@@ -83,7 +94,7 @@ def parse_spawn(name, allow_renaming, uri, resource_string, namespace, taken,
       without its '/'); a shape has none. Anything else: NAMESPACE_INVALID. A MiRo whose
       namespace was asked for is not renamed.
     """
-    text, source = _resource(uri, resource_string, resolve)
+    text, source = _resource(uri, resource_string, world_folders)
     if _is_urdf(uri, text):
         _check_miro(text, source)
         return RobotSpawn(_robot_name(name, allow_renaming, namespace, taken))
@@ -124,17 +135,22 @@ def body_bounds(body):
     return entity_bounds('cylinder', (body.radius, body.length))
 
 
+def robot_box(foot, yaw):
+    """(half extents, centre) of MiRo's box (ROBOT_BOX) when it stands at ``foot`` (the
+    point on its floor under the axle) turned by ``yaw``, a centimetre smaller on every
+    side: what a wall or a table must stay out of for MiRo to be put there. Standing on a
+    floor or a table top, or against a wall, it only touches them."""
+    top, bottom = ROBOT_BOX
+    half = tuple((t - b) / 2 - TOUCH_M for t, b in zip(top, bottom))
+    x, y, z = ((t + b) / 2 for t, b in zip(top, bottom))
+    c, s = math.cos(yaw), math.sin(yaw)
+    return half, (foot[0] + c * x - s * y, foot[1] + s * x + c * y, foot[2] + z)
+
+
 def robot_reach(foot, yaw):
-    """(low, high) corners of the box round a MiRo standing at ``foot`` (the point on its
-    floor under the axle) turned by ``yaw``, a centimetre smaller on every side."""
-    (top, bottom), c, s = ROBOT_BOX, math.cos(yaw), math.sin(yaw)
-    corners = [(foot[0] + c * x - s * y, foot[1] + s * x + c * y)
-               for x in (bottom[0], top[0]) for y in (bottom[1], top[1])]
-    low = (min(p[0] for p in corners) + TOUCH_M, min(p[1] for p in corners) + TOUCH_M,
-           foot[2] + bottom[2] + TOUCH_M)
-    high = (max(p[0] for p in corners) - TOUCH_M, max(p[1] for p in corners) - TOUCH_M,
-            foot[2] + top[2] - TOUCH_M)
-    return low, high
+    """(low, high) corners of the upright box round robot_box(foot, yaw)."""
+    half, centre = robot_box(foot, yaw)
+    return _around(half, centre, yaw)
 
 
 def reach(body, centre, yaw):
@@ -142,27 +158,32 @@ def reach(body, centre, yaw):
     by ``yaw``, a centimetre smaller on every side: bodies that only touch do not reach
     into each other."""
     if isinstance(body, Ball) or body.kind == 'sphere':
-        half = (body.radius,) * 3
+        half, yaw = (body.radius,) * 3, 0.0
     elif body.kind == 'cylinder':
-        half = (body.radius, body.radius, body.length / 2)
+        half, yaw = (body.radius, body.radius, body.length / 2), 0.0
     else:
-        c, s = abs(math.cos(yaw)), abs(math.sin(yaw))
-        sx, sy, sz = body.size
-        half = ((c * sx + s * sy) / 2, (s * sx + c * sy) / 2, sz / 2)
-    half = [max(0.0, h - TOUCH_M) for h in half]
-    return (tuple(p - h for p, h in zip(centre, half)),
-            tuple(p + h for p, h in zip(centre, half)))
+        half = tuple(size / 2 for size in body.size)
+    return _around([max(0.0, h - TOUCH_M) for h in half], centre, yaw)
+
+
+def _around(half, centre, yaw):
+    """(low, high) corners of the upright box round a box of ``half`` extents at
+    ``centre`` turned by ``yaw`` about the vertical."""
+    c, s = abs(math.cos(yaw)), abs(math.sin(yaw))
+    extent = (c * half[0] + s * half[1], s * half[0] + c * half[1], half[2])
+    return (tuple(p - e for p, e in zip(centre, extent)),
+            tuple(p + e for p, e in zip(centre, extent)))
 
 
 # -- the resource -----------------------------------------------------------------------
-def _resource(uri, resource_string, resolve):
+def _resource(uri, resource_string, world_folders):
     if uri:
         suffix = Path(uri).suffix.lower()
         if suffix not in ('.urdf', '.toml'):
             raise Refused(SpawnResult.UNSUPPORTED_FORMAT,
                           f'{uri[:80]!r}: a {suffix or "file without a suffix"} cannot be '
                           f'spawned: formats are {", ".join(SPAWN_FORMATS)} (.urdf, .toml)')
-        return resolve(uri)
+        return resolve_uri(uri, world_folders)
     if not resource_string:
         raise Refused(SpawnResult.NO_RESOURCE, 'no resource: give a uri (see get_spawnables) '
                                                'or a resource_string (URDF or TOML)')
@@ -204,20 +225,28 @@ def _check_miro(text, source):
                       f'links differ from it ({", ".join(other[:3])[:80]} ...)')
 
 
-def _locate(uri):
-    """The path a uri names, or Refused(NO_RESOURCE)."""
+def _locate(uri, world_folders):
+    """The resolved path a uri names, in its package or in ``world_folders``; OSError when
+    there is none (a file elsewhere included), Refused(NO_RESOURCE) for no uri at all."""
     if uri.startswith('package://'):
         package, _, rest = uri[len('package://'):].partition('/')
-        if not _PACKAGE.fullmatch(package) or not rest or '..' in Path(rest).parts:
+        if not _PACKAGE.fullmatch(package) or not rest:
             raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: not package://PACKAGE/PATH '
                                                    'of a file inside the package')
         if package == 'miro_ball' and rest.startswith('worlds/'):
-            return Path(str(importlib.resources.files('miro_sim_bullet.worlds'))) / rest[7:]
-        return _share(package, uri) / rest
-    path = Path(unquote(uri[len('file://'):]) if uri.startswith('file://') else uri)
-    if not path.is_absolute():
-        raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: a uri is package://, file:// '
-                                               'or an absolute path')
+            share = Path(str(importlib.resources.files('miro_sim_bullet.worlds')))
+            rest = rest[len('worlds/'):]
+        else:
+            share = _share(package, uri)
+        path = allowed_path(rest, (share.resolve(),))
+    else:
+        name = unquote(uri[len('file://'):]) if uri.startswith('file://') else uri
+        if not Path(name).is_absolute():
+            raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: a uri is package://, file:// '
+                                                   'or an absolute path')
+        path = allowed_path(name, world_folders)
+    if path is None:
+        raise FileRefused(uri)
     return path
 
 
@@ -235,14 +264,7 @@ def _share(package, uri):
 
 
 def _read_text(path, uri):
-    try:
-        if not path.is_file():
-            raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: no such file')
-        with path.open('rb') as file:
-            raw = file.read(MAX_RESOURCE_BYTES + 1)
-    except OSError as err:
-        raise Refused(SpawnResult.NO_RESOURCE,
-                      f'{uri[:80]!r}: cannot read: {err.strerror or err}') from None
+    raw = read_regular(path, MAX_RESOURCE_BYTES)
     if len(raw) > MAX_RESOURCE_BYTES:
         raise Refused(SpawnResult.RESOURCE_PARSE_ERROR,
                       f'{uri[:80]!r}: larger than {MAX_RESOURCE_BYTES} bytes')

@@ -30,6 +30,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 
 from miro_ball.common.cli import user_args
 from miro_ball.common.clock_watch import ClockWatch
+from miro_ball.common.files import folders_parameter
 from miro_ball.common.lifecycle import run_node
 from miro_ball.common.ros_params import declare, help_lines, LiveParams
 from miro_ball.common.qos import profile
@@ -52,7 +53,6 @@ from miro_sim_bullet.ros.scene import SCENE_RATE_HZ
 from miro_sim_bullet.ros.scene_interface import SceneInterface
 from miro_sim_bullet.ros.sim_interface import SimInterface
 from miro_sim_bullet.ros.tf import TfInterface
-from miro_sim_bullet.scene.sounds import sound_folders
 from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, World, world_uri, \
     WorldError
 
@@ -66,8 +66,9 @@ except ModuleNotFoundError as missing:
 
 # Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 TYPE_CHECK_PERIOD_S = 1.0  # wall seconds between looks for control publishers of a wrong type
-FIXED_PARAMS = ('world', 'sound_folders', 'physics_dt', 'frame_width', 'frame_height',
-                'camera_rate', 'hfov_deg', 'lens', 'renderer', 'eye_workers', 'peer_check_s')
+FIXED_PARAMS = ('world', 'sound_folders', 'world_folders', 'physics_dt', 'frame_width',
+                'frame_height', 'camera_rate', 'hfov_deg', 'lens', 'renderer', 'eye_workers',
+                'peer_check_s')
 
 
 class SimNode(Node):
@@ -98,7 +99,8 @@ class SimNode(Node):
         self.said = Throttled(self.get_logger().info)  # what clients ask often (a reset)
         # The world file is read first: a typo in its name is said at once, not after the
         # look for another simulator (peer_check_s).
-        self.sound_folders = folders = sound_folders(p.sound_folders)
+        self.sound_folders = folders = folders_parameter('sound_folders', p.sound_folders)
+        self.world_folders = folders_parameter('world_folders', p.world_folders)
         world = load_world(p.world, folders)
         self.world_uri = world_uri(p.world) if p.world in bundled_worlds() \
             else str(Path(p.world).resolve())

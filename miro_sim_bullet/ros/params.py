@@ -17,6 +17,11 @@ class SimParams:
         default='', metadata={'help': "folders (separated by ':') whose sound files "
                                       '/miro_sim/sound and the world file may play, besides the '
                                       "bundled sounds and the world file's own folder"})
+    world_folders: str = field(
+        default='', metadata={'help': "folders (separated by ':') whose world files, models and "
+                                      'pictures clients may load, spawn and list (load_world, '
+                                      'spawn_entity, get_available_worlds), besides the bundled '
+                                      'ones; none by default'})
     real_time_factor: float = field(
         default=1.0, metadata={'help': 'simulated seconds per wall second; 0 = as fast as possible',
                                'range': (0.0, 1000.0)})

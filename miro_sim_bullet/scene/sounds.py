@@ -19,7 +19,7 @@ import stat
 from dataclasses import dataclass
 from pathlib import Path
 
-from miro_ball.common.files import allowed_path, folders_parameter, open_regular
+from miro_ball.common.files import allowed_path, open_regular
 
 KINDS = ('file', 'tone', 'noise')
 MAX_SOUNDS = 32
@@ -111,12 +111,6 @@ def bundled_sound(name):
     """The path of a bundled sound file (worlds/sounds/), or None when there is none."""
     bundled = _bundled_folder() / name
     return bundled if bundled.is_file() else None
-
-
-def sound_folders(text):
-    """The sound_folders parameter (folders separated by ':', as PATH) as resolved Paths;
-    ValueError in one line for one that is no folder."""
-    return folders_parameter('sound_folders', text)
 
 
 def _sound_file(parser, where, value):

@@ -44,11 +44,14 @@ for next to the world file.
 import importlib.resources
 import math
 import reprlib
+import time
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 
+from miro_ball.common.files import allowed_path, FileRefused, MAX_FOLDERS, MAX_PATH, \
+    read_regular
 from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_sim_bullet.scene.png import PngError, png_size
 from miro_sim_bullet.scene.sounds import Hearing, parse_hearing, parse_sounds
@@ -63,7 +66,8 @@ PANEL_SIZE = (0.01, 0.65, 0.30)  # the MDK's wall panel: thickness, width, heigh
 MAX_TAGS = 32
 MAX_TAG_LENGTH = 64
 MAX_POSES = 100
-MAX_CATALOGUE = 1000  # world files listed from one folder
+MAX_CATALOGUE = 1000  # world files listed in all
+CATALOGUE_BUDGET_S = 1.0  # reading world files for one request: the simulator waits meanwhile
 MAX_NAME = 255  # characters of a file's name (Linux's NAME_MAX)
 START_SUFFIX = '_start'  # of the poses named_poses() makes: a declared pose cannot end so
 ENTITY_KINDS = ('ball', 'box', 'sphere', 'cylinder')  # what load_entity() builds
@@ -76,6 +80,13 @@ PICTURE_LIFT = 0.001  # a picture floats 1 mm in front of its surface: no depth 
 BOX_FACES = ('+x', '-x', '+y', '-y', '+z')
 # A panel's faces are its box's +x and -x: a [[ring]] turns +x outwards, a [[wall]] to the
 # left of the row (looking from 'from' to 'to').
+# The rule for files a client names (docs/limits.md), said whenever a name breaks it, whether
+# the file it names is absent, unreadable or elsewhere.
+WORLD_RULE = ('a bundled world ({}), or a .toml file in a folder the simulator was started '
+              'with (its world_folders parameter)')
+FOLDER_RULE = ('not a folder the simulator may list: the bundled worlds, or a folder in its '
+               'world_folders parameter or below')
+PICTURE_RULE = "bundled ({}), the world's folder, world_folders"
 PANEL_SIDES = {'ring': {'inside': '-x', 'outside': '+x'},
                'wall': {'left': '+x', 'right': '-x'}}
 
@@ -199,26 +210,30 @@ def bundled_worlds():
     return sorted(p.name[:-5] for p in _bundled().iterdir() if p.name.endswith('.toml'))
 
 
-def load_world(name_or_path, sound_folders=()):
+def load_world(name_or_path, sound_folders=(), world_folders=None):
     """A bundled world by name ('miro', 'empty', ...) or URI (world_uri()), or a user's
-    .toml file by path or file:// URI; its sound files may also come from
-    ``sound_folders`` (resolved Paths: scene.sounds)."""
-    raw, source, folder = _read(str(name_or_path))
+    .toml file by path or file:// URI. ``world_folders`` (resolved Paths) is None for a world
+    this program chose (its command line, a script): any path; for one a client asked for, the
+    file must lie in those folders (requested_world). Its pictures may come from the bundled
+    ones, its own folder and below, or ``world_folders``; its sound files from the bundled
+    ones, its own folder and below, or ``sound_folders`` (scene.sounds)."""
+    raw, source, folder = _read(str(name_or_path), world_folders)
     if len(raw) > MAX_FILE_BYTES:
         raise WorldError(f'{source}: larger than {MAX_FILE_BYTES} bytes')
     try:
         text = raw.decode('utf-8')
     except UnicodeDecodeError:
         raise WorldError(f'{source}: not a UTF-8 text file') from None
-    return _Parser(source, folder, sound_folders).world(_toml(text, source),
-                                                       Path(source).stem)
+    return _Parser(source, folder, sound_folders, world_folders).world(
+        _toml(text, source), Path(source).stem)
 
 
-def parse_world(text, source, sound_folders=()):
+def parse_world(text, source, sound_folders=(), world_folders=()):
     """A world from the text of a world file (LoadWorld's resource_string); ``source``
-    names it in messages and as its name. Its pictures and sounds are bundled ones or
-    absolute paths."""
-    return _Parser(source, None, sound_folders).world(_toml(text, source), source)
+    names it in messages and as its name. It has no folder of its own: its pictures are
+    bundled ones or in ``world_folders``, its sounds bundled ones or in ``sound_folders``."""
+    return _Parser(source, None, sound_folders, world_folders).world(_toml(text, source),
+                                                                     source)
 
 
 def _toml(text, source):
@@ -274,37 +289,95 @@ def world_uri(name):
     return f'{BUNDLED_URI}{name}.toml'
 
 
-def world_catalogue(folders=()):
-    """(worlds, problems): worlds = [(name, uri, description, tags)] of every bundled
-    world and every *.toml file in each folder given (its uri the file's absolute path);
-    problems = one line for each folder that cannot be read and each file that is no
-    world, for the caller to report. Each world is read whole, so what is listed loads
-    (the bundled ones take 35 ms together the first time in a process, 15 ms after)."""
-    worlds, problems = [], []
-
-    def read(name, uri, source):
+def world_catalogue(sources=(), world_folders=(), sound_folders=(), cache=None,
+                    budget_s=CATALOGUE_BUDGET_S, clock=time.monotonic):
+    """(worlds, problems): worlds = [(name, uri, description, tags)] of every bundled world
+    and every *.toml file in each folder of ``sources`` (its uri the file's resolved path);
+    problems = one line for each source that is no folder in ``world_folders``, each folder
+    that cannot be listed and each file that is no world, for the caller to report. Each
+    world is read whole, so what is listed loads. A source is resolved before it is taken,
+    and each folder is listed once however it is spelt; at most MAX_CATALOGUE files in all,
+    and no more reading once ``budget_s`` of ``clock`` have passed (a request must not hold
+    the simulator): what was read is kept in ``cache`` (a WorldCache), so asking again
+    goes on from there. The bundled worlds take 35 ms the first time in a process."""
+    cache = WorldCache() if cache is None else cache
+    worlds, problems, files = [], [], []
+    for name in bundled_worlds():  # read by name: the allowed folders are for a user's files
+        files.append((name, world_uri(name), _bundled() / f'{name}.toml'))
+    for folder in _source_folders(sources, world_folders, problems):
         try:
-            world = load_world(source)
-        except WorldError as err:
-            problems.append(str(err))
-        else:
-            worlds.append((name, uri, world.description, world.tags))
-
-    for name in bundled_worlds():
-        read(name, world_uri(name), name)
-    for folder in dict.fromkeys(folders):  # each once: a request may name one 10,000 times
-        try:
-            files = sorted(p for p in Path(folder).iterdir() if p.suffix == '.toml')
-        except (OSError, ValueError) as err:  # ValueError: a NUL in the name
-            problems.append(f'{_show(folder)}: cannot list world files: '
-                            f'{getattr(err, "strerror", None) or err}')
+            found = sorted(p for p in folder.iterdir() if p.suffix == '.toml')
+        except OSError as err:
+            problems.append(f'{_show(str(folder))}: cannot list world files: '
+                            f'{err.strerror or err}')
             continue
-        if len(files) > MAX_CATALOGUE:
-            problems.append(f'{folder}: more than {MAX_CATALOGUE} world files; '
-                            f'listing the first {MAX_CATALOGUE}')
-        for path in files[:MAX_CATALOGUE]:
-            read(path.stem, str(path.resolve()), str(path))
+        files += [(path.stem, str(path), path) for path in found]
+    if len(files) > MAX_CATALOGUE:
+        problems.append(f'more than {MAX_CATALOGUE} world files; listing the first '
+                        f'{MAX_CATALOGUE}')
+        del files[MAX_CATALOGUE:]
+    deadline, unread = clock() + budget_s, 0
+    for name, uri, path in files:
+        bundled = uri.startswith(BUNDLED_URI)
+        found = cache.read(path, lambda: load_world(name, sound_folders) if bundled else
+                           load_world(str(path), sound_folders, world_folders),
+                           may_load=lambda: clock() <= deadline)
+        if found is None:
+            unread += 1
+        elif isinstance(found, WorldError):
+            problems.append(str(found))
+        else:
+            worlds.append((name, uri, found.description, found.tags))
+    if unread:
+        problems.append(f'{unread} world files not read within {budget_s:g} s (ask again: '
+                        'what was read is remembered)')
     return worlds, problems
+
+
+def _source_folders(sources, world_folders, problems):
+    """The folders of a request's ``sources``, resolved, each once, in ``world_folders`` or
+    the bundled worlds' (a problem line for any other); ValueError for too many or too long."""
+    sources = list(sources)
+    if len(sources) > MAX_FOLDERS or any(len(source) > MAX_PATH for source in sources):
+        raise ValueError(f'at most {MAX_FOLDERS} sources of at most {MAX_PATH} characters each')
+    bundled = Path(str(_bundled())).resolve()
+    folders = {}
+    for source in sources:
+        path = allowed_path(source[len('file://'):] if source.startswith('file://') else source,
+                            (bundled, *world_folders))
+        if path is None or not path.is_dir():
+            problems.append(f'{_show(source)}: {FOLDER_RULE}')
+        elif path != bundled:
+            folders[path] = None
+    return list(folders)
+
+
+class WorldCache:
+    """What each world file read held (a World or the WorldError), by its path, size and time
+    of change; at most MAX_CATALOGUE files."""
+
+    def __init__(self):
+        self._held = {}
+
+    def read(self, path, load, may_load=lambda: True):
+        """The World or WorldError of ``path``: held, else load() when may_load(), else
+        None."""
+        try:
+            found = Path(path).stat()
+        except OSError as err:
+            return WorldError(f'{_show(str(path))}: cannot read world file: '
+                              f'{err.strerror or err}')
+        key = (str(path), found.st_size, found.st_mtime_ns)
+        if key not in self._held:
+            if not may_load():
+                return None
+            if len(self._held) >= MAX_CATALOGUE:
+                self._held.clear()
+            try:
+                self._held[key] = load()
+            except WorldError as err:
+                self._held[key] = err
+        return self._held[key]
 
 
 def named_poses(world, robot_name):
@@ -345,9 +418,9 @@ def _choices():
     return f'bundled worlds are {", ".join(bundled_worlds())}, or give a path to a .toml file'
 
 
-def _read(name):
+def _read(name, world_folders=None):
     """The file's first MAX_FILE_BYTES + 1 bytes (enough to tell it is too big), its name
-    and its folder (None for a bundled world)."""
+    and its folder (None for a bundled world). ``world_folders``: see load_world."""
     if not name:
         raise WorldError(f'empty world name: {_choices()}')
     if name.startswith(BUNDLED_URI) and name.endswith('.toml'):
@@ -358,31 +431,44 @@ def _read(name):
         name = name[len('file://'):]
     path = Path(name)
     if path.suffix == '.toml' or path.parent != Path('.'):
+        if world_folders is not None:
+            return _read_requested(name, world_folders)
         shown = _show(str(path))
         try:
-            # A FIFO would block the simulator until someone writes to it; a device never ends.
-            regular = path.is_file() or not path.exists()
-            if regular:
-                with path.open('rb') as file:
-                    return file.read(MAX_FILE_BYTES + 1), str(path), path.parent
+            return read_regular(path, MAX_FILE_BYTES), str(path), path.parent
+        except FileRefused:
+            raise WorldError(f'{shown}: cannot read world file: not a regular file') from None
         except OSError as err:
             raise WorldError(f'{shown}: cannot read world file: {err.strerror or err}') from None
         except ValueError:  # a NUL in the name
             raise WorldError(f'{shown}: cannot read world file: no such name') from None
-        raise WorldError(f'{shown}: cannot read world file: not a regular file')
     resource = _bundled() / f'{name}.toml'
     if len(name) > MAX_NAME or not resource.is_file():  # a longer name cannot be a file
         raise WorldError(f'unknown world {_show(name)}: {_choices()}')
     return resource.read_bytes(), f'{name}.toml', None
 
 
+def _read_requested(name, world_folders):
+    """_read of a file a client named: in ``world_folders``, a regular .toml file that can be
+    read, else one line naming the rule, the same whatever is or is not there."""
+    path = allowed_path(name, world_folders)
+    try:
+        if path is None or path.suffix != '.toml':
+            raise FileRefused(name)
+        return read_regular(path, MAX_FILE_BYTES), str(path), path.parent
+    except OSError:
+        raise WorldError(f'no world file {_show(name)} in the allowed folders: '
+                         f'{WORLD_RULE.format(", ".join(bundled_worlds()))}') from None
+
+
 class _Parser:
     """Checks one file's tables and turns them into dataclasses."""
 
-    def __init__(self, source, folder=None, sound_folders=()):
+    def __init__(self, source, folder=None, sound_folders=(), world_folders=()):
         self.source = source
         self.folder = folder  # of a user's world file: where its pictures' paths start
         self.sound_folders = tuple(sound_folders)  # besides it, where sound files may be
+        self.world_folders = tuple(world_folders or ())  # and pictures
         self.names = {BALL_NAME}  # taken so far; the ball's name is always taken
         self.shapes = []
         self.pictures = []
@@ -393,8 +479,10 @@ class _Parser:
 
     def sound_roots(self):
         """The folders a sound file may come from besides the bundled sounds."""
-        own = [Path(self.folder).resolve()] if self.folder is not None else []
-        return own + list(self.sound_folders)
+        return self.own_folder() + list(self.sound_folders)
+
+    def own_folder(self):
+        return [Path(self.folder).resolve()] if self.folder is not None else []
 
     def keys(self, where, table, allowed):
         if not isinstance(table, dict):
@@ -655,17 +743,25 @@ class _Parser:
         return [self.picture_file(f'{where}.picture', value)] * count, sides[side]
 
     def picture_file(self, where, value):
-        """Absolute path of a checked PNG named by the world file."""
+        """Absolute path of a checked PNG named by the world file: in the allowed folders
+        (PICTURE_RULE), a regular file, read without waiting; one line naming the rule
+        whether a file elsewhere is absent or not, readable or not."""
         if not isinstance(value, str) or not value or '\0' in value:
             self.fail(where, f'must be the file name of a PNG, got {_show(value)}')
-        path = self.find_picture(where, value)
-        if path in self.images:
-            return path
+        bundled = Path(str(_bundled() / 'pictures')).resolve()
+        # A bare name is a bundled picture first, then one beside the world file.
+        folders = [bundled] if Path(value).name == value else []
+        path = allowed_path(value, folders + self.own_folder() + list(self.world_folders))
         try:
-            with open(path, 'rb') as file:
-                data = file.read(MAX_PICTURE_BYTES + 1)
-        except OSError as err:
-            self.fail(where, f'cannot read {_show(value)}: {err.strerror or err}')
+            if path is None:
+                raise FileRefused(value)
+            path = str(path)
+            if path in self.images:
+                return path
+            data = read_regular(path, MAX_PICTURE_BYTES)
+        except OSError:
+            self.fail(where, f'no picture {_show(value)} in the allowed folders: '
+                             f'{PICTURE_RULE.format(_picture_choices())}')
         if len(data) > MAX_PICTURE_BYTES:
             self.fail(where, f'{_show(value)} is larger than {MAX_PICTURE_BYTES} bytes')
         try:
@@ -677,23 +773,6 @@ class _Parser:
                              'pixels in all')
         self.images[path] = (width, height)
         return path
-
-    def find_picture(self, where, value):
-        """A bare name is a bundled picture, else (in a user's world) a file next to the
-        world file; a path is taken from the world file's folder, or as it is."""
-        path = Path(value)
-        try:
-            bundled = _bundled() / 'pictures' / value
-            if path.name == value and bundled.is_file():
-                path = Path(str(bundled))
-            elif self.folder is not None and not path.is_absolute():
-                path = self.folder / path
-            if path.is_file():
-                return str(path.resolve())
-        except (OSError, ValueError):  # a name too long for the file system, say
-            pass
-        self.fail(where, f'no picture {_show(value)}: bundled pictures are '
-                         f'{_picture_choices()}, or give a path to a PNG')
 
     def place_picture(self, where, table, box, face, image):
         """Add the Picture of ``image`` on ``face`` of ``box``, centred, its size given
