@@ -248,6 +248,9 @@ def test_an_action_outside_its_space_is_refused_naming_the_part(part, value, pro
     assert (robot.kin_targets, robot.cosmetic, robot.illum) == before
     env.step({'head': [0.5, 0.3, 0.0]})  # and the environment goes on
     assert robot.kin_targets[2] == pytest.approx(0.3)
+    # float32 arithmetic a hair over a bound is rounding, not a request (0.4 m/s here).
+    env.step({'wheels': np.float32([0.40000004, -0.40000004])})
+    assert robot.wheel_cmd == (0.4, -0.4)
     env.close()
 
 

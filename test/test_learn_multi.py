@@ -116,6 +116,54 @@ def test_football_refuses_garbage_in_one_line(kwargs):
     assert '\n' not in str(refused.value)
 
 
+def test_football_refuses_a_nan_or_out_of_space_action_and_plays_on_soundly():
+    """One NaN head target sank every robot into the floor, in every later episode."""
+    env = football.parallel_env(robots=2, eyes=None)
+    env.reset(seed=1)
+    robots = env.rig.sim.robots
+    targets = {name: list(robot.kin_targets) for name, robot in robots.items()}
+    for head in ([math.nan, 0.0, 0.0], [5.0, 0.0, 0.0]):
+        with pytest.raises(ValueError, match=r"^miro02: action part 'head' .* Box\(") as no:
+            env.step({'miro01': {'head': [0.5, 0.3, 0.0]}, 'miro02': {'head': head}})
+        assert '\n' not in str(no.value)
+    # Refused before anything moved: miro01's sound action is not taken either.
+    assert {name: robot.kin_targets for name, robot in robots.items()} == targets
+    for seed in (1, 2):
+        observations, _ = env.reset(seed=seed)
+        for _ in range(5):
+            observations, rewards, terminations, *_ = env.step(
+                {agent: {'wheels': np.zeros(2)} for agent in env.agents})
+            assert not any(terminations.values())
+            assert all(np.isfinite(value).all() for obs in observations.values()
+                       for value in obs.values())
+            assert all(math.isfinite(reward) for reward in rewards.values())
+    env.close()
+
+
+def test_football_used_after_close_says_it_is_closed():
+    env = football.parallel_env(robots=2, eyes=None, render_mode='rgb_array')
+    env.reset(seed=1)
+    env.close()
+    for use in (lambda: env.step({}), lambda: env.reset(seed=2), env.render):
+        with pytest.raises(RuntimeError, match='^the environment is closed$'):
+            use()
+
+
+def test_the_t_maze_refuses_a_nan_action_and_the_next_episode_is_sound():
+    env = gymnasium.make('miro_ball/TMaze-v0', eyes=None, detectors=(), limit_s=1.0)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"^action part 'head' \[0.5, nan, 0.0\] is not "
+                                         'finite'):
+        env.step({'head': np.array([0.5, np.nan, 0.0])})
+    obs, _ = env.reset(seed=1)
+    for _ in range(5):
+        obs, reward, terminated, truncated, _ = env.step({'wheels': np.zeros(2)})
+        assert (reward, terminated) == (0.0, False)
+        assert all(np.isfinite(value).all() for value in obs.values())
+    assert env.unwrapped.rig.sim.robot.height() > 0.03
+    env.close()
+
+
 def test_the_t_maze_passes_gymnasiums_checks():
     env = gymnasium.make('miro_ball/TMaze-v0', limit_s=1.0)
     check_env(env)

@@ -94,6 +94,22 @@ def test_out_of_range_head_targets_are_clamped(empty):
     assert reached[2] == pytest.approx(JOINT_LIMITS_RAD[2][0], abs=math.radians(1.5))
 
 
+def test_a_non_finite_command_is_refused_by_the_clamps(empty):
+    """min(max(nan, lo), hi) is NaN: a NaN head target reached the physics and sank MiRo
+    into the floor. Each command holding one is refused whole."""
+    robot = empty.robot
+    robot.set_cmd_vel(0.1, 0.0)
+    targets, cosmetic, wheels = list(robot.kin_targets), list(robot.cosmetic), robot.wheel_cmd
+    assert robot.set_kinematic_targets([0.0, math.nan, 0.0, 0.0]) == tuple(targets)
+    robot.set_cosmetic([0.5, math.inf, 0.5, 0.5, 0.5, 0.5])
+    assert robot.set_cmd_vel(math.nan, 0.0) is False
+    assert robot.play_tone(math.nan, 100, 10) is None
+    assert (robot.kin_targets, robot.cosmetic, robot.wheel_cmd) == (targets, cosmetic, wheels)
+    empty.run(0.3)
+    assert empty.finite() and all(math.isfinite(v) for v in robot.sensors.kinematic_positions)
+    assert robot.height() == pytest.approx(0.045, abs=0.003)
+
+
 @pytest.fixture
 def on_table():
     """MiRo on the table at the origin of the tables world, facing its free edge at x -0.75

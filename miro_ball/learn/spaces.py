@@ -151,10 +151,15 @@ def _shown(array):
     return str(array.tolist())  # one line, whatever the shape
 
 
+# How far past a bound of a float space a value may be (relative to the bound, at least
+# absolute): a learner's float32 arithmetic lands a hair over (0.4 m/s as 0.40000002).
+BOUND_SLACK = 1e-6
+
+
 def check_part(name, space, value):
     """ValueError naming ``name`` and ``space`` (a Box) unless ``value`` is in it: its
-    shape, finite, within the bounds (a value rounded to the space's float type may touch
-    them), whole numbers for a whole-number space."""
+    shape, finite, within the bounds (give or take BOUND_SLACK for a float space), whole
+    numbers for a whole-number space."""
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):
@@ -163,15 +168,15 @@ def check_part(name, space, value):
         raise ValueError(f'{name} has shape {array.shape}; its space is {space}')
     if not np.isfinite(array).all():
         raise ValueError(f'{name} {_shown(array)} is not finite; its space is {space}')
+    low, high = space.low.astype(np.float64), space.high.astype(np.float64)
     if np.issubdtype(space.dtype, np.integer):
         if (array != np.floor(array)).any():
             raise ValueError(f'{name} {_shown(array)} is not whole numbers; its space is '
                              f'{space}')
-        within = array
     else:
-        with np.errstate(over='ignore'):  # a float32 space: beyond its range is inf
-            within = array.astype(space.dtype)
-    if (within < space.low).any() or (within > space.high).any():
+        low = low - BOUND_SLACK * np.maximum(1.0, abs(low))
+        high = high + BOUND_SLACK * np.maximum(1.0, abs(high))
+    if (array < low).any() or (array > high).any():
         raise ValueError(f'{name} {_shown(array)} is outside its space {space}')
 
 
