@@ -99,3 +99,43 @@ def test_a_process_whose_file_says_respawn_is_restarted(tmp_path):
     assert code == 0 and left == [], output
     assert output.count('[launch] again exited with code 0; respawning in 0.1 s') >= 2, output
     assert len(count.read_text()) >= 3  # each time, the program itself ran anew
+
+
+def test_a_respawned_process_leaves_nothing_of_its_earlier_runs(tmp_path):
+    """Each run starts a helper in its own process group and ends: the helper goes with it,
+    not at the launcher's end (they were left running after '[launch] stopped')."""
+    pids = tmp_path / 'helpers'
+    starter = script(tmp_path, 'starter', f"""import subprocess, sys
+helper = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(99)'])
+open({str(pids)!r}, 'a').write(f'{{helper.pid}}\\n')
+print('up')
+""")
+    launch = Launch(launch_file(tmp_path, f'''<executable name="starter" respawn="true"
+                                            respawn_delay="0.1" cmd="{starter}"/>'''))
+    try:
+        for _ in range(3):
+            launch.line('[starter] up')
+        helpers = [int(pid) for pid in pids.read_text().split()]
+        left_running = proc_tree.wait_gone(helpers[:2], 0)  # those of the ended runs
+        code, _, left, output = launch.ctrl_c()
+        assert left_running == [], output
+        assert code == 0 and left == [] and output.rstrip().endswith('[launch] stopped'), output
+        assert proc_tree.wait_gone([int(pid) for pid in pids.read_text().split()], 0) == []
+    finally:  # on a failure, nothing left behind either
+        proc_tree.send([int(pid) for pid in pids.read_text().split()], signal.SIGKILL)
+
+
+def test_a_line_without_end_is_cut_and_what_follows_still_printed(tmp_path):
+    from miro_ball.launch.runner import MAX_LINE_BYTES
+
+    hog = script(tmp_path, 'hog', """import sys
+sys.stdout.write('x' * 8_000_000)
+sys.stdout.write('\\nend\\n')
+""")
+    launch = Launch(launch_file(tmp_path, f'<executable name="hog" cmd="{hog}"/>'))
+    code, output = launch.finish()
+    lines = output.splitlines()
+    assert code == 1 and len(lines) == 5, [line[:80] for line in lines]  # the rest dropped
+    assert lines[1:] == [f'[hog] {"x" * MAX_LINE_BYTES} [cut at {MAX_LINE_BYTES} bytes]',
+                         '[hog] end', '[launch] hog exited with code 0; stopping the others',
+                         '[launch] ended'], [line[:80] for line in lines]

@@ -184,6 +184,11 @@ def test_the_command_line_runs_the_console_script_as_its_own_would(tmp_path):
     ('<launch><include file="child.launch.py"/></launch>', 'Python launch files need ros2'),
     ('<launch><include file="bad.launch.xml"/></launch>', 'include itself'),
     ('<launch><node>', 'not well-formed XML'),
+    # Bounds in all, whatever the depth: actions, processes, a value that doubles itself.
+    ('<launch>' + '<let name="a" value="b"/>' * 5001 + '</launch>', 'over 5000 actions in all'),
+    ('<launch>' + '<executable cmd="a"/>' * 101 + '</launch>', 'over 100 processes in all'),
+    ('<launch><let name="a" value="ab"/>' + '<let name="a" value="$(var a)$(var a)"/>' * 20
+     + '</launch>', 'over 10000 characters once substituted'),
     ('<robot/>', 'the root element is <robot>'),
 ])
 def test_what_is_outside_the_subset_is_refused_in_one_line_naming_it_and_its_file(
@@ -200,10 +205,100 @@ def test_what_is_outside_the_subset_is_refused_in_one_line_naming_it_and_its_fil
     ('launch:\n- timer: {period: 1}\n', '<timer> is not supported'),
     ('launch:\n- node: {pkg: a, exec: b, param: {name: a}}\n', 'param holds a list'),
     ('launch:\n- node: {pkg: a, exec: b, name: [1, 2]}\n', 'must be a single value'),
+    # Aliases are refused before they are expanded: these 300 bytes are 10^7 values.
+    ('launch:\n- - &a [x, x, x, x, x, x, x, x, x, x]\n'
+     + ''.join(f'  - &{b} [{", ".join([f"*{a}"] * 10)}]\n' for a, b in zip('abcdef', 'bcdefg')),
+     'YAML aliases (*name)'),
 ])
 def test_yaml_outside_the_subset_is_refused_too(tmp_path, text, words):
     message = refusal(tmp_path, text, suffix='.launch.yaml')
     assert words in message and 'bad.launch.yaml' in message, message
+
+
+def self_including(folder, depth=19, fan_out=4):
+    """A launch file that includes itself fan_out times, each include's arguments shifted
+    so that the includes stop at ``depth``, under the depth limit: fan_out^depth includes."""
+    names = [f'a{i}' for i in range(depth)]
+    declared = ''.join(f'<arg name="{name}" default="true"/>' for name in names)
+    shifted = ''.join(f'<arg name="{name}" value="$(var {after})"/>'
+                      for name, after in zip(names, names[1:]))
+    include = (f'<include file="bomb.launch.xml" if="$(var a0)">{shifted}'
+               f'<arg name="{names[-1]}" value="false"/></include>')
+    return write(folder, 'bomb.launch.xml', f'<launch>{declared}{include * fan_out}'
+                                            '<executable cmd="true"/></launch>')
+
+
+def test_a_file_including_itself_under_the_depth_limit_is_refused_at_once(tmp_path):
+    bomb = self_including(tmp_path)
+    assert len(bomb.read_bytes()) < 4000  # 4^19 includes, each within the depth limit
+    refused = run_cli(str(bomb), '--print')
+    assert refused.returncode == 2 and refused.stdout == '', refused.stderr
+    assert len(refused.stderr.splitlines()) == 1, refused.stderr
+    assert 'bomb.launch.xml: <include>: over 100 includes in all' in refused.stderr
+    # Two deep it is an ordinary file: the bound is on the total, not on what is usual.
+    assert [p.cmd for p in plan(self_including(tmp_path, depth=2)).processes] == \
+        [('true',)] * (1 + 4 + 16)
+
+
+@pytest.mark.parametrize('name, text, words', [
+    ('deep.launch.xml', '<launch>' + '<group>' * 5000 + '</group>' * 5000 + '</launch>',
+     '<group> is nested over 12 elements deep'),
+    ('deep.launch.yaml', 'launch: ' + '[{group: ' * 5000 + '[]' + '}]' * 5000,
+     'nested too deeply'),
+    ('deep.launch.yaml', 'launch: ' + '[{group: ' * 20 + '[]' + '}]' * 20,
+     '<group> is nested over 12 elements deep'),
+])
+def test_a_file_nested_too_deep_gets_one_line(tmp_path, name, text, words):
+    refused = run_cli(str(write(tmp_path, name, text)), '--print')
+    assert refused.returncode == 2 and refused.stdout == '', refused.stderr[-2000:]
+    assert len(refused.stderr.splitlines()) == 1 and words in refused.stderr, refused.stderr
+
+
+def test_an_include_of_a_fifo_or_a_folder_is_refused_without_waiting(tmp_path):
+    os.mkfifo(tmp_path / 'fifo.launch.xml')
+    (tmp_path / 'folder.launch.xml').mkdir()
+    for name in ('fifo.launch.xml', 'folder.launch.xml'):
+        including = write(tmp_path, 'main.launch.xml', f'<launch><include file="{name}"/>'
+                                                       '</launch>')
+        refused = run_cli(str(including), '--print')  # a hang would be the guard's timeout
+        assert refused.returncode == 2 and len(refused.stderr.splitlines()) == 1
+        assert f"main.launch.xml: <include>: {tmp_path / name}: can not be read ('{name}' " \
+            'is not a regular file)' in refused.stderr, refused.stderr
+
+
+def test_a_file_too_big_is_refused(tmp_path):
+    big = write(tmp_path, 'big.launch.xml', '<launch>' + ' ' * (1 << 20) + '</launch>')
+    assert refusal(tmp_path, f'<launch><include file="{big}"/></launch>').endswith(
+        'big.launch.xml: over 1 MB, too big for a launch file')
+
+
+# A Ctrl+C (SIGINT to itself) as the launcher imports its planner, or as it plans.
+INTERRUPTED = {
+    'import': """
+class Interrupt:
+    def find_spec(self, name, path=None, target=None):
+        if name == 'miro_ball.launch.plan':
+            os.kill(os.getpid(), signal.SIGINT)
+sys.meta_path.insert(0, Interrupt())
+""",
+    'planning': """
+import miro_ball.launch.plan as plan
+real = plan.make_plan
+def interrupted(*args):
+    os.kill(os.getpid(), signal.SIGINT)
+    return real(*args)
+plan.make_plan = interrupted
+"""}
+
+
+@pytest.mark.parametrize('when', INTERRUPTED)
+def test_ctrl_c_while_it_imports_or_plans_ends_it_quietly(when):
+    code = ('import os, runpy, signal, sys\n' + INTERRUPTED[when]
+            + "sys.argv = ['launch', 'football', '--print']\n"
+            "runpy.run_module('miro_ball.launch', run_name='__main__', alter_sys=True)\n")
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          timeout=60)
+    assert (done.returncode, done.stdout, done.stderr) == (130, '', '')
 
 
 def test_arguments_the_files_do_not_take_are_refused(sample, tmp_path):
@@ -246,7 +341,7 @@ def test_the_bundled_files_start_what_their_docs_say():
 
 def run_cli(*args, env=None, cwd=None):
     return subprocess.run([sys.executable, '-m', 'miro_ball.launch', *args], capture_output=True,
-                          text=True, env=env, cwd=cwd)
+                          text=True, env=env, cwd=cwd, timeout=60)  # a hang guard only
 
 
 def test_help_lists_the_bundled_files_and_their_arguments_and_print_runs_nothing():

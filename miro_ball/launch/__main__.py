@@ -1,9 +1,15 @@
 """python -m miro_ball.launch FILE_OR_NAME [name:=value ...]: a launch file run without
 ROS 2's launch (docs/launch.md)."""
+import signal
+import sys
+
+if __name__ == '__main__':  # first: a Ctrl+C while the rest imports, or while the files are
+    # read and planned, ends it quietly (130, as a shell says); the run notes its own
+    signal.signal(signal.SIGINT, lambda *_: sys.exit(130))
+
 import argparse
 import os
 import shlex
-import sys
 
 from miro_ball.common.cli import Parser
 from miro_ball.launch import LaunchError

@@ -12,7 +12,14 @@ from xml.etree import ElementTree
 
 import yaml
 
+from miro_ball.common.files import read_regular
 from miro_ball.launch import LaunchError
+from miro_ball.ros2.convert import check_yaml
+
+MAX_FILE_BYTES = 1 << 20  # ours are 2 kB; a launch file is text a person writes
+# Elements inside elements, <launch> counted: ours nest three deep. Also what keeps reading
+# and planning (a recursion each) far from Python's recursion limit, includes and all.
+MAX_NESTING = 12
 
 ACTIONS = ('arg', 'let', 'node', 'executable', 'group', 'include')
 CONDITIONS = ('if', 'unless')
@@ -56,18 +63,24 @@ def read_file(path):
     if read is None:
         raise LaunchError(f'{path}: not a launch file in XML or YAML (.launch.xml, '
                           '.launch.yaml; Python launch files need ros2 launch)')
-    try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as err:
+    try:  # links followed (a colcon --symlink-install's share folder is links), then
+        # opened without waiting: a FIFO or a device is refused, not waited on
+        data = read_regular(path.resolve(), MAX_FILE_BYTES)
+        text = data.decode()
+    except (OSError, RuntimeError, UnicodeDecodeError) as err:
         raise LaunchError(f'{path}: can not be read ({err})') from None
+    if len(data) > MAX_FILE_BYTES:
+        raise LaunchError(f'{path}: over {MAX_FILE_BYTES >> 20} MB, too big for a launch file')
     return read(text, path)
 
 
-def _checked(kind, attrs, path, parent):
+def _checked(kind, attrs, path, parent, depth):
     """The entity's row of SUBSET; LaunchError for an element, attribute or missing
-    attribute outside it."""
+    attribute outside it, or for one nested deeper than MAX_NESTING."""
     key = f'{parent}/{kind}' if f'{parent}/{kind}' in SUBSET else kind
     where = f'{path}: <{kind}>'
+    if depth > MAX_NESTING:
+        raise LaunchError(f'{where} is nested over {MAX_NESTING} elements deep')
     if key not in SUBSET or (parent and kind not in SUBSET[parent][1]):
         inside = f' inside <{parent}>' if parent not in ('', 'launch') else ''
         raise LaunchError(f'{where}{inside} is not supported by python -m miro_ball.launch '
@@ -90,46 +103,50 @@ def _from_xml(text, path):
         raise LaunchError(f'{path}: not well-formed XML ({err})') from None
     if root.tag != 'launch':
         raise LaunchError(f'{path}: the root element is <{root.tag}>, not <launch>')
-    return _xml_entity(root, path, '')
+    return _xml_entity(root, path, '', 1)
 
 
-def _xml_entity(element, path, parent):
-    key = _checked(element.tag, element.attrib, path, parent)
+def _xml_entity(element, path, parent, depth):
+    key = _checked(element.tag, element.attrib, path, parent, depth)
     return Entity(key, dict(element.attrib), path,
-                  [_xml_entity(child, path, key) for child in element])
+                  [_xml_entity(child, path, key, depth + 1) for child in element])
 
 
 def _from_yaml(text, path):
-    try:
+    try:  # aliases expand 300 bytes into millions of values: refused before they are built
+        check_yaml(text)
         document = yaml.safe_load(text)
     except yaml.YAMLError as err:
         raise LaunchError(f'{path}: not valid YAML ({" ".join(str(err).split())})') from None
+    except ValueError as err:
+        raise LaunchError(f'{path}: {err}') from None
     if not isinstance(document, dict) or list(document) != ['launch']:
         raise LaunchError(f'{path}: a YAML launch file is one mapping, launch: [actions]')
-    return _yaml_entity('launch', document['launch'], path, '')
+    return _yaml_entity('launch', document['launch'], path, '', 1)
 
 
-def _yaml_entity(kind, body, path, parent):
+def _yaml_entity(kind, body, path, parent, depth):
     where = f'{path}: <{kind}>'
     if kind in ACTION_LISTS:  # a list of actions, or (a group) a mapping with its children
         attrs = {str(k): v for k, v in body.items()} if isinstance(body, dict) else {}
         listed = attrs.pop('children', []) if isinstance(body, dict) else body
         if not isinstance(listed, list):
             raise LaunchError(f'{where} holds a list of actions')
-        key = _checked(kind, attrs, path, parent)
+        key = _checked(kind, attrs, path, parent, depth)
         attrs = _scalars(attrs, where)
-        return Entity(key, attrs, path,
-                      [_yaml_entity(*_one_key(item, where), path, key) for item in listed])
+        return Entity(key, attrs, path, [_yaml_entity(*_one_key(item, where), path, key,
+                                                      depth + 1) for item in listed])
     if not isinstance(body, dict):
         raise LaunchError(f'{where} is a mapping of its attributes')
     children = SUBSET.get(kind, ((), ()))[1]
     attrs = {str(name): value for name, value in body.items() if name not in children}
-    key = _checked(kind, attrs, path, parent)
+    key = _checked(kind, attrs, path, parent, depth)
     entity = Entity(key, _scalars(attrs, where), path)
     for child in (name for name in body if name in children):
         if not isinstance(body[child], list):
             raise LaunchError(f'{where}: {child} holds a list of mappings')
-        entity.children += [_yaml_entity(child, item, path, key) for item in body[child]]
+        entity.children += [_yaml_entity(child, item, path, key, depth + 1)
+                            for item in body[child]]
     return entity
 
 

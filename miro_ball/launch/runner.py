@@ -4,7 +4,9 @@ its output printed line by line after its label; one that ends restarted or endi
 killed if they have not after STOP_GRACE_S (``run.processes.stop_all``).
 
 The children's own sessions keep a terminal's Ctrl+C from reaching them straight: the
-launcher tells each one itself, so that it knows which it told and waits for them all.
+launcher tells each one itself, so that it knows which it told and waits for them all. What
+one that ended leaves running in its group (its helpers) is killed there and then: a
+process restarted leaves nothing of its earlier runs behind.
 """
 import subprocess
 import sys
@@ -12,11 +14,14 @@ import threading
 import time
 
 from miro_ball.launch.exits import Restart, after_exit
-from miro_ball.run.processes import stop_all
+from miro_ball.run.processes import stop_all, stop_group
 
 POLL_S = 0.05
 STOP_GRACE_S = 5.0  # our nodes stop within a second of their Ctrl+C
 READER_WAIT_S = 1.0  # for the last lines of a process that ended
+# A line longer is cut there, the rest of it skipped: 250 MB with no newline took the
+# launcher to 1 GB. A log line is under a kilobyte; a traceback's longest, a few.
+MAX_LINE_BYTES = 16384
 
 
 class Output:
@@ -38,11 +43,22 @@ class Output:
         """A thread that prints what pipe brings, line by line, until it closes."""
         def read():
             with pipe:
-                for raw in pipe:
+                for raw in bounded_lines(pipe, MAX_LINE_BYTES):
                     self.say(label, raw.decode(errors='replace').rstrip('\r\n'))
         thread = threading.Thread(target=read, daemon=True)
         thread.start()
         return thread
+
+
+def bounded_lines(pipe, limit):
+    """The lines of a binary pipe, each at most limit bytes: a longer one is cut, said at
+    its end, and the rest of it read and dropped."""
+    while line := pipe.readline(limit):
+        if len(line) == limit and not line.endswith(b'\n'):
+            while (rest := pipe.readline(limit)) and not rest.endswith(b'\n'):
+                pass
+            line += f' [cut at {limit} bytes]'.encode()
+        yield line
 
 
 class Running:
@@ -104,6 +120,7 @@ def _look(running, env, output, now):
         code = one.proc.poll()
         if code is None:
             continue
+        stop_group(one.proc, 0)  # what it left running; they hold its output open too
         one.reader.join(READER_WAIT_S)  # its last words before ours
         decision = after_exit(one.process, code, now)
         output.say('launch', decision.line)

@@ -7,6 +7,7 @@ import shlex
 from miro_ball.launch import LaunchError
 
 SUPPORTED = ('var', 'find-pkg-share', 'env')
+MAX_CHARS = 10_000  # of a value once substituted: a let that doubles itself grows 2^n
 
 
 def substitute(text, scope):
@@ -21,7 +22,11 @@ def substitute(text, scope):
             raise LaunchError(f'{scope.file}: {what} in {text!r} (not supported)')
         done += [rest[:start], _one(inner, scope)]
         rest = rest[end + 1:]
-    return ''.join(done) + rest
+    value = ''.join(done) + rest
+    if len(value) > MAX_CHARS:
+        raise LaunchError(f'{scope.file}: {text[:40]!r} is over {MAX_CHARS} characters once '
+                          'substituted')
+    return value
 
 
 def _one(inner, scope):

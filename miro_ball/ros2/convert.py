@@ -58,7 +58,7 @@ def has_alias(text):
     return any(isinstance(event, yaml.AliasEvent) for event in yaml.parse(text))
 
 
-def _check_events(text):
+def check_yaml(text):
     """ValueError for aliases, or for nesting deeper than any message has, seen as the text
     is read: 5000 brackets cost PyYAML 6 s of CPU before it ran out of recursion."""
     depth = 0
@@ -79,7 +79,7 @@ def parse_yaml(text):
     No anchors or aliases (& and *): 270 bytes of aliases nine deep expand to billions of
     values (a MemoryError after 40 s); a message's fields never need them."""
     try:
-        _check_events(text)
+        check_yaml(text)
         data = yaml.safe_load(text) if text.strip() else {}
     except yaml.YAMLError as err:
         mark = getattr(err, 'problem_mark', None)
