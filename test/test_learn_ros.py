@@ -1,14 +1,18 @@
 """What is learnt in an environment behaves the same on the ROS simulator: seeded KickBall
 episodes, the same controller class, in the environment and as the controller node on the
-stepped ROS simulator (the grader's placement of the seed in both)."""
+stepped ROS simulator (the grader's placement of the seed in both); and a policy folder the
+node cannot use is refused at start."""
+import os
+
 from miro_ball.controller.behaviour import BehaviourParams, make_behaviour
 from miro_ball.learn.controllers import run_controller
 from miro_ball.learn.env import MiroEnv
-from miro_ball.learn.policy_controller import PolicyController
+from miro_ball.learn.policy_controller import POLICY_ENV, PolicyController
 from miro_ball.learn.tasks import KickBall
 from miro_ball.run.episode import run_episode
 from miro_ball.run.placements import placements
 from miro_ball.run.stepped_rig import SteppedRig
+from program import Program
 
 LIMIT_S = 20.0
 EYES = (160, 90)
@@ -45,3 +49,14 @@ def test_the_trained_policy_kicks_as_the_controller_node_on_the_ros_simulator(ro
         on_ros, here = both(ros_context, POLICY, PolicyController(), seed)
         assert on_ros.kicked and here['kicked'], (seed, on_ros, here)
         assert not on_ros.fell and not here['fell']
+
+
+def test_a_policy_file_that_is_a_fifo_is_refused_at_start(tmp_path, monkeypatch):
+    """MIRO_POLICY naming a folder whose policy.json is a FIFO held the controller node at
+    start for ever, deaf to Ctrl+C and SIGTERM."""
+    os.mkfifo(tmp_path / 'policy.json')
+    monkeypatch.setenv(POLICY_ENV, str(tmp_path))
+    code, output = Program('miro_ball', '--ros-args', '-p', f'mode:={POLICY}',
+                           guard_s=60).finish()
+    assert code == 2 and len(output.strip().splitlines()) == 1, output
+    assert "policy.json: 'policy.json' is not a regular file" in output

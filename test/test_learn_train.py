@@ -1,8 +1,11 @@
 """Training and evaluating (learn.train, learn.evaluate), the bundled KickBall policy as a
 controller, the k-bandit's tabular learner. Tiny budgets: a user's runs are benchmarks."""
 import os
+import shutil
 import subprocess
 import sys
+import tracemalloc
+import zipfile
 
 import numpy as np
 import pytest
@@ -14,6 +17,7 @@ from miro_ball.learn.policy import load
 from miro_ball.learn.policy_controller import BUNDLED, POLICY_ENV, PolicyController
 from miro_ball.learn.registry import kick_ball
 from miro_ball.learn.trainers import held_out_seeds
+from program import Program
 
 SHORT_S = 10.0  # simulated seconds of a test's KickBall episode
 
@@ -103,3 +107,68 @@ def test_a_folder_of_garbage_is_refused_in_one_line(tmp_path):
     assert done.returncode == 2
     lines = [line for line in done.stderr.splitlines() if 'error' in line or 'Trace' in line]
     assert len(lines) == 1 and 'cannot read' in lines[0], done.stderr
+
+
+def test_a_policy_file_that_is_a_fifo_is_refused_at_once(tmp_path):
+    """A FIFO named policy.json held evaluate for ever (and the controller node: test_learn_ros)."""
+    os.mkfifo(tmp_path / 'policy.json')
+    code, output = Program('miro_ball.learn.evaluate', 'kick_ball', str(tmp_path),
+                           '--workers', '1', guard_s=60).finish()
+    assert code == 2 and len(output.strip().splitlines()) == 1, output
+    assert "'policy.json' is not a regular file" in output
+
+
+def weights_file(folder, shape, zeros):
+    """A policy.npz (deflated) whose weights' header says ``shape`` of float64 and which
+    holds ``zeros`` zeros after it."""
+    with zipfile.ZipFile(folder / 'policy.npz', 'w', zipfile.ZIP_DEFLATED) as archive, \
+            archive.open('weights.npy', 'w', force_zip64=True) as member:
+        np.lib.format.write_array_header_1_0(
+            member, {'descr': '<f8', 'fortran_order': False, 'shape': shape})
+        block = bytes(1 << 20)
+        for start in range(0, 8 * zeros, len(block)):
+            member.write(block[:8 * zeros - start])
+
+
+def hostile_folder(folder, kind):
+    """A policy folder whose policy.json or policy.npz is made to hurt its reader."""
+    shutil.copy(os.path.join(BUNDLED, 'policy.json'), folder)
+    if kind == 'nested':  # 20 kB
+        (folder / 'policy.json').write_text('[' * 20000)
+    elif kind == 'huge settings':  # 100 MB of nothing (a sparse file)
+        os.truncate(folder / 'policy.json', 100_000_000)
+    elif kind == 'zip bomb':  # 40 MB of zeros in 39 kB
+        weights_file(folder, (5_000_000,), 5_000_000)
+        assert os.path.getsize(folder / 'policy.npz') < 50_000
+    elif kind == 'lying header':  # 2**40 numbers claimed in 200 bytes
+        weights_file(folder, (2 ** 40,), 0)
+        assert os.path.getsize(folder / 'policy.npz') < 400
+
+
+@pytest.mark.parametrize('kind, says', [
+    ('nested', 'policy.json: nested too deeply'),
+    ('huge settings', 'policy.json: more than 65536 bytes'),
+    ('zip bomb', 'policy.npz: weights unpacks to 40000128 bytes; at most 65536'),
+    ('lying header', 'policy.npz: weights holds (1099511627776,) of float64; the policy needs '
+                     '12 numbers'),
+])
+def test_a_hostile_policy_is_refused_in_one_line_before_it_is_read(kind, says, tmp_path,
+                                                                   capsys):
+    """Its sizes and headers are checked before a number is unpacked: a 2.9 MB policy.npz
+    of 3 GB of zeros grew evaluate to 2.5 GB, a lying header and deep nesting were
+    tracebacks (MemoryError, RecursionError)."""
+    hostile_folder(tmp_path, kind)
+    tracemalloc.start()
+    try:
+        with pytest.raises(ValueError) as refused:
+            load(str(tmp_path))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert says in str(refused.value) and '\n' not in str(refused.value)
+    assert peak < 1_000_000, f'{peak} bytes taken to refuse it'
+    with pytest.raises(SystemExit) as ended:
+        evaluate.main(['kick_ball', str(tmp_path), '--workers', '1'])
+    err = capsys.readouterr().err
+    assert ended.value.code == 2 and len(err.strip().splitlines()) == 1, err
+    assert says in err

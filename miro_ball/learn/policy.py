@@ -18,6 +18,7 @@ import os
 
 import numpy as np
 
+from miro_ball.learn.policy_files import read_numbers, read_settings
 from miro_ball.miro.constants import WHEEL_MAX_SPEED_M_PER_S
 from miro_sim_bullet.physics.model import SONAR_RANGE
 
@@ -96,36 +97,30 @@ class LinearPolicy:
 
 def load_settings(folder):
     """The settings a policy folder was saved with; ValueError (one line) if unreadable."""
-    path = os.path.join(folder, SETTINGS_FILE)
-    try:
-        with open(path) as source:
-            settings = json.load(source)
-    except (OSError, ValueError) as err:
-        raise ValueError(f'cannot read {path}: {err}') from None
-    if not isinstance(settings, dict):
-        raise ValueError(f'{path} is not a JSON object of settings')
-    return settings
+    return read_settings(os.path.join(folder, SETTINGS_FILE))
 
 
 def load(folder):
     """The LinearPolicy saved in ``folder``; ValueError (one line) when it is not one."""
     settings = load_settings(folder)
-    if list(settings.get('features', ())) != list(FEATURES):
-        raise ValueError(f'{folder}: a policy of other features ({settings.get("features")}), '
-                         f'not {", ".join(FEATURES)}')
+    if settings.get('features') != list(FEATURES):
+        raise ValueError(f'{folder}: a policy of other features ({_show(settings.get("features"))}'
+                         f'), not {", ".join(FEATURES)}')
     path = os.path.join(folder, WEIGHTS_FILE)
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            weights = np.array(data['weights'], np.float64)
-    except (OSError, ValueError, KeyError) as err:
-        raise ValueError(f'cannot read {path}: {err}') from None
-    if weights.size != LinearPolicy.size() or not np.all(np.isfinite(weights)):
-        raise ValueError(f'{path}: {weights.size} weights, not {LinearPolicy.size()} finite ones')
+    weights = read_numbers(path, 'weights', LinearPolicy.size())
+    if not np.all(np.isfinite(weights)):
+        raise ValueError(f'{path}: weights that are not finite numbers')
     eyes = settings.get('eyes')
     if not (isinstance(eyes, list) and len(eyes) == 2 and all(
             isinstance(v, int) and 8 <= v <= 1280 for v in eyes)):
-        raise ValueError(f'{folder}: eyes must be [width, height], got {eyes!r}')
+        raise ValueError(f'{folder}: eyes must be [width, height], got {_show(eyes)}')
     skip = settings.get('frame_skip')
     if not isinstance(skip, int) or not 1 <= skip <= 1000:
-        raise ValueError(f'{folder}: frame_skip must be 1..1000, got {skip!r}')
+        raise ValueError(f'{folder}: frame_skip must be 1..1000, got {_show(skip)}')
     return LinearPolicy(weights, settings)
+
+
+def _show(value, limit=80):
+    """A value of the settings as a message shows it: at most ``limit`` characters."""
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + '...'

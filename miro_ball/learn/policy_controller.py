@@ -14,6 +14,7 @@ was trained, holding the wheels in between (the node calls act() every tick).
 import dataclasses
 import os
 
+from miro_ball.common.files import MAX_PATH
 from miro_ball.controller.contract import Action
 from miro_ball.learn import spaces
 from miro_ball.learn.policy import load
@@ -35,6 +36,9 @@ class PolicyController:
 
     def __init__(self, params=None):
         folder = os.environ.get(POLICY_ENV) or self.folder or BUNDLED
+        if len(folder) > MAX_PATH:
+            raise ValueError(f'{POLICY_ENV}: a folder\'s name of {len(folder)} characters; '
+                             f'at most {MAX_PATH}')
         self.policy = load(folder)  # ValueError (one line) for a folder of no policy
         self.space = spaces.observation_space(None, self.detectors)
         self.hold_s = self.policy.settings['frame_skip'] * PLATFORM_TICK_S
