@@ -31,7 +31,7 @@ from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.sim_interface import SERVICE_QOS
 from miro_sim_bullet.scene.world_file import (Ball, named_poses, parse_world, world_catalogue,
-                                              WorldError, load_world)
+                                              WorldCache, WorldError, load_world)
 
 MAX_SPAWNS = 64  # entities one SpawnEntities request may ask for
 # A StepSimulation answers when its steps are done, and the simulator does nothing else
@@ -66,8 +66,9 @@ def _result(code=Result.OK, message=''):
 class ControlInterface:
     """The services of the standard, made with ros (Endpoints) for ``host``, the node:
     it has ``sim`` (the SimWorld), ``state`` (codes.SimulationState), ``robot_name`` (for
-    a world's unnamed robot), ``world_uri`` (of the world loaded), ``sound_folders`` (where
-    a world's sound files may come from), said(kind, text) (a rate-limited info line) and
+    a world's unnamed robot), ``world_uri`` (of the world loaded), ``sound_folders`` and
+    ``world_folders`` (where a client's sound files, and worlds, models and pictures, may
+    come from), said(kind, text) (a rate-limited info line) and
     the acts act(action) ('play', 'pause', 'stop', 'quit'), step(n) -> (done, message),
     reset(scope), world_changed() and load(world, uri) / unload(). warn(kind, message) is
     a rate-limited warning, errors(text) logs a failure of ours (with its traceback)."""
@@ -76,6 +77,7 @@ class ControlInterface:
         self.host, self._warn, self._errors = host, warn, errors
         self.info = {}  # entity name -> Entity (set_entity_info's, or its defaults)
         self._velocity = {}  # entity name -> ((t, v, w) at the last platform tick, before)
+        self._world_cache = WorldCache()  # what get_available_worlds read, asked again
         handlers = {
             srv.GetSimulatorFeatures: self._features, srv.GetSimulationState: self._get_state,
             srv.SetSimulationState: self._set_state, srv.StepSimulation: self._step,
@@ -329,7 +331,7 @@ class ControlInterface:
         # Every name get_entities lists is taken: 'wall_3' (a world's unnamed wall) too.
         spawn = parse_spawn(request.name, request.allow_renaming, resource.uri,
                             resource.resource_string, request.entity_namespace,
-                            sim.names() | set(sim.entities()))
+                            sim.names() | set(sim.entities()), self.host.world_folders)
         (x, y, z), orientation = self._world_pose(request.initial_pose.header.frame_id,
                                                   request.initial_pose.pose,
                                                   codes.SpawnResult.INVALID_POSE)
@@ -417,7 +419,12 @@ class ControlInterface:
         response.result = _result()
 
     def _worlds(self, request, response):
-        worlds, problems = world_catalogue(list(request.additional_sources))
+        try:
+            worlds, problems = world_catalogue(
+                list(request.additional_sources), self.host.world_folders,
+                self.host.sound_folders, self._world_cache)
+        except ValueError as err:  # too many sources, or too long
+            raise Refused(Result.OPERATION_FAILED, str(err)) from None
         if problems and not request.continue_on_error:
             raise Refused(Result.OPERATION_FAILED, problems[0])
         keep = tag_filter(list(request.filter.tags), request.filter.filter_mode)
@@ -439,16 +446,18 @@ class ControlInterface:
             raise Refused(Result.INCORRECT_STATE, 'a world is loading already')
         try:
             if request.uri:
-                world, uri = load_world(request.uri, self.host.sound_folders), request.uri
+                world = load_world(request.uri, self.host.sound_folders,
+                                   self.host.world_folders)
+                uri = request.uri
             elif request.resource_string:
                 world = parse_world(request.resource_string, 'resource_string',
-                                    self.host.sound_folders)
+                                    self.host.sound_folders, self.host.world_folders)
                 uri = ''
             else:
                 raise Refused(code.NO_RESOURCE, 'give a uri (a bundled world, a file) or a '
                                                 'resource_string (a world file\'s text)')
         except WorldError as err:
-            unknown = 'unknown world' in str(err) or 'cannot read' in str(err)
+            unknown = any(text in str(err) for text in ('unknown world', 'no world file'))
             raise Refused(code.NO_RESOURCE if unknown else code.RESOURCE_PARSE_ERROR,
                           f'{err} (the current world stays loaded)') from None
         self.host.load(world, uri)

@@ -1,0 +1,124 @@
+"""The standard simulator services read no file outside the allowed folders: the bundled
+worlds, models and pictures, and the folders the simulator was started with (world_folders).
+Anything else is refused in one line that names the rule, the same line whether the file is
+there or not, and never a word of what a file holds; the world steps on meanwhile."""
+import re
+from importlib.resources import files
+
+import pytest
+from simulation_interfaces import srv
+
+from test_sim_standard_hostile import FAILED, ok, pose, serve, still_works
+
+SECRET = 'AKIA-PLANTED-SECRET'
+
+
+@pytest.fixture
+def folders(tmp_path):
+    """(the simulator's world_folders, a private folder): each with a world, a config file
+    and a picture holding SECRET."""
+    allowed, private = tmp_path / 'worlds', tmp_path / 'private'
+    png = (files('miro_sim_bullet.worlds') / 'pictures' / 'face_photo.png').read_bytes()
+    for folder in (allowed, private):
+        folder.mkdir()
+        (folder / 'world.toml').write_text(f'description = "{SECRET}"\n[robot]\n')
+        (folder / 'config.toml').write_text(f'[ball]\nradius = "{SECRET}"\n')
+        (folder / 'crate.toml').write_text('[box]\nsize = [0.1, 0.1, 0.1]\nmass = 0.5\n')
+        (folder / 'photo.png').write_bytes(png)
+        (folder / 'notes.png').write_text(SECRET)
+    return allowed, private
+
+
+def one_line(message, name):
+    """The refusal with the name it quotes taken out: what it says of the rule."""
+    assert SECRET not in message and '\n' not in message, message
+    return re.sub(r"'[^']*'", 'NAME', message, count=1).replace(name, 'NAME')
+
+
+def test_the_catalogue_lists_the_allowed_folders_only(make_sim, folders):
+    allowed, private = folders
+    node = make_sim(world_folders=str(allowed))
+    for sources in ([str(private)], [f'{allowed}/../private'], ['/etc'], ['~']):
+        refused = serve(node, srv.GetAvailableWorlds, additional_sources=sources)
+        assert refused.result.result == FAILED
+        assert 'not a folder the simulator may list' in one_line(
+            refused.result.error_message, sources[0])
+        listed = ok(serve(node, srv.GetAvailableWorlds, additional_sources=sources,
+                          continue_on_error=True))
+        assert SECRET not in str(listed) and 'world' not in {w.name for w in listed.worlds}
+    listed = ok(serve(node, srv.GetAvailableWorlds, additional_sources=[str(allowed)],
+                      continue_on_error=True))
+    assert {'miro', 'world'} <= {w.name for w in listed.worlds}
+    still_works(node)
+
+
+def test_a_flood_of_spellings_of_one_folder_is_refused_at_once(make_sim, folders):
+    """2,187 spellings of worlds/ (74 kB) stopped /clock for 71 s."""
+    allowed, _ = folders
+    node = make_sim(world_folders=str(allowed))
+    spelt = [str(allowed) + '/.' * k for k in range(2187)]
+    refused = serve(node, srv.GetAvailableWorlds, additional_sources=spelt)
+    assert refused.result.result == FAILED
+    assert 'at most 16 sources' in refused.result.error_message
+    listed = ok(serve(node, srv.GetAvailableWorlds, additional_sources=spelt[:16],
+                      continue_on_error=True))
+    assert [w.name for w in listed.worlds].count('world') == 1  # each folder once
+    still_works(node)
+
+
+def test_load_world_reads_no_file_outside_and_says_the_same_whatever_is_there(make_sim,
+                                                                              folders):
+    allowed, private = folders
+    node = make_sim(world_folders=str(allowed))
+    lines = set()
+    for uri in (str(private / 'world.toml'), str(private / 'config.toml'),
+                str(private / 'missing.toml'), f'file://{private}/world.toml',
+                f'{allowed}/../private/config.toml', '/etc/shadow', '/etc/passwd'):
+        refused = serve(node, srv.LoadWorld, uri=uri)
+        assert refused.result.result == srv.LoadWorld.Response.NO_RESOURCE, uri
+        lines.add(one_line(refused.result.error_message, uri))
+    assert len(lines) == 1 and 'world_folders' in lines.pop()
+    assert ok(serve(node, srv.GetCurrentWorld)).world.name == 'miro'  # stays loaded
+    assert ok(serve(node, srv.LoadWorld, uri='world.toml')).world.name == 'world'
+    still_works(node)
+
+
+def test_a_worlds_picture_is_no_window_onto_other_files(make_sim, folders):
+    """A box's picture = "/absolute/path.png" hung any PNG on a wall, in MiRo's eyes."""
+    allowed, private = folders
+    node = make_sim(world_folders=str(allowed))
+    box = '[robot]\n[[box]]\nsize = [1, 1, 1]\nposition = [2, 0, 0.5]\npicture = "{}"\n'
+    lines = set()
+    for picture in (private / 'photo.png', private / 'notes.png', private / 'missing.png',
+                    f'{allowed}/../private/photo.png'):
+        refused = serve(node, srv.LoadWorld, resource_string=box.format(picture))
+        assert refused.result.result == srv.LoadWorld.Response.RESOURCE_PARSE_ERROR
+        lines.add(one_line(refused.result.error_message, str(picture)))
+    assert len(lines) == 1 and 'no picture' in lines.pop()
+    assert ok(serve(node, srv.LoadWorld, resource_string=box.format(allowed / 'photo.png')))
+    assert node.sim.loaded.pictures
+    still_works(node)
+
+
+def test_spawn_entity_reads_models_from_packages_and_the_allowed_folders_only(make_sim,
+                                                                               folders):
+    allowed, private = folders
+    node = make_sim(world_folders=str(allowed))
+    lines = set()
+    for uri in (str(private / 'crate.toml'), str(private / 'missing.toml'),
+                f'file://{private}/config.toml', 'package://miro_ball//etc/passwd.toml',
+                'package://miro_ball/../../../etc/x.toml'):
+        refused = serve(node, srv.SpawnEntity, name='crate', uri=uri,
+                        initial_pose=pose(1.0, 1.0))
+        assert refused.result.result == srv.SpawnEntity.Response.NO_RESOURCE, uri
+        lines.add(one_line(refused.result.error_message, uri))
+    assert len(lines) == 1 and 'world_folders' in lines.pop()
+    ok(serve(node, srv.SpawnEntity, name='crate', uri=str(allowed / 'crate.toml'),
+             initial_pose=pose(1.0, 1.0)))
+    assert 'crate' in still_works(node)
+
+
+def test_a_world_folder_that_is_no_folder_stops_the_start(make_sim, tmp_path):
+    with pytest.raises(ValueError, match="parameter world_folders: '.*none' is not a folder"):
+        make_sim(world_folders=str(tmp_path / 'none'))
+
