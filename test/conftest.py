@@ -34,7 +34,7 @@ TIERS = {
              'test_client_map', 'test_robot_object', 'test_scene', 'test_grade_host',
              'test_callback_faults', 'test_sensors_package', 'test_ros2_cli', 'test_foxglove',
              'test_tf', 'test_audio_clients', 'test_animal', 'test_readers',
-             'test_ros2_sim_interfaces', 'test_sim_standard_hostile')),
+             'test_ros2_sim_interfaces', 'test_sim_standard_hostile', 'test_sim_files')),
     'e2e': ('whole runs as processes: demo, grader, recorder, tutorial, soak, packaging',
             ('test_closed_loop', 'test_lab', 'test_grade', 'test_launch',
              'test_record', 'test_restart', 'test_scenario_bench',
