@@ -6,20 +6,24 @@ every entity's state is finite.
 """
 import math
 import os
+import threading
+from types import SimpleNamespace
 
 import pytest
 from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CompressedImage
-from rclpy.action import ActionClient
+from rclpy.action import ActionClient, GoalResponse
+from rclpy.qos import QoSProfile
 from simulation_interfaces import msg as si
 from simulation_interfaces import srv
 from simulation_interfaces.action import SimulateSteps
 
 from fuzzmsg import hostile
 from miro_ball.miro.interface import RobotTopics
-from miro_sim_bullet.ros.step_action import MAX_GOALS
+from miro_sim_bullet.ros import step_action
+from miro_sim_bullet.ros.step_action import MAX_GOALS, StepAction
 from miro_sim_bullet.scene.world_file import MAX_SHAPES, Shape
 from rostools import advance_ticks, Probe, spin_until
 
@@ -167,11 +171,11 @@ def test_robots_are_limited_per_request_and_per_world(paused_sim):
     many = serve(node, srv.SpawnEntities, spawn_requests=[one] * 10000)
     assert many.result.result == FAILED and 'at most 64' in many.result.error_message
     assert len(node.sim.robots) == 1
-    for k in range(15):  # half a metre apart: a MiRo is not spawned inside another
+    for k in range(15):  # on the ground beyond the arena's wall, half a metre apart
         ok(serve(node, srv.SpawnEntity, allow_renaming=True, uri=MIRO_URDF,
-                 initial_pose=pose(x=-2.0 + 0.5 * (k % 5), y=1.0 + 0.5 * (k // 5))))
+                 initial_pose=pose(x=-3.5 + 0.5 * (k % 5), y=1.0 + 0.5 * (k // 5), z=-1.0)))
     full = serve(node, srv.SpawnEntity, allow_renaming=True, uri=MIRO_URDF,
-                 initial_pose=pose(x=-2.0, y=-1.0))
+                 initial_pose=pose(x=-3.0, y=-1.0, z=-1.0))
     assert full.result.result == FAILED and '16 robots' in full.result.error_message
     for name in list(node.sim.robots):  # every robot gone, its topics with it
         ok(serve(node, srv.DeleteEntity, entity=name))
@@ -306,6 +310,117 @@ def test_simulate_steps_huge_many_and_across_a_world_load(paused_sim, ros_contex
     assert 'ball' in still_works(node)
 
 
+class Steps:
+    """A client of /miro_sim/simulate_steps whose own queues are deep: what goes unanswered
+    is the simulator's doing."""
+
+    def __init__(self, ros_context, executor):
+        self.executor = executor
+        deep = QoSProfile(depth=1000)
+        self.action = ActionClient(Probe(ros_context, executor).node, SimulateSteps,
+                                   '/miro_sim/simulate_steps', goal_service_qos_profile=deep,
+                                   result_service_qos_profile=deep,
+                                   cancel_service_qos_profile=deep)
+        assert self.action.wait_for_server(timeout_sec=10)
+
+    def send(self, steps):
+        """The goal's handle, once answered."""
+        sent = self.action.send_goal_async(SimulateSteps.Goal(steps=steps))
+        spin_until(self.executor, sent.done)
+        return sent.result()
+
+    def result(self, goal):
+        ended = goal.get_result_async()
+        spin_until(self.executor, ended.done)
+        return ended.result()
+
+
+def test_every_goal_of_a_burst_is_answered(paused_sim, ros_context, executor):
+    """16 goals sent at once: 10 were accepted and 6 never answered, neither accepted nor
+    rejected (the action's services kept ROS's default queue of 10 requests)."""
+    node = paused_sim
+    steps = Steps(ros_context, executor)
+    start = node.sim.time
+    sent = [steps.action.send_goal_async(SimulateSteps.Goal(steps=5))
+            for _ in range(MAX_GOALS + 4)]
+    spin_until(executor, lambda: all(s.done() for s in sent))
+    accepted = [s.result() for s in sent if s.result().accepted]
+    assert len(accepted) >= MAX_GOALS  # the rest rejected: over the limit
+    for goal in accepted:
+        assert steps.result(goal).status == GoalStatus.STATUS_SUCCEEDED
+    assert node.sim.time == pytest.approx(start + 5 * len(accepted) * node.sim.dt)
+    still_works(node)
+
+
+def test_a_cancelled_goal_that_waits_ends_at_once(paused_sim, ros_context, executor):
+    """A goal waiting behind one of 2**64-1 steps was cancelled and never ended: only the
+    goal in hand was looked at."""
+    node = paused_sim
+    steps = Steps(ros_context, executor)
+    endless, waiting = steps.send(2 ** 64 - 1), steps.send(10)
+    assert endless.accepted and waiting.accepted
+    cancel = waiting.cancel_goal_async()
+    spin_until(executor, cancel.done)
+    assert steps.result(waiting).status == GoalStatus.STATUS_CANCELED
+    assert endless.status == GoalStatus.STATUS_EXECUTING
+    start = node.sim.time
+    spin_until(executor, lambda: node.sim.time > start + 0.1)  # the endless one steps on
+    cancel = endless.cancel_goal_async()
+    spin_until(executor, cancel.done)
+    assert steps.result(endless).status == GoalStatus.STATUS_CANCELED
+    still_works(node)
+
+
+def test_a_callback_that_fails_does_not_end_the_action(paused_sim, ros_context, executor,
+                                                        monkeypatch, capfd):
+    """rclpy raises a callback's error in the thread that spins the action's node, and it
+    was caught there for good: one failed goal callback, and no goal was answered again. A
+    failure in a goal's execution kept its place: 16 of them, and every goal was rejected."""
+    node = paused_sim
+    steps = Steps(ros_context, executor)
+    accept, failed = node.step_action._accept, []
+
+    def fails_once(request):
+        if not failed:
+            failed.append(request)
+            raise RuntimeError('injected fault in the goal callback')
+        return accept(request)
+    node.step_action.server.register_goal_callback(fails_once)
+    lost = steps.action.send_goal_async(SimulateSteps.Goal(steps=1))
+    spin_until(executor, lambda: failed)
+    for _ in range(3):
+        goal = steps.send(2)
+        assert steps.result(goal).status == GoalStatus.STATUS_SUCCEEDED
+    assert not lost.done()  # its callback failed: no answer, and the next ones got theirs
+    assert 'injected fault in the goal callback' in capfd.readouterr().err
+
+    def broken(handle):
+        raise RuntimeError('injected fault in a goal')
+    monkeypatch.setattr(step_action, 'Goal', broken)
+    for _ in range(MAX_GOALS):
+        assert steps.result(steps.send(1)).status == GoalStatus.STATUS_ABORTED
+    monkeypatch.undo()
+    goal = steps.send(3)
+    assert goal.accepted and steps.result(goal).status == GoalStatus.STATUS_SUCCEEDED
+    still_works(node)
+
+
+def test_a_goal_accepted_as_the_action_closes_ends_at_once(ros_context):
+    """close() ended the goals waiting; one whose execution began just after waited for
+    ever, a thread with it."""
+    action = StepAction(host=None, context=ros_context)
+    assert action._accept(SimulateSteps.Goal(steps=10)) == GoalResponse.ACCEPT
+    action.close()
+    ended = []
+    handle = SimpleNamespace(request=SimulateSteps.Goal(steps=10), is_cancel_requested=False,
+                             abort=lambda: ended.append('aborted'))
+    late = threading.Thread(target=action._execute, args=(handle,), daemon=True)
+    late.start()
+    late.join(timeout=10.0)  # a guard against the hang
+    assert not late.is_alive() and ended == ['aborted']
+    assert action._accept(SimulateSteps.Goal(steps=10)) == GoalResponse.REJECT
+
+
 def test_name_filters_that_backtrack_forever_in_re_answer_at_once(paused_sim):
     """'(a+)+$' took 2**n steps in Python's re on a name of n a's and a '_': a spawned box
     named so, then one get_entities, and the simulator hung for good."""
@@ -387,6 +502,47 @@ def test_a_miro_is_not_spawned_inside_another_or_a_box_inside_a_miro(paused_sim)
     assert box.result.result == srv.SpawnEntity.Response.INVALID_POSE
     ok(serve(node, srv.SpawnEntity, name='miro_b', uri=MIRO_URDF,
                     initial_pose=pose(x=-0.6, y=0.6)))
+    still_works(node)
+
+
+def test_a_miro_is_never_put_inside_a_wall_or_a_table_but_may_stand_beside_or_on_one(
+        paused_sim):
+    """MiRo set or spawned into a wall panel was answered OK, and thrown 2.2 m up and out of
+    the arena. Walls and tables are tested by their shapes: beside a turned panel (inside
+    its bounding box) is clear, and so are a floor and a table top to stand on."""
+    node = paused_sim
+    robot = next(iter(node.robots))
+    where = ok(serve(node, srv.GetEntityState, entity=robot)).state.pose
+    half_turn = (0.0, 0.0, math.sin(math.pi / 12), math.cos(math.pi / 12))  # 30 deg
+    into_panel = {'x': 1.15, 'y': 0.0}  # panel 0 stands at x = 1.21, MiRo's nose 0.19 ahead
+    set_ = serve(node, srv.SetEntityState, entity=robot, state=entity_state(pose(**into_panel)))
+    assert set_.result.result == srv.SetEntityState.Response.INVALID_POSE
+    assert set_.result.error_message == (f'{robot} there would be inside ring_0: put it '
+                                         'elsewhere (or on top)')
+    assert ok(serve(node, srv.GetEntityState, entity=robot)).state.pose == where
+    spawned = serve(node, srv.SpawnEntity, name='miro_b', uri=MIRO_URDF,
+                    initial_pose=pose(**into_panel, q=half_turn))
+    assert spawned.result.result == srv.SpawnEntity.Response.INVALID_POSE
+    assert 'miro_b there would be inside ring_0' in spawned.result.error_message
+    assert 'miro_b' not in still_works(node)
+    # Nose 5 mm from panel 0; facing panel 1 (at 30 deg), 5 mm from it, well inside the
+    # panel's bounding box.
+    ok(serve(node, srv.SetEntityState, entity=robot, state=entity_state(pose(x=1.01))))
+    beside = 1.01 * math.cos(math.pi / 6), 1.01 * math.sin(math.pi / 6)
+    ok(serve(node, srv.SpawnEntity, name='miro_b', uri=MIRO_URDF,
+             initial_pose=pose(*beside, q=half_turn)))
+    node.advance(500)  # a second: neither is thrown
+    for name, (x, y) in ((robot, (1.01, 0.0)), ('miro_b', beside)):
+        at = ok(serve(node, srv.GetEntityState, entity=name)).state.pose.position
+        assert (at.x, at.y, at.z) == pytest.approx((x, y, 0.0), abs=0.02), name
+    ok(serve(node, srv.LoadWorld, uri='tables'))  # MiRo stands on the table at the origin
+    robot = next(iter(node.robots))
+    ok(serve(node, srv.SetEntityState, entity=robot, state=entity_state(pose(x=0.3, z=1.0))))
+    ok(serve(node, srv.SetEntityState, entity=robot, state=entity_state(pose(x=0.3))))  # under
+    into_top = serve(node, srv.SetEntityState, entity=robot,
+                     state=entity_state(pose(x=0.3, z=0.9)))
+    assert into_top.result.result == srv.SetEntityState.Response.INVALID_POSE
+    assert 'would be inside table_' in into_top.result.error_message
     still_works(node)
 
 
