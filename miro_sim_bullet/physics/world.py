@@ -79,6 +79,7 @@ class SimWorld:
         world = self.description
         # body id -> (name or group, 'static' | 'mover' | 'robot'): what the scene calls it.
         self.body_labels = {}
+        self._probes = {}  # half extents -> a collision shape for statics_within()
         self.shape_of = {}  # body id -> the world_file Shape (or Ball) it was made from
         if world.ground_height is not None:
             plane = Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
@@ -322,6 +323,25 @@ class SimWorld:
         bodies = {body for body, _ in found}
         movers = {**self.objects, **{name: r.body_id for name, r in self.robots.items()}}
         return sorted(name for name, body in movers.items() if body in bodies)
+
+    def statics_within(self, half, centre, yaw):
+        """Names of the static bodies (walls, tables, the floor) that a box of ``half``
+        extents at ``centre``, turned by ``yaw``, reaches into: by their shapes, not their
+        bounding boxes, so that a box beside a turned wall panel is clear of it."""
+        kw = self._kw()
+        flat = math.hypot(half[0], half[1])  # the box turned any way stays within this
+        low = (centre[0] - flat, centre[1] - flat, centre[2] - half[2])
+        high = (centre[0] + flat, centre[1] + flat, centre[2] + half[2])
+        near = {body for body, _ in pb.getOverlappingObjects(low, high, **kw) or ()}
+        if half not in self._probes:  # once a build: Bullet can not free a collision shape
+            self._probes[half] = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, **kw)
+        turn = pb.getQuaternionFromEuler((0, 0, yaw))
+        return sorted(name for name, body in self.entities().items()
+                      if body in near and self.body_labels[body][1] == 'static'
+                      and pb.getClosestPoints(bodyA=-1, bodyB=body, distance=0.0,
+                                              collisionShapeA=self._probes[half],
+                                              collisionShapePositionA=centre,
+                                              collisionShapeOrientationA=turn, **kw))
 
     def _check_free(self, name):
         if not name or name in self.names():

@@ -25,8 +25,9 @@ from miro_sim_bullet.control import codes
 from miro_sim_bullet.control.codes import EntityCategory, Refused, Result
 from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter, tag_filter
 from miro_sim_bullet.control.poses import check_pose, check_twist, in_world, WORLD_FRAMES
-from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, reach, robot_reach,
-                                              RobotSpawn, SPAWN_FORMATS, spawnables)
+from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, reach, robot_box,
+                                              robot_reach, RobotSpawn, SPAWN_FORMATS,
+                                              spawnables)
 from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.sim_interface import SERVICE_QOS
@@ -255,6 +256,8 @@ class ControlInterface:
                                       invalid)
         if entity.category == EntityCategory.STATIC_OBJECT:
             raise Refused(Result.OPERATION_FAILED, f'{entity.name} is static: it does not move')
+        if entity.name in self.sim.robots:
+            self._check_room(entity.name, invalid, robot_at=(position, yaw_of(*orientation)))
         self.sim.set_object_pose(entity.name, position, orientation)
         if entity.name not in self.sim.robots:  # a robot's wheels say how it moves
             self.sim.set_body_velocity(self.sim.entities()[entity.name], linear, angular)
@@ -337,11 +340,11 @@ class ControlInterface:
                                                   codes.SpawnResult.INVALID_POSE)
         try:
             if isinstance(spawn, RobotSpawn):
-                self._check_room(spawn.name, robot_reach((x, y, z), yaw_of(*orientation)))
+                self._check_room(spawn.name, robot_at=((x, y, z), yaw_of(*orientation)))
                 sim.spawn_robot(spawn.name, x, y, yaw_of(*orientation), floor=z)
             elif isinstance(spawn.body, Ball):
                 centre = (x, y, max(z, spawn.body.radius + spawn.body.floor))
-                self._check_room(spawn.name, reach(spawn.body, centre, 0.0))
+                self._check_room(spawn.name, box=reach(spawn.body, centre, 0.0))
                 sim.spawn_ball(spawn.body, *centre)
             else:
                 shape = spawn.body
@@ -349,7 +352,7 @@ class ControlInterface:
                 shape = dataclasses.replace(shape, position=(x, y, max(z, lowest)),
                                             yaw=yaw_of(*orientation))
                 if shape.mass > 0:
-                    self._check_room(spawn.name, reach(shape, shape.position, shape.yaw))
+                    self._check_room(spawn.name, box=reach(shape, shape.position, shape.yaw))
                 sim.spawn_shape(shape)
         except ValueError as err:  # the world is full
             raise Refused(Result.OPERATION_FAILED, str(err)) from None
@@ -364,15 +367,21 @@ class ControlInterface:
         self.host.said('spawn', f'spawned {spawn.name} ({what}) at ({x:.3f}, {y:.3f}, {z:.3f})')
         return spawn.name
 
-    def _check_room(self, name, box):
-        """Refused INVALID_POSE if a movable body or robot spawned into ``box`` (low, high
-        corners) would be inside a movable object or robot: 64 boxes spawned on one spot
-        took 15 s of physics for 50 steps, 2,500 forever; a MiRo on a MiRo threw both."""
-        inside = self.sim.movers_within(*box)
+    def _check_room(self, name, code=codes.SpawnResult.INVALID_POSE, box=None, robot_at=None):
+        """Refused ``code`` if the movable body ``name`` put into ``box`` (low, high corners)
+        would be inside another movable object or robot: 64 boxes spawned on one spot took
+        15 s of physics for 50 steps, 2,500 forever; a MiRo on a MiRo threw both. A robot
+        (``robot_at``: its foot and heading) must also be clear of every static body by its
+        shape: one put into a wall panel was thrown 2.2 m up and out of the arena. On a
+        floor or a table top, or against a wall, it only touches them (robot_box)."""
+        statics = []
+        if robot_at is not None:
+            box = robot_reach(*robot_at)
+            statics = self.sim.statics_within(*robot_box(*robot_at), robot_at[1])
+        inside = [other for other in self.sim.movers_within(*box) if other != name] + statics
         if inside:
-            raise Refused(codes.SpawnResult.INVALID_POSE,
-                          f'{name} there would be inside {", ".join(inside[:3])}: '
-                          'spawn it elsewhere (or on top)')
+            raise Refused(code, f'{name} there would be inside {", ".join(inside[:3])}: '
+                                'put it elsewhere (or on top)')
 
     def _delete(self, request, response):
         self._need_world()
