@@ -13,6 +13,7 @@ from miro_sim_bullet.control import codes
 from miro_sim_bullet.control.codes import (Bounds, EntityCategory, Refused, SimulationState,
                                            SpawnResult, TagsFilter)
 from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter
+from miro_sim_bullet.control.posix_regex import compile_ere, MAX_PATTERN, MAX_STATES
 from miro_sim_bullet.control.spawning import (parse_spawn, resolve_uri, RobotSpawn,
                                               ShapeSpawn, SPAWNABLE_MIRO, spawnables)
 from miro_sim_bullet.control.states import transition
@@ -83,6 +84,18 @@ def test_the_name_filter_is_a_posix_extended_search():
 def test_a_pattern_that_is_no_posix_extended_expression_is_refused(pattern):
     error = refused(entity_filter, pattern, [], [], TagsFilter.ANY, EVERYWHERE)
     assert error.code == codes.Result.OPERATION_FAILED and 'filter' in str(error)
+
+
+def test_a_filter_whose_automaton_would_be_big_is_refused():
+    """'(.?){990}Q' made an automaton of 1982 states: each is looked at once a character of
+    every name, and a name cost 155 times what it cost with 'a'. Counted repetition may not
+    take an expression past as many states as a pattern has characters at most."""
+    for pattern in ('(.?){990}Q', 'x{300}', '((a?){20}){20}', '[a-z]{0,900}Q'):
+        error = refused(entity_filter, pattern, [], [], TagsFilter.ANY, EVERYWHERE)
+        assert 'too complex' in str(error) and '\n' not in str(error), pattern
+    biggest = compile_ere('^(.?){126}Q$')
+    assert len(biggest.states) <= MAX_STATES == MAX_PATTERN
+    assert biggest.search('x' * 126 + 'Q') and not biggest.search('x' * 127 + 'Q')
 
 
 def test_categories_keep_any_of_those_given_and_unknown_ones_are_refused():

@@ -12,15 +12,23 @@ longest rule and re's leftmost-first one, so a search answers as regexec would.
 The search is not re's: re backtracks, and '(a+)+$' on a name of 40 a's and a '_' would
 have taken days (2**40 ways to split the a's), the simulator with it; so would 'a*a*a*...$'.
 Pattern runs the expression as a set of automaton states a character instead: time linear
-in the name's length whatever the pattern.
+in the name's length, times at most the automaton's size. That size is bounded: written
+out without counted repetition a pattern has about as many states as characters, and a
+count that multiplies them past MAX_STATES is refused ('(.?){990}Q' had 1982 states, and a
+name cost 155 times what it costs with 'a').
 """
 import re
 import string
-from re import _constants as sre, _parser  # re's own parse tree: what re would read
+
+try:  # re's own parse tree: what re would read
+    from re import _constants as sre, _parser
+except ImportError:  # Python 3.10: the same modules under their old names
+    import sre_constants as sre
+    import sre_parse as _parser
 
 MAX_PATTERN = 256  # characters; a filter is a name pattern, not a program
-MAX_STATES = 2000  # of the automaton: 'x{1,1000}' is as big as its thousand x's
-MAX_STEPS = 20000  # (states, character) steps remembered between searches
+MAX_STATES = MAX_PATTERN  # of the automaton: 'x{300}' is as big as its 300 x's
+MAX_STEPS = 4096  # (states, character) steps remembered between searches: 35 MB at worst
 
 # The POSIX classes, over ASCII: entity names are ROS names.
 _CLASSES = {
@@ -30,7 +38,6 @@ _CLASSES = {
     'graph': r'\x21-\x7e',
 }
 _REPEATS = '*+?}'
-_REPEAT_OPS = (sre.MAX_REPEAT, sre.MIN_REPEAT, sre.POSSESSIVE_REPEAT)
 _STARTS = (sre.AT_BEGINNING, sre.AT_BEGINNING_STRING)
 _ENDS = (sre.AT_END, sre.AT_END_STRING)
 
@@ -111,7 +118,7 @@ class Pattern:
             return self._add(('split', [self._sequence(branch, then) for branch in value[1]]))
         if op == sre.AT and value in _STARTS + _ENDS:
             return self._add(('at', value, then))
-        if op in _REPEAT_OPS:
+        if op == sre.MAX_REPEAT:  # lazy and possessive ones are refused by _translate
             low, high, body = value
             if high == sre.MAXREPEAT:  # a loop: the body again, or on
                 tail = self._add(('split', []))
