@@ -166,14 +166,16 @@ def check_part(name, space, value):
         raise ValueError(f'{name} is not numbers; its space is {space}') from None
     if array.shape != space.shape:
         raise ValueError(f'{name} has shape {array.shape}; its space is {space}')
+    whole = space.dtype.kind in 'iu'
+    if (array >= space.low).all() and (array <= space.high).all() and \
+            not (whole and (array != np.floor(array)).any()):
+        return  # the usual case, quickly (a NaN fails both comparisons)
     if not np.isfinite(array).all():
         raise ValueError(f'{name} {_shown(array)} is not finite; its space is {space}')
+    if whole and (array != np.floor(array)).any():
+        raise ValueError(f'{name} {_shown(array)} is not whole numbers; its space is {space}')
     low, high = space.low.astype(np.float64), space.high.astype(np.float64)
-    if np.issubdtype(space.dtype, np.integer):
-        if (array != np.floor(array)).any():
-            raise ValueError(f'{name} {_shown(array)} is not whole numbers; its space is '
-                             f'{space}')
-    else:
+    if not whole:
         low = low - BOUND_SLACK * np.maximum(1.0, abs(low))
         high = high + BOUND_SLACK * np.maximum(1.0, abs(high))
     if (array < low).any() or (array > high).any():
