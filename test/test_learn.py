@@ -267,17 +267,23 @@ def test_the_k_bandit_refuses_an_expression_that_is_not_one():
     env.close()
 
 
-def test_a_nan_that_reaches_the_rig_is_dropped_and_the_physics_stays_finite():
+def test_a_nan_that_reaches_the_rig_is_dropped_and_the_physics_stays_finite(caplog):
     """The rig is the environments' door to the physics: what the robot's control topics
-    ignore (a NaN, a wrong length) it drops too, whoever calls it."""
+    ignore (a NaN, a wrong length) it drops too, whoever calls it, with a rate-limited
+    warning."""
     env = MiroEnv(KickBall(), eyes=None, detectors=())
     env.reset(seed=1)
     rig, robot = env.rig, env.rig.sim.robot
     targets, cosmetic = list(robot.kin_targets), list(robot.cosmetic)
-    refused = rig.act(env.robot, Action(head=(0.0, np.nan, 0.0, 0.0), wheels=(np.nan, 0.1),
-                                        cosmetic=(0.5,) * 5, tone=(440, 100, np.nan),
-                                        illum=(0xFFFFFFFF,) * 6))
+    for _ in range(3):
+        refused = rig.act(env.robot, Action(
+            head=(0.0, np.nan, 0.0, 0.0), wheels=(np.nan, 0.1), cosmetic=(0.5,) * 5,
+            tone=(440, 100, np.nan), illum=(0xFFFFFFFF,) * 6))
     assert sorted(refused) == ['cosmetic', 'head', 'tone', 'wheels']
+    said = [record.getMessage() for record in caplog.records]
+    assert len(said) == 4, said  # one line a part, however often
+    assert any(line.startswith(f'{env.robot}: action head ignored: need 4 finite positions')
+               for line in said)
     assert (robot.kin_targets, robot.cosmetic, robot.wheel_cmd) == (targets, cosmetic,
                                                                     (0.0, 0.0))
     assert robot.illum == [0xFFFFFFFF] * 6  # the sound part is taken

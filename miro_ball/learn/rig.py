@@ -6,7 +6,9 @@ The same SimWorld (robot model, worlds, physics, microphones) and the same Camer
 (renderer, MiRo's lens) as the ROS simulator. What the simulator's topics would carry is
 taken here from the robot's own tick (its ``sensors``), and an Action reaches the robot as
 the simulator's control topics hand it over, so that what is learnt here behaves the same
-there. A snapshot of the built world makes a reset cheap: restored, never rebuilt.
+there. A snapshot of the built world makes a reset cheap: restored, not rebuilt (unless
+the world holds a non-finite value). What the control topics would ignore of an Action (a
+NaN, a wrong length) never reaches the robot (learn.action_checks).
 """
 import dataclasses
 import logging
@@ -17,10 +19,10 @@ from miro_ball.common.throttle import Throttled
 from miro_ball.controller.contract import Eye, Percepts
 from miro_ball.controller.detection import DetectionParams
 from miro_ball.controller.detectors import make_detectors
+from miro_ball.learn.action_checks import refusals
 from miro_ball.miro.camera_model import CameraModel, PINHOLE
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM
 from miro_ball.miro.hearing import locate
-from miro_ball.learn.action_checks import refusals
 from miro_ball.miro.kinematics import clamp_wheel_speeds, wheel_speed2cmd_vel
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
@@ -158,8 +160,9 @@ class WorldRig:
             robot.set_kinematic_targets([float(v) for v in action.head])
         if action.cosmetic is not None:
             robot.set_cosmetic([float(v) for v in action.cosmetic])
-        if action.illum is not None and [int(v) for v in action.illum] != robot.illum:
-            robot.set_illum([int(v) for v in action.illum])
+        illum = None if action.illum is None else [int(v) for v in action.illum]
+        if illum is not None and illum != robot.illum:
+            robot.set_illum(illum)
         if action.tone is not None:
             robot.play_tone(*(int(v) for v in action.tone))
         if action.stream is not None:
