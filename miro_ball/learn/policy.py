@@ -11,7 +11,9 @@ speeds.
 
 A policy is saved as a folder: ``policy.npz`` (its weights) and ``policy.json`` (the
 settings it was trained with: eyes, frame_skip, what it was trained on), read back by
-``load`` for evaluation and for the controller node (learn.policy_controller).
+``load`` for evaluation and for the controller node (learn.policy_controller), through
+learn.policy_files: the folder may come from anyone, so its files are checked and bounded
+before they are read.
 """
 import json
 import os

@@ -54,6 +54,10 @@ def read_settings(path):
     return settings
 
 
+class _Refused(Exception):
+    """What a policy's weights file holds that the policy cannot use."""
+
+
 def read_numbers(path, name, count):
     """The array ``name`` of the .npz file ``path`` as ``count`` float64 numbers (of any
     shape); ValueError (one line) when it is not, said before its numbers are unpacked."""
@@ -77,10 +81,6 @@ def read_numbers(path, name, count):
         raise ValueError(f'{path}: {err}') from None
     except UNREADABLE as err:
         raise ValueError(f'cannot read {path}: {first_line(err)}') from None
-
-
-class _Refused(Exception):
-    """What a policy's weights file holds that the policy cannot use."""
 
 
 def _numbers(stream, name, count):
