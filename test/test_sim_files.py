@@ -35,6 +35,18 @@ def one_line(message, name):
     return re.sub(r"'[^']*'", 'NAME', message, count=1).replace(name, 'NAME')
 
 
+def the_refusal(node, kind, code, requests):
+    """The one line (one_line) ``kind`` answers every request of ``requests`` (name ->
+    the request's fields) with, each with result ``code``."""
+    lines = set()
+    for name, fields in requests.items():
+        refused = serve(node, kind, **fields)
+        assert refused.result.result == code, name
+        lines.add(one_line(refused.result.error_message, name))
+    assert len(lines) == 1, lines
+    return lines.pop()
+
+
 def test_the_catalogue_lists_the_allowed_folders_only(make_sim, folders):
     allowed, private = folders
     node = make_sim(world_folders=str(allowed))
@@ -70,14 +82,11 @@ def test_load_world_reads_no_file_outside_and_says_the_same_whatever_is_there(ma
                                                                               folders):
     allowed, private = folders
     node = make_sim(world_folders=str(allowed))
-    lines = set()
-    for uri in (str(private / 'world.toml'), str(private / 'config.toml'),
-                str(private / 'missing.toml'), f'file://{private}/world.toml',
-                f'{allowed}/../private/config.toml', '/etc/shadow', '/etc/passwd'):
-        refused = serve(node, srv.LoadWorld, uri=uri)
-        assert refused.result.result == srv.LoadWorld.Response.NO_RESOURCE, uri
-        lines.add(one_line(refused.result.error_message, uri))
-    assert len(lines) == 1 and 'world_folders' in lines.pop()
+    uris = (str(private / 'world.toml'), str(private / 'config.toml'),
+            str(private / 'missing.toml'), f'file://{private}/world.toml',
+            f'{allowed}/../private/config.toml', '/etc/shadow', '/etc/passwd')
+    assert 'world_folders' in the_refusal(node, srv.LoadWorld, srv.LoadWorld.Response.NO_RESOURCE,
+                                          {uri: {'uri': uri} for uri in uris})
     assert ok(serve(node, srv.GetCurrentWorld)).world.name == 'miro'  # stays loaded
     assert ok(serve(node, srv.LoadWorld, uri='world.toml')).world.name == 'world'
     still_works(node)
@@ -88,13 +97,11 @@ def test_a_worlds_picture_is_no_window_onto_other_files(make_sim, folders):
     allowed, private = folders
     node = make_sim(world_folders=str(allowed))
     box = '[robot]\n[[box]]\nsize = [1, 1, 1]\nposition = [2, 0, 0.5]\npicture = "{}"\n'
-    lines = set()
-    for picture in (private / 'photo.png', private / 'notes.png', private / 'missing.png',
-                    f'{allowed}/../private/photo.png'):
-        refused = serve(node, srv.LoadWorld, resource_string=box.format(picture))
-        assert refused.result.result == srv.LoadWorld.Response.RESOURCE_PARSE_ERROR
-        lines.add(one_line(refused.result.error_message, str(picture)))
-    assert len(lines) == 1 and 'no picture' in lines.pop()
+    pictures = (private / 'photo.png', private / 'notes.png', private / 'missing.png',
+                f'{allowed}/../private/photo.png')
+    assert 'no picture' in the_refusal(
+        node, srv.LoadWorld, srv.LoadWorld.Response.RESOURCE_PARSE_ERROR,
+        {str(picture): {'resource_string': box.format(picture)} for picture in pictures})
     assert ok(serve(node, srv.LoadWorld, resource_string=box.format(allowed / 'photo.png')))
     assert node.sim.loaded.pictures
     still_works(node)
@@ -104,15 +111,12 @@ def test_spawn_entity_reads_models_from_packages_and_the_allowed_folders_only(ma
                                                                                folders):
     allowed, private = folders
     node = make_sim(world_folders=str(allowed))
-    lines = set()
-    for uri in (str(private / 'crate.toml'), str(private / 'missing.toml'),
-                f'file://{private}/config.toml', 'package://miro_ball//etc/passwd.toml',
-                'package://miro_ball/../../../etc/x.toml'):
-        refused = serve(node, srv.SpawnEntity, name='crate', uri=uri,
-                        initial_pose=pose(1.0, 1.0))
-        assert refused.result.result == srv.SpawnEntity.Response.NO_RESOURCE, uri
-        lines.add(one_line(refused.result.error_message, uri))
-    assert len(lines) == 1 and 'world_folders' in lines.pop()
+    uris = (str(private / 'crate.toml'), str(private / 'missing.toml'),
+            f'file://{private}/config.toml', 'package://miro_ball//etc/passwd.toml',
+            'package://miro_ball/../../../etc/x.toml')
+    assert 'world_folders' in the_refusal(
+        node, srv.SpawnEntity, srv.SpawnEntity.Response.NO_RESOURCE,
+        {uri: {'name': 'crate', 'uri': uri, 'initial_pose': pose(1.0, 1.0)} for uri in uris})
     ok(serve(node, srv.SpawnEntity, name='crate', uri=str(allowed / 'crate.toml'),
              initial_pose=pose(1.0, 1.0)))
     assert 'crate' in still_works(node)
