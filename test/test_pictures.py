@@ -4,6 +4,7 @@ renderers, through the pinhole and MiRo's lens."""
 import math
 import struct
 import zlib
+from importlib.resources import files
 
 import cv2
 import numpy as np
@@ -351,6 +352,35 @@ def test_miro_sees_the_arenas_tag_and_the_pictures_survive_a_reset(kind):
         world.reset()
         again, = cameras.render_eyes([(world.robot, 1)], camera)
         assert np.array_equal(first, again)
+    finally:
+        cameras.close()
+        world.close()
+
+
+@pytest.mark.parametrize('renderer', RENDERERS)
+def test_a_picture_is_read_once_and_a_file_put_in_its_place_later_is_never_read(tmp_path,
+                                                                                 renderer):
+    """The renderers and the scene's markers drew and sent the file again by its path: a
+    link put there after the check showed (and published) any file."""
+    from miro_sim_bullet.ros.scene import SceneMarkers
+
+    pictures = files('miro_sim_bullet.worlds') / 'pictures'
+    mine = tmp_path / 'mine.png'
+    mine.write_bytes((pictures / TAG).read_bytes())
+    path = write(tmp_path, '[ground]\nheight = 0.0\n[[box]]\nposition = [0.6, 0.0, 0.3]\n'
+                           'size = [0.02, 0.3, 0.3]\npicture = "mine.png"\n'
+                           'picture_face = "-x"\npicture_size = [0.25, 0.25]\n')
+    description = load_world(path)
+    checked = mine.read_bytes()
+    mine.unlink()
+    mine.symlink_to(pictures / 'apriltag36h11_1.png')  # tag 1 where tag 0 was checked
+    world = SimWorld(description)
+    cameras = Cameras(world, renderer, log=lambda _: None)
+    try:
+        rgb, = cameras.render_eyes([(world.robot, 1)], CameraModel(640, 360))
+        assert detect_tags(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY))[1] == [0]
+        sent = [m for m in SceneMarkers(world).layout().markers if m.ns == 'picture']
+        assert [bytes(m.texture.data) for m in sent] == [checked]
     finally:
         cameras.close()
         world.close()

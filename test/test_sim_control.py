@@ -8,6 +8,7 @@ from importlib.resources import files
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from miro_ball.common.files import allowed_path, folders_parameter, read_regular
 from miro_ball.miro.urdf import urdf
 from miro_sim_bullet.control import codes
 from miro_sim_bullet.control.codes import (Bounds, EntityCategory, Refused, SimulationState,
@@ -476,6 +477,53 @@ def test_a_picture_is_bundled_beside_the_world_or_in_the_allowed_folders(private
         load_world(write(allowed, box.format(elsewhere / 'secret.png'), 'framed.toml'))
 
 
+def test_a_name_of_a_user_there_is_none_of_is_refused_as_any_other(private):
+    """~nosuchuser raised RuntimeError: answered 'a bug', it told which accounts exist."""
+    allowed, _ = private
+    for name in ('~nosuchuser/x.toml', '~root/x.toml'):
+        assert allowed_path(name, (allowed,)) is None
+        with pytest.raises(WorldError, match='no world file'):
+            load_world(name, (), (allowed,))
+    with pytest.raises(ValueError, match="parameter world_folders: '~nosuchuser' is not a"):
+        folders_parameter('world_folders', '~nosuchuser')
+
+
+def test_a_file_is_read_through_no_link_on_its_way(private):
+    """A folder swapped for a link between the check and the read led out of the allowed
+    folders: every part of the path is opened without following a link."""
+    allowed, elsewhere = private
+    (allowed / 'sub').symlink_to(elsewhere)
+    for path in (allowed / 'sub' / 'world.toml', allowed / 'sub' / '..' / 'world.toml'):
+        with pytest.raises(OSError):
+            read_regular(path, 100)
+    assert SECRET.encode() in read_regular(elsewhere / 'world.toml', 100)
+
+
+def test_the_catalogue_says_the_rule_for_a_link_out_whatever_it_points_at(private):
+    allowed, elsewhere = private
+    (allowed / 'out.toml').symlink_to(elsewhere / 'world.toml')
+    (allowed / 'dangling.toml').symlink_to(elsewhere / 'missing.toml')
+    (allowed / 'loop.toml').symlink_to(allowed / 'loop.toml')
+    (allowed / 'in.toml').symlink_to(allowed / 'world.toml')
+    os.mkfifo(allowed / 'pipe.toml')
+    (allowed / 'caf\udce9.toml'.encode('utf-8', 'surrogateescape').decode(
+        'utf-8', 'surrogateescape')).write_text('description = "x"\n')
+    worlds, problems = world_catalogue([str(allowed)], (allowed,))
+    listed = {name: uri for name, uri, *_ in worlds}
+    assert listed['in'] == str(allowed / 'world.toml')  # by its resolved path
+    lines = {re.sub("'.*?' in", "'NAME' in", line, count=1) for line in problems
+             if any(k in line for k in ('out', 'dangling', 'loop', 'caf'))}
+    assert lines == {"no world file 'NAME' in the allowed folders"}, problems
+    assert any('pipe.toml' in line for line in problems) and 'pipe' not in listed
+    '\n'.join(problems).encode('utf-8')  # every line can be sent
+
+
+def test_a_description_is_bounded(tmp_path):
+    """get_available_worlds answers 1000 descriptions at once."""
+    with pytest.raises(WorldError, match='description: must be a string of at most 4096'):
+        load_world(write(tmp_path, f'description = "{"x" * 4097}"\n'))
+
+
 def test_a_model_a_client_names_is_in_its_package_or_in_the_allowed_folders(private):
     allowed, elsewhere = private
     write(allowed, '[[box]]\nsize = [0.1, 0.1, 0.1]\n', 'crate.toml')
@@ -484,7 +532,8 @@ def test_a_model_a_client_names_is_in_its_package_or_in_the_allowed_folders(priv
     lines = set()
     for uri in (str(elsewhere / 'config.toml'), str(elsewhere / 'missing.toml'),
                 f'{allowed}/../private/config.toml', 'package://miro_ball/../../etc/x.toml',
-                'package://miro_ball//etc/x.toml', 'package://miro_ball/worlds/../../x.toml'):
+                'package://miro_ball//etc/x.toml', 'package://miro_ball/worlds/../../x.toml',
+                'package://miro_ball/test/x.toml', 'package://no_such_package/x.toml'):
         caught = refused(resolve_uri, uri, (allowed,))
         assert caught.code == SpawnResult.NO_RESOURCE and SECRET not in str(caught)
         lines.add(re.sub("'.*?':", "'NAME':", str(caught), count=1))

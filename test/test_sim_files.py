@@ -6,6 +6,7 @@ import re
 from importlib.resources import files
 
 import pytest
+from simulation_interfaces import msg as si
 from simulation_interfaces import srv
 
 from test_sim_standard_hostile import FAILED, ok, pose, serve, still_works
@@ -126,3 +127,16 @@ def test_a_world_folder_that_is_no_folder_stops_the_start(make_sim, tmp_path):
     with pytest.raises(ValueError, match="parameter world_folders: '.*none' is not a folder"):
         make_sim(world_folders=str(tmp_path / 'none'))
 
+
+
+def test_spawn_entities_reads_at_most_a_megabyte_of_text_a_request(paused_sim):
+    """64 entities of 1 MB of TOML each held the simulator for about a minute."""
+    node = paused_sim
+    text = '[box]\nsize = [0.1, 0.1, 0.1]\n' + '#' * 400_000 + '\n'
+    requests = [si.SpawnEntity(name=f'box{k}', entity_resource=si.Resource(resource_string=text),
+                               initial_pose=pose(1.0, 0.3 * k)) for k in range(3)]
+    refused = serve(node, srv.SpawnEntities, spawn_requests=requests)
+    assert refused.result.result == FAILED
+    assert 'at most 1048576 in all' in refused.result.error_message
+    assert ok(serve(node, srv.SpawnEntities, spawn_requests=requests[:2]))
+    assert {'box0', 'box1'} <= set(still_works(node))

@@ -5,9 +5,10 @@ may be read, and reading them without being held.
   the allowed folders. A caller refuses everything else with one line that names its rule and
   the name it was given, the same line whether the file is absent, unreadable or elsewhere: it
   never says whether a file outside exists, nor what it holds.
-- ``open_regular``: opened without waiting and not through a link, then looked at: a FIFO, a
-  device or a folder is refused, never waited on (a FIFO held a program until someone wrote to
-  it, deaf to Ctrl+C), and so is one swapped in between a check and the read.
+- ``open_regular``: opened without waiting and not through a link (nor through a folder that
+  is one), then looked at: a FIFO, a device or a folder is refused, never waited on (a FIFO
+  held a program until someone wrote to it, deaf to Ctrl+C), and so is one swapped in between a
+  check and the read.
 - ``folders_parameter``: a ':'-separated list of folders given at start (as PATH), checked.
 """
 import os
@@ -23,8 +24,21 @@ class FileRefused(OSError):
 
 
 def open_regular(path):
-    """A binary file object of ``path`` if it is a regular file; OSError else."""
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW)
+    """A binary file object of ``path`` if it is a regular file; OSError else. Each folder on
+    the way is opened in turn, none through a link: give a resolved path (one with links in
+    it is refused). A folder swapped for a link between a check and the read would lead
+    elsewhere."""
+    path = Path(path)
+    parts = path.parts if path.is_absolute() else ('.', *path.parts)
+    folder = os.open(parts[0], os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        for part in parts[1:-1]:
+            inner = os.open(part, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW, dir_fd=folder)
+            os.close(folder)
+            folder = inner
+        fd = os.open(parts[-1], os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW, dir_fd=folder)
+    finally:
+        os.close(folder)
     if not stat.S_ISREG(os.fstat(fd).st_mode):
         os.close(fd)
         raise FileRefused(f'{Path(path).name!r} is not a regular file')
@@ -44,7 +58,9 @@ def allowed_path(value, folders):
     and '..' is resolved, and something is there (not necessarily a regular file)."""
     if not isinstance(value, str) or not value or '\0' in value or len(value) > MAX_PATH:
         return None
-    name = Path(value).expanduser() if value.startswith('~') else Path(value)
+    name = _expanded(value)
+    if name is None:
+        return None
     candidates = [name] if name.is_absolute() else [folder / name for folder in folders]
     for candidate in candidates:
         try:
@@ -61,11 +77,20 @@ def folders_parameter(name, text):
     once; ValueError in one line for one that is no folder, or for too many."""
     folders = []
     for entry in filter(None, text.split(os.pathsep)):
-        path = Path(entry).expanduser()
-        if not path.is_dir():
+        path = _expanded(entry)
+        if path is None or not path.is_dir():
             raise ValueError(f'parameter {name}: {entry!r} is not a folder'[:200])
         folders.append(path.resolve())
     folders = list(dict.fromkeys(folders))
     if len(folders) > MAX_FOLDERS:
         raise ValueError(f'parameter {name}: {len(folders)} folders; at most {MAX_FOLDERS}')
     return tuple(folders)
+
+
+def _expanded(name):
+    """Path(name) with a leading ``~`` or ``~user`` expanded; None for a user there is none
+    of (Path.expanduser raises)."""
+    try:
+        return Path(name).expanduser()
+    except RuntimeError:
+        return None

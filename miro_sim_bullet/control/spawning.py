@@ -15,7 +15,6 @@ from pathlib import Path
 from urllib.parse import unquote
 from xml.etree import ElementTree
 
-import miro_ball
 from miro_ball.common.files import allowed_path, FileRefused, read_regular
 from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_ball.miro.urdf import MAX_URDF_BYTES, urdf
@@ -59,7 +58,7 @@ class ShapeSpawn:
 def resolve_uri(uri, world_folders=()):
     """(text, source) of a resource: SPAWNABLE_MIRO (MiRo's URDF, from the body model),
     package://miro_ball/worlds/... (the bundled worlds and models, wherever installed),
-    package://miro_ball/<path> (the installed share/miro_ball, or the checkout),
+    package://miro_ball/<path> (the installed share/miro_ball, in a ROS 2 install),
     package://<other>/<path> (with ament_index, in a ROS 2 install), each inside its
     package once links are resolved; file:///path or an absolute path in one of
     ``world_folders`` (resolved Paths: the simulator's parameter). Refused: NO_RESOURCE in
@@ -251,16 +250,14 @@ def _locate(uri, world_folders):
 
 
 def _share(package, uri):
-    """The share folder of a package: ament_index's, else (for ours) the checkout's root."""
+    """The share folder of a package, ament_index's (in a ROS 2 install). Without one, ours
+    has only its bundled worlds and models (a checkout's root holds much else: a venv,
+    builds, a user's own files)."""
     try:
         from ament_index_python.packages import get_package_share_directory
         return Path(get_package_share_directory(package))
     except (ImportError, LookupError, ValueError, OSError):  # no package, or no ament index
-        pass
-    root = Path(miro_ball.__file__).resolve().parent.parent
-    if package == 'miro_ball' and (root / 'package.xml').is_file():
-        return root
-    raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: no package {package[:40]!r} found')
+        raise FileRefused(uri) from None  # said as any file that is not there
 
 
 def _read_text(path, uri):

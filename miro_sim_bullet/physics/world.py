@@ -6,6 +6,8 @@ sleeps or looks at the wall clock, and nothing draws: the cameras
 (render.cameras.Cameras) take a world and draw its client's bodies.
 """
 import math
+import os
+import tempfile
 from dataclasses import replace
 
 from miro_ball.miro.constants import PLATFORM_TICK_S
@@ -212,7 +214,7 @@ class SimWorld:
         textures = {}  # one texture per image file
         for picture in self.description.pictures:
             if picture.image not in textures:
-                textures[picture.image] = pb.loadTexture(picture.image, **kw)
+                textures[picture.image] = _texture(picture.png, kw)
             corners = [list(c) for c in picture.corners]
             edge_a = [b - a for a, b in zip(corners[0], corners[1])]
             edge_b = [b - a for a, b in zip(corners[0], corners[3])]
@@ -541,3 +543,14 @@ class SimWorld:
             robot.set_joint_angles(angles)
             if illum != robot.illum:
                 robot.set_illum(illum)
+
+
+def _texture(png, kw):
+    """A PyBullet texture of the PNG bytes checked when the world was read. PyBullet loads a
+    texture from a file only: the bytes go to a file of this process's own, not the world
+    file's picture again (a link or FIFO put there since would be read unchecked)."""
+    with tempfile.TemporaryDirectory(prefix='miro_picture_') as folder:
+        path = os.path.join(folder, 'picture.png')
+        with open(path, 'wb') as file:
+            file.write(png)
+        return pb.loadTexture(path, **kw)

@@ -190,10 +190,9 @@ def _picture_vertices(pictures, to_sun):
     return np.array(rows, 'f4').reshape(-1, 6)
 
 
-def _load_rgb(path):
-    """The image as RGB rows, top row first, or None if it cannot be read now (it was
-    checked when the world was loaded: only a file changed since then is left out)."""
-    bgr = cv2.imread(path, cv2.IMREAD_COLOR)
+def _load_rgb(png):
+    """The PNG's bytes (checked when the world was read) as RGB rows, top row first."""
+    bgr = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)
     return None if bgr is None else np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))
 
 
@@ -342,8 +341,8 @@ class GlBackend:
         for picture in pictures:
             by_image.setdefault(picture.image, []).append(picture)
         self.by_texture = []
-        for image, pictures in by_image.items():
-            rgb = _load_rgb(image)
+        for pictures in by_image.values():
+            rgb = _load_rgb(pictures[0].png)
             if rgb is None:
                 continue
             texture = self.ctx.texture((rgb.shape[1], rgb.shape[0]), 3, rgb.tobytes(),

@@ -86,7 +86,7 @@ def sound_marker(name, position, marker_id):
 
 def picture_marker(picture, marker_id):
     """A picture as a textured TRIANGLE_LIST in frame world (its PNG travels inside)."""
-    data = Path(picture.image).read_bytes()
+    data = picture.png
     key = f'{Path(picture.image).stem}-{hashlib.sha1(data).hexdigest()[:10]}'
     marker = Marker(ns='picture', id=marker_id, type=Marker.TRIANGLE_LIST, action=Marker.ADD,
                     texture_resource=f'embedded://{key}.png',

@@ -25,9 +25,9 @@ from miro_sim_bullet.control import codes
 from miro_sim_bullet.control.codes import EntityCategory, Refused, Result
 from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter, tag_filter
 from miro_sim_bullet.control.poses import check_pose, check_twist, in_world, WORLD_FRAMES
-from miro_sim_bullet.control.spawning import (body_bounds, parse_spawn, reach, robot_box,
-                                              robot_reach, RobotSpawn, SPAWN_FORMATS,
-                                              spawnables)
+from miro_sim_bullet.control.spawning import (body_bounds, MAX_RESOURCE_BYTES, parse_spawn,
+                                              reach, robot_box, robot_reach, RobotSpawn,
+                                              SPAWN_FORMATS, spawnables)
 from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.sim_interface import SERVICE_QOS
@@ -312,6 +312,11 @@ class ControlInterface:
         if len(request.spawn_requests) > MAX_SPAWNS:
             raise Refused(Result.OPERATION_FAILED, f'{len(request.spawn_requests)} entities '
                           f'asked for at once; at most {MAX_SPAWNS} a request')
+        # Reading a text takes about a second a megabyte, and the world waits meanwhile.
+        text = sum(len(one.entity_resource.resource_string) for one in request.spawn_requests)
+        if text > MAX_RESOURCE_BYTES:
+            raise Refused(Result.OPERATION_FAILED, f'{text} characters of resource_string in '
+                          f'one request; at most {MAX_RESOURCE_BYTES} in all')
         failed = 0
         for one in request.spawn_requests:
             result = si.SpawnResult(result=_result())

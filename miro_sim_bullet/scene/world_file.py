@@ -48,7 +48,7 @@ import time
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-
+from urllib.parse import unquote
 
 from miro_ball.common.files import allowed_path, FileRefused, MAX_FOLDERS, MAX_PATH, \
     read_regular
@@ -64,6 +64,7 @@ MAX_PANELS = 1000
 MAX_SHAPES = 2000
 PANEL_SIZE = (0.01, 0.65, 0.30)  # the MDK's wall panel: thickness, width, height (m)
 MAX_TAGS = 32
+MAX_DESCRIPTION = 4096  # characters: get_available_worlds answers 1000 of them at once
 MAX_TAG_LENGTH = 64
 MAX_POSES = 100
 MAX_CATALOGUE = 1000  # world files listed in all
@@ -142,8 +143,11 @@ class Picture:
     which take the image's corners: in image coordinates (u right, v down, 0..1) the
     corners' (u, v) are (0, 1), (1, 1), (1, 0), (0, 0)."""
     source: str  # the world-file table: 'wall[2]', 'ring[0]', 'box[1]'
-    image: str  # absolute path of the PNG
+    image: str  # absolute path of the PNG: its name
     corners: tuple
+    # The file's bytes as checked when the world was read: what is drawn and sent, never the
+    # file again (a link or a FIFO put in its place later would be read unchecked).
+    png: bytes = field(default=b'', repr=False, compare=False)
 
 
 PICTURE_UV = ((0.0, 1.0), (1.0, 1.0), (1.0, 0.0), (0.0, 0.0))  # of Picture.corners
@@ -295,11 +299,12 @@ def world_catalogue(sources=(), world_folders=(), sound_folders=(), cache=None,
     and every *.toml file in each folder of ``sources`` (its uri the file's resolved path);
     problems = one line for each source that is no folder in ``world_folders``, each folder
     that cannot be listed and each file that is no world, for the caller to report. Each
-    world is read whole, so what is listed loads. A source is resolved before it is taken,
-    and each folder is listed once however it is spelt; at most MAX_CATALOGUE files in all,
-    and no more reading once ``budget_s`` of ``clock`` have passed (a request must not hold
-    the simulator): what was read is kept in ``cache`` (a WorldCache), so asking again
-    goes on from there. The bundled worlds take 35 ms the first time in a process."""
+    world is read whole, so what is listed loads. A source and a file are resolved before
+    they are taken (a link that leads out is refused as the rule says), and each folder is
+    listed once however it is spelt; at most MAX_CATALOGUE files in all, and no file more is
+    read once ``budget_s`` of ``clock`` have passed (a request must not hold the simulator):
+    what was read is kept in ``cache`` (a WorldCache), so asking again goes on from there.
+    The bundled worlds take 35 ms the first time in a process."""
     cache = WorldCache() if cache is None else cache
     worlds, problems, files = [], [], []
     for name in bundled_worlds():  # read by name: the allowed folders are for a user's files
@@ -311,7 +316,12 @@ def world_catalogue(sources=(), world_folders=(), sound_folders=(), cache=None,
             problems.append(f'{_show(str(folder))}: cannot list world files: '
                             f'{err.strerror or err}')
             continue
-        files += [(path.stem, str(path), path) for path in found]
+        for path in found[:MAX_CATALOGUE]:
+            resolved = allowed_path(str(path), world_folders)
+            if resolved is None or not _utf8(str(resolved)):  # a message must carry its name
+                problems.append(f'no world file {_show(str(path))} in the allowed folders')
+            else:
+                files.append((path.stem, str(resolved), resolved))
     if len(files) > MAX_CATALOGUE:
         problems.append(f'more than {MAX_CATALOGUE} world files; listing the first '
                         f'{MAX_CATALOGUE}')
@@ -324,49 +334,61 @@ def world_catalogue(sources=(), world_folders=(), sound_folders=(), cache=None,
                            may_load=lambda: clock() <= deadline)
         if found is None:
             unread += 1
-        elif isinstance(found, WorldError):
-            problems.append(str(found))
+        elif isinstance(found, str):
+            problems.append(found)
         else:
-            worlds.append((name, uri, found.description, found.tags))
+            worlds.append((name, uri, *found))
     if unread:
         problems.append(f'{unread} world files not read within {budget_s:g} s (ask again: '
                         'what was read is remembered)')
     return worlds, problems
 
 
+def _utf8(text):
+    try:
+        text.encode('utf-8')
+    except UnicodeEncodeError:  # a file name of bytes that are not UTF-8
+        return False
+    return True
+
+
 def _source_folders(sources, world_folders, problems):
-    """The folders of a request's ``sources``, resolved, each once, in ``world_folders`` or
-    the bundled worlds' (a problem line for any other); ValueError for too many or too long."""
+    """The folders of a request's ``sources``, resolved, each once, in ``world_folders``
+    (a problem line for any other; the bundled worlds are listed anyway); ValueError for
+    too many or too long."""
     sources = list(sources)
     if len(sources) > MAX_FOLDERS or any(len(source) > MAX_PATH for source in sources):
         raise ValueError(f'at most {MAX_FOLDERS} sources of at most {MAX_PATH} characters each')
     bundled = Path(str(_bundled())).resolve()
     folders = {}
     for source in sources:
-        path = allowed_path(source[len('file://'):] if source.startswith('file://') else source,
-                            (bundled, *world_folders))
+        path = allowed_path(_file_name(source), (bundled, *world_folders))
         if path is None or not path.is_dir():
             problems.append(f'{_show(source)}: {FOLDER_RULE}')
-        elif path != bundled:
+        elif not path.is_relative_to(bundled):
             folders[path] = None
     return list(folders)
 
 
+def _file_name(uri):
+    """The file name a path or file:// URI (%-escapes decoded) names."""
+    return unquote(uri[len('file://'):]) if uri.startswith('file://') else uri
+
+
 class WorldCache:
-    """What each world file read held (a World or the WorldError), by its path, size and time
-    of change; at most MAX_CATALOGUE files."""
+    """What each world file read said of itself ((description, tags)) or the one line why it
+    is no world, by its path, size and time of change; at most MAX_CATALOGUE files."""
 
     def __init__(self):
         self._held = {}
 
     def read(self, path, load, may_load=lambda: True):
-        """The World or WorldError of ``path``: held, else load() when may_load(), else
-        None."""
+        """(description, tags) or the problem line of ``path`` (resolved): held, else
+        load() (a World, or WorldError) when may_load(), else None."""
         try:
             found = Path(path).stat()
         except OSError as err:
-            return WorldError(f'{_show(str(path))}: cannot read world file: '
-                              f'{err.strerror or err}')
+            return f'{_show(str(path))}: cannot read world file: {err.strerror or err}'
         key = (str(path), found.st_size, found.st_mtime_ns)
         if key not in self._held:
             if not may_load():
@@ -374,9 +396,10 @@ class WorldCache:
             if len(self._held) >= MAX_CATALOGUE:
                 self._held.clear()
             try:
-                self._held[key] = load()
+                world = load()
+                self._held[key] = (world.description, world.tags)
             except WorldError as err:
-                self._held[key] = err
+                self._held[key] = str(err)
         return self._held[key]
 
 
@@ -427,20 +450,20 @@ def _read(name, world_folders=None):
         name = name[len(BUNDLED_URI):-len('.toml')]
         if '/' in name:  # models/ are entities, not worlds
             raise WorldError(f'unknown world {_show(name)}: {_choices()}')
-    elif name.startswith('file://'):
-        name = name[len('file://'):]
+    else:
+        name = _file_name(name)
     path = Path(name)
     if path.suffix == '.toml' or path.parent != Path('.'):
         if world_folders is not None:
             return _read_requested(name, world_folders)
         shown = _show(str(path))
         try:
-            return read_regular(path, MAX_FILE_BYTES), str(path), path.parent
+            return read_regular(path.resolve(), MAX_FILE_BYTES), str(path), path.parent
         except FileRefused:
             raise WorldError(f'{shown}: cannot read world file: not a regular file') from None
         except OSError as err:
             raise WorldError(f'{shown}: cannot read world file: {err.strerror or err}') from None
-        except ValueError:  # a NUL in the name
+        except (ValueError, RuntimeError):  # a NUL in the name, a loop of links
             raise WorldError(f'{shown}: cannot read world file: no such name') from None
     resource = _bundled() / f'{name}.toml'
     if len(name) > MAX_NAME or not resource.is_file():  # a longer name cannot be a file
@@ -472,7 +495,7 @@ class _Parser:
         self.names = {BALL_NAME}  # taken so far; the ball's name is always taken
         self.shapes = []
         self.pictures = []
-        self.images = {}  # absolute path -> (width, height) of each picture read
+        self.images = {}  # absolute path -> (width, height, bytes) of each picture read
 
     def fail(self, where, problem):
         raise WorldError(f'{self.source}: {where}: {problem}')
@@ -594,8 +617,8 @@ class _Parser:
 
     def description(self, table, where='description'):
         value = table.get('description', '')
-        if not isinstance(value, str):
-            self.fail(where, 'must be a string')
+        if not isinstance(value, str) or len(value) > MAX_DESCRIPTION:
+            self.fail(where, f'must be a string of at most {MAX_DESCRIPTION} characters')
         return value
 
     def tags(self, where, value):
@@ -768,10 +791,10 @@ class _Parser:
             width, height = png_size(data, MAX_PICTURE_SIDE)
         except PngError as err:
             self.fail(where, f'{_show(value)}: {err}')
-        if sum(w * h for w, h in self.images.values()) + width * height > MAX_PICTURE_PIXELS:
+        if sum(w * h for w, h, _ in self.images.values()) + width * height > MAX_PICTURE_PIXELS:
             self.fail(where, f"the world's pictures have more than {MAX_PICTURE_PIXELS} "
                              'pixels in all')
-        self.images[path] = (width, height)
+        self.images[path] = (width, height, data)
         return path
 
     def place_picture(self, where, table, box, face, image):
@@ -789,7 +812,7 @@ class _Parser:
                 self.fail(f'{where}.picture_size', f'[{width:g}, {height:g}] does not fit '
                                                    f'on the face, {face_w:g} x {face_h:g} m')
         else:
-            pixels_w, pixels_h = self.images[image]
+            pixels_w, pixels_h, _ = self.images[image]
             scale = min(face_w / pixels_w, face_h / pixels_h)
             width, height = pixels_w * scale, pixels_h * scale
         lift = half[axis] + PICTURE_LIFT
@@ -798,7 +821,8 @@ class _Parser:
         up = tuple(v * height / 2 for v in _turn(box.yaw, up))
         corners = tuple(tuple(float(c + a * r + b * u) for c, r, u in zip(centre, right, up))
                         for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)))
-        self.pictures.append(Picture(source=where, image=image, corners=corners))
+        self.pictures.append(Picture(source=where, image=image, corners=corners,
+                                     png=self.images[image][2]))
 
     def ring(self, where, table):
         self.keys(where, table, {'count', 'radius', 'size', 'centre', 'yaw', 'colour',
