@@ -449,6 +449,41 @@ def test_a_page_that_shows_the_world_gets_it_whole_then_what_moved_and_its_pictu
     assert tone == {'t': 'tone', 'hz': 440, 'volume': 100, 'ticks': 5}
 
 
+def test_a_page_that_stopped_reading_is_cut_off_as_the_server_stops():
+    """A page that took nothing more (a busy browser's) held the GUI's server for ever as
+    it stopped, and the GUI deaf to SIGINT and SIGTERM until ros2 launch killed it."""
+    import base64
+    import socket
+
+    from miro_ball.gui.frames import Frame
+
+    async def run():
+        loop = asyncio.get_running_loop()
+        bridge = FakeBridge()
+        bridge.shown[0] = Frame(seq=1, stamp=1.0, jpeg=bytes(8 << 20))  # more than a socket holds
+        page = socket.socket()
+        page.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        page.setblocking(False)
+        async with web_gui(bridge) as (server, address, warnings):
+            host, port = address.split('//')[1].strip('/').split(':')
+            await loop.sock_connect(page, (host, int(port)))
+            key = base64.b64encode(b'a page that reads'[:16]).decode()
+            await loop.sock_sendall(page, (
+                f'GET /ws HTTP/1.1\r\nHost: {host}:{port}\r\nUpgrade: websocket\r\n'
+                f'Connection: Upgrade\r\nSec-WebSocket-Key: {key}\r\n'
+                'Sec-WebSocket-Version: 13\r\n\r\n').encode())
+            await until(lambda: any(0 in p.in_flight for p in server.pages.values()))
+        # Stopped (a hang would be the guard's timeout): the page's connection is cut.
+        with contextlib.suppress(ConnectionError):
+            while await loop.sock_recv(page, 1 << 16):
+                pass
+        page.close()
+        return bridge.commands
+
+    commands = asyncio.run(asyncio.wait_for(run(), timeout=10.0))  # a hang guard only
+    assert commands == [('open', 1), ('release', 1)]
+
+
 def test_the_pages_hearing_levels_spectrum_and_sound():
     import base64
 

@@ -1,6 +1,7 @@
 """Every node ends on Ctrl+C (SIGINT) or SIGTERM within a second, with or without a peer,
-exit code 0, no traceback, nothing it started left running; and every program that runs a
-node runs it through common/lifecycle.py's run_node.
+exit code 0, no traceback, nothing it started left running (and one whose clean-up hangs, at
+its deadline or at a second signal); and every program that runs a node runs it through
+common/lifecycle.py's run_node.
 
 Without a simulator there is no /clock, so the controller's spin sits in rcl's wait:
 the case that used to ignore signals until the main job killed it.
@@ -42,9 +43,11 @@ class Node:
     """One entry point as a child process on the test's ROS domain."""
 
     def __init__(self, module, ready, extra):
+        """``python -m module extra...``; no module: ``python extra...``."""
         self.ready = ready
         env = isolated_env(int(os.environ['ROS_DOMAIN_ID']))
-        self.proc = subprocess.Popen([sys.executable, '-m', module, *extra], env=env,
+        run = ['-m', module] if module else []
+        self.proc = subprocess.Popen([sys.executable, *run, *extra], env=env,
                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                      text=True)
         self.output = []
@@ -118,6 +121,63 @@ def test_simulator_under_a_running_controller_then_a_second_ctrl_c(nodes):
     controller.proc.send_signal(signal.SIGINT)
     assert_clean_exit(controller.stop(signal.SIGINT), 'controller after two Ctrl+C',
                       STOP_BUSY_WITHIN_S)
+
+
+# -- a clean-up that never ends: the deadline, or a second signal, ends the program ----------
+# A node whose last act hangs (as the GUI's did, waiting on a page that read nothing more),
+# with a child in its group that ignores Ctrl+C.
+HANGS_ON_STOP = '''
+import subprocess, sys, threading
+from rclpy.node import Node
+from miro_ball.common.lifecycle import run_node
+
+def make():
+    subprocess.Popen([sys.executable, '-c', 'import signal, time; '
+                      'signal.signal(signal.SIGINT, signal.SIG_IGN); time.sleep(60)'],
+                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    print('up', flush=True)
+    return Node('hangs_on_stop')
+
+def hang(node):
+    print('stopping', flush=True)
+    threading.Event().wait()
+
+run_node('hangs_on_stop', make, sys.argv, on_stop=hang)
+'''
+HANGS = (None, 'up', ['-c', HANGS_ON_STOP])
+
+
+def test_a_node_whose_clean_up_hangs_ends_at_its_deadline_taking_its_children(nodes):
+    from miro_ball.common.lifecycle import STOP_DEADLINE_S
+
+    node = nodes(HANGS).wait_ready()
+    children = proc_tree.descendants(node.proc.pid)
+    code, seconds, output = node.stop(signal.SIGTERM)
+    assert code == 128 + signal.SIGTERM, output
+    assert output.splitlines()[:3] == [
+        'up', 'stopping', 'hangs_on_stop: still running 3 s after SIGTERM: ended without '
+        'finishing its clean-up (exit code 143)'], output
+    assert 'most recent call first' in output and 'in hang' in output  # where, for a report
+    assert seconds >= STOP_DEADLINE_S  # its clean-up had its time
+    assert children and proc_tree.wait_gone(children, 0) == []
+
+
+def test_a_second_signal_ends_a_node_whose_clean_up_hangs_at_once(nodes):
+    from miro_ball.common.lifecycle import REPEAT_S
+
+    node = nodes(HANGS).wait_ready()
+    children = proc_tree.descendants(node.proc.pid)
+    first = time.monotonic()
+    node.proc.send_signal(signal.SIGINT)
+    assert node.proc.stdout.readline() == 'stopping\n'
+    # A second signal within REPEAT_S is the same stop (a terminal's and the parent's).
+    node.proc.send_signal(signal.SIGINT)
+    time.sleep(max(0.0, first + REPEAT_S + 0.2 - time.monotonic()))  # the user's patience
+    code, _, output = node.stop(signal.SIGINT)
+    assert code == 128 + signal.SIGINT, output
+    assert output.splitlines() == ['up', 'hangs_on_stop: SIGINT while it was stopping: ended '
+                                   'without finishing its clean-up (exit code 130)'], output
+    assert children and proc_tree.wait_gone(children, 0) == []
 
 
 # -- every program that runs a node: up, one Ctrl+C, gone within a second --------------------

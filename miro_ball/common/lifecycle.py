@@ -20,10 +20,18 @@ twist: its whole 0.5 s bound, see fast_acks.py), Python freeing every module aft
 only after the GUI was done. So the children are told to stop first, and stop while the
 node cleans up; and once everything is closed and flushed, the process ends without the
 interpreter's teardown: there is nothing left for it to do but spend time.
+
+And whatever the clean-up does, a signal is never ignored for long (_StopDeadline): a
+program still there STOP_DEADLINE_S after the first SIGINT or SIGTERM, or given another
+one more than REPEAT_S after it, ends at once, its children killed, exit code 128 + the
+signal's number. The GUI once sat deaf through SIGINT and SIGTERM until ros2 launch killed
+it: its web server waited for ever on a page that had stopped reading.
 """
 import ctypes
+import faulthandler
 import logging
 import os
+import select
 import signal
 import sys
 import threading
@@ -43,6 +51,14 @@ KILL_WAIT_S = 0.1  # for the kernel to take a killed child away
 # A spin thread (serve=) ends within a wake-up period; a callback stuck for longer than
 # this is left behind with the daemon thread it runs in.
 SPIN_JOIN_S = 1.0
+# A stop takes well under a second (test_signals.py); ros2 launch sends SIGTERM 5 s after
+# its SIGINT, and kills 5 s later. Past this, what is left of the clean-up is given up.
+STOP_DEADLINE_S = 3.0
+# Signals this close after the first are the same stop: a Ctrl+C in a terminal reaches a
+# program and its children, and the program tells its children once more (run_node).
+REPEAT_S = 1.0
+SAY_S = 0.5  # for the last words of a forced end, in case stderr is a pipe nobody reads
+_DISARMED = 0  # no signal's number: what close() writes to wake the watch
 
 
 def first_line(err):
@@ -91,52 +107,53 @@ def run_node(prog, make_node, argv=None, *, make_executor=None, on_stop=None,
     # Before rclpy.init: a signal from now on is noted, never a KeyboardInterrupt; and
     # the last message's acknowledgement comes in tens of milliseconds, not seconds.
     stop = StopRequest()
-    use_fast_acks()
-    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    try:
-        node = make_node()
-    except BAD_START + (ParameterException, NameValidationException) + tuple(bad_start) as err:
-        rclpy.try_shutdown()
-        refuse(prog, err)
-    except BaseException:
-        rclpy.try_shutdown()
-        raise
-    # The node's own way to end its program as Ctrl+C would, quietly (the simulator asked
-    # to quit through the standard's set_simulation_state).
-    node.request_stop = stop.request
-    executor = (make_executor or SingleThreadedExecutor)()
-    executor.add_node(node)
-    code = 0
-    try:
-        if serve is None:
-            spin_until_stopped(executor, stop, fatal=fatal)
-        else:
-            _serve_beside_the_spin(serve, node, executor, stop)
-    except SystemExit as done:  # a client that has done its job
-        code = done.code or 0
-    except tuple(fatal) as err:
-        node.get_logger().error(f'{err}: {prog} stopped')
-        code = 1
-    finally:
-        # Told first, the children stop while this node cleans up, not after it: those a
-        # Ctrl+C in the terminal reaches too (the simulator's eye workers, in a session of
-        # their own, are stopped by its destroy_node). Whatever is left at the end is killed.
-        children = [pid for pid in proc_tree.descendants(os.getpid()) if pid not in before]
-        proc_tree.send(proc_tree.in_my_group(children), signal.SIGINT)
-        children_by = time.monotonic() + CHILD_GRACE_S
+    with _StopDeadline(prog, before):
+        use_fast_acks()
+        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
         try:
-            if on_stop is not None:
-                code = on_stop(node) or code
-        finally:
-            executor.shutdown()
-            node.destroy_node()
+            node = make_node()
+        except BAD_START + (ParameterException, NameValidationException) + tuple(bad_start) as err:
             rclpy.try_shutdown()
-            left = proc_tree.wait_gone(children, max(0.0, children_by - time.monotonic()))
-            proc_tree.send(left, signal.SIGKILL)
-            proc_tree.wait_gone(left, KILL_WAIT_S)
-    if stop.signum:  # a signal, not the program's own request
-        end_process(code)
-    return code
+            refuse(prog, err)
+        except BaseException:
+            rclpy.try_shutdown()
+            raise
+        # The node's own way to end its program as Ctrl+C would, quietly (the simulator asked
+        # to quit through the standard's set_simulation_state).
+        node.request_stop = stop.request
+        executor = (make_executor or SingleThreadedExecutor)()
+        executor.add_node(node)
+        code = 0
+        try:
+            if serve is None:
+                spin_until_stopped(executor, stop, fatal=fatal)
+            else:
+                _serve_beside_the_spin(serve, node, executor, stop)
+        except SystemExit as done:  # a client that has done its job
+            code = done.code or 0
+        except tuple(fatal) as err:
+            node.get_logger().error(f'{err}: {prog} stopped')
+            code = 1
+        finally:
+            # Told first, the children stop while this node cleans up, not after it: those a
+            # Ctrl+C in the terminal reaches too (the simulator's eye workers, in a session of
+            # their own, are stopped by its destroy_node). Whatever is left at the end is killed.
+            children = [pid for pid in proc_tree.descendants(os.getpid()) if pid not in before]
+            proc_tree.send(proc_tree.in_my_group(children), signal.SIGINT)
+            children_by = time.monotonic() + CHILD_GRACE_S
+            try:
+                if on_stop is not None:
+                    code = on_stop(node) or code
+            finally:
+                executor.shutdown()
+                node.destroy_node()
+                rclpy.try_shutdown()
+                left = proc_tree.wait_gone(children, max(0.0, children_by - time.monotonic()))
+                proc_tree.send(left, signal.SIGKILL)
+                proc_tree.wait_gone(left, KILL_WAIT_S)
+        if stop.signum:  # a signal, not the program's own request
+            end_process(code)
+        return code
 
 
 def _serve_beside_the_spin(serve, node, executor, stop):
@@ -163,3 +180,71 @@ def end_process(code):
             pass
     ctypes.CDLL(None).fflush(None)
     os._exit(code if isinstance(code, int) else 1)  # SystemExit('why') has said why
+
+
+class _StopDeadline:
+    """While a node runs: STOP_DEADLINE_S after the first SIGINT or SIGTERM, or at another
+    one more than REPEAT_S after it, the process ends at once (_end), whatever its main
+    thread is doing.
+
+    Python runs a signal's handler in the main thread, and only between bytecodes: a main
+    thread blocked in a C call, or waiting on a page for ever, never gets to it. But the
+    C-level handler writes every signal's number to the wakeup fd at once, so a thread of
+    our own reads the signals from there, and keeps the time.
+    """
+
+    def __init__(self, prog, before):
+        self.prog, self.before = prog, before
+        self._read, self._write = os.pipe()
+        os.set_blocking(self._write, False)  # as set_wakeup_fd wants it
+        self._previous = signal.set_wakeup_fd(self._write, warn_on_full_buffer=False)
+        self._watch = threading.Thread(target=self._watching, name='stop deadline',
+                                       daemon=True)
+        self._watch.start()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        """The node has ended and run_node returns (a program that calls it and goes on,
+        a test): the wakeup fd is given back, the watch ends."""
+        signal.set_wakeup_fd(self._previous)
+        os.write(self._write, bytes([_DISARMED]))
+        self._watch.join()
+        os.close(self._read)
+        os.close(self._write)
+
+    def _watching(self):
+        first, since = None, None  # the first stop signal's number, and when it came
+        while True:
+            wait = None if since is None else max(0.0, since + STOP_DEADLINE_S - time.monotonic())
+            if not select.select([self._read], [], [], wait)[0]:
+                self._end(first, f'still running {STOP_DEADLINE_S:g} s after '
+                                 f'{signal.Signals(first).name}', stacks=True)
+            for signum in os.read(self._read, 64):
+                if signum == _DISARMED:
+                    return
+                if signum not in (signal.SIGINT, signal.SIGTERM):
+                    continue
+                if since is None:
+                    first, since = signum, time.monotonic()
+                elif time.monotonic() - since > REPEAT_S:
+                    self._end(signum, f'{signal.Signals(signum).name} while it was stopping')
+
+    def _end(self, signum, why, stacks=False):
+        """End now: the children killed, a line on stderr (and what each thread was doing,
+        for a report, when the deadline passed), exit code 128 + signum. Nothing that the
+        stuck main thread may hold is touched (logging's or stderr's locks)."""
+        children = [pid for pid in proc_tree.descendants(os.getpid()) if pid not in self.before]
+        proc_tree.send(children, signal.SIGKILL)
+        line = (f'{self.prog}: {why}: ended without finishing its clean-up '
+                f'(exit code {128 + signum})\n')
+
+        def say():
+            os.write(2, line.encode())
+            if stacks:
+                faulthandler.dump_traceback(file=2, all_threads=True)
+        saying = threading.Thread(target=say, daemon=True)
+        saying.start()
+        saying.join(SAY_S)
+        os._exit(128 + signum)

@@ -36,6 +36,10 @@ PLACE_RATE_HZ = 30.0  # a dragged object's places to the simulator, per page
 OUTBOX_LENGTH = 50  # events (tones) waiting for a slow page; the oldest go first
 TEXTURE_PATH = re.compile(r'([A-Za-z0-9_][A-Za-z0-9_.-]{0,99})\.png\Z')
 MAX_MESSAGE_BYTES = 1 << 20  # beyond this aiohttp closes that socket; below, parse() refuses
+# How long a page has to take its close as the GUI stops, and the server's requests to end:
+# aiohttp waits on a page that has stopped reading (a busy browser) for ever, and the GUI
+# sat deaf to SIGINT and SIGTERM until it was killed. Such a page is cut off.
+CLOSE_S = 0.5
 LOOPBACK_NAMES = ('localhost',)
 HEADERS = {
     'Cache-Control': 'no-cache',
@@ -77,9 +81,10 @@ def origin_allowed(origin, host_header, loopback_only):
 class Page:
     """One connected page: its socket and what it has been sent."""
 
-    def __init__(self, ws, number):
+    def __init__(self, ws, number, transport):
         self.ws = ws
         self.number = number
+        self.transport = transport  # its connection, to cut it off (CLOSE_S)
         self.wake = asyncio.Event()
         self.sent = {}  # channel: seq of the last frame sent
         self.in_flight = {}  # channel: when the unacknowledged frame went out
@@ -140,8 +145,15 @@ class GuiServer:
 
     async def _closing(self, app):
         self.ticker.cancel()
-        for page in list(self.pages.values()):
-            await page.ws.close()
+        await asyncio.gather(*(self._close(page) for page in list(self.pages.values())))
+
+    @staticmethod
+    async def _close(page):
+        try:
+            await asyncio.wait_for(page.ws.close(), CLOSE_S)
+        except asyncio.TimeoutError:
+            if page.transport is not None:  # None: the connection is gone already
+                page.transport.abort()
 
     def frame_arrived(self, channel):
         """Called from the ROS thread for every new image."""
@@ -197,7 +209,7 @@ class GuiServer:
         ws = web.WebSocketResponse(max_msg_size=MAX_MESSAGE_BYTES, compress=False,
                                    heartbeat=2.0)
         await ws.prepare(request)
-        page = Page(ws, next(self.numbers))
+        page = Page(ws, next(self.numbers), request.transport)
         self.pages[page.number] = page
         self.bridge.open(page.number)
         self.log(f'page {page.number} connected from {request.remote} '
@@ -341,7 +353,7 @@ def url(sock):
 async def serve(server, sock, stop):
     """Serve on the socket until stop.requested."""
     runner = web.AppRunner(server.app, handle_signals=False, access_log=None,
-                           logger=server.http_logger)
+                           logger=server.http_logger, shutdown_timeout=CLOSE_S)
     await runner.setup()
     try:
         await web.SockSite(runner, sock).start()
