@@ -25,7 +25,7 @@ And whatever the clean-up does, a signal is never ignored for long (_StopDeadlin
 program still there STOP_DEADLINE_S after the first SIGINT or SIGTERM, or given another
 one more than REPEAT_S after it, ends at once, its children killed, exit code 128 + the
 signal's number. The GUI once sat deaf through SIGINT and SIGTERM until ros2 launch killed
-it: its web server waited for ever on a page that had stopped reading.
+it (its web server could wait for ever on a page that had stopped reading: server.py).
 """
 import ctypes
 import faulthandler

@@ -37,8 +37,8 @@ OUTBOX_LENGTH = 50  # events (tones) waiting for a slow page; the oldest go firs
 TEXTURE_PATH = re.compile(r'([A-Za-z0-9_][A-Za-z0-9_.-]{0,99})\.png\Z')
 MAX_MESSAGE_BYTES = 1 << 20  # beyond this aiohttp closes that socket; below, parse() refuses
 # How long a page has to take its close as the GUI stops, and the server's requests to end:
-# aiohttp waits on a page that has stopped reading (a busy browser) for ever, and the GUI
-# sat deaf to SIGINT and SIGTERM until it was killed. Such a page is cut off.
+# aiohttp waited for ever on a page that had stopped reading (a busy browser's), and the
+# GUI's stop with it, deaf to SIGINT and SIGTERM. Such a page is cut off.
 CLOSE_S = 0.5
 LOOPBACK_NAMES = ('localhost',)
 HEADERS = {
