@@ -109,7 +109,9 @@ def test_jointed_poses_are_the_urdfs(model, positions):
     for link, pose in zip(JOINTED, poses):
         expected = model.get_transform(link.name, link.parent)
         assert pose[:3] == pytest.approx(expected[:3, 3], abs=1e-9)
-        assert quaternion_matrix(pose[3:]) == pytest.approx(expected[:3, :3], abs=1e-9)
+        # 1e-8: yourdfpy once answered a joint turned by 1.8e-9 rad as not turned at all,
+        # and turned on the same example's second call (hypothesis: FlakyFailure).
+        assert quaternion_matrix(pose[3:]) == pytest.approx(expected[:3, :3], abs=1e-8)
 
 
 @settings(max_examples=50, deadline=None)
