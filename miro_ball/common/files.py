@@ -10,10 +10,12 @@ may be read, and reading them without being held.
   held a program until someone wrote to it, deaf to Ctrl+C), and so is one swapped in between a
   check and the read.
 - ``folders_parameter``: a ':'-separated list of folders given at start (as PATH), checked.
+- ``uri_path``: the file name a path or a ``file://`` URI names.
 """
 import os
 import stat
 from pathlib import Path
+from urllib.parse import unquote
 
 MAX_PATH = 4096  # characters of a name (Linux's PATH_MAX)
 MAX_FOLDERS = 16  # in a parameter or a request
@@ -49,6 +51,11 @@ def read_regular(path, limit):
     """The first ``limit`` + 1 bytes of a regular file (enough to tell it is too big)."""
     with open_regular(path) as file:
         return file.read(limit + 1)
+
+
+def uri_path(uri):
+    """The file name a path or a file:// URI (its %-escapes decoded) names."""
+    return unquote(uri[len('file://'):]) if uri.startswith('file://') else uri
 
 
 def allowed_path(value, folders):

@@ -12,10 +12,9 @@ import re
 from dataclasses import dataclass, replace
 from functools import cache
 from pathlib import Path
-from urllib.parse import unquote
 from xml.etree import ElementTree
 
-from miro_ball.common.files import allowed_path, FileRefused, read_regular
+from miro_ball.common.files import allowed_path, FileRefused, read_regular, uri_path
 from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_ball.miro.urdf import MAX_URDF_BYTES, urdf
 from miro_sim_bullet.control.codes import Refused, SpawnResult
@@ -239,7 +238,7 @@ def _locate(uri, world_folders):
             share = _share(package, uri)
         path = allowed_path(rest, (share.resolve(),))
     else:
-        name = unquote(uri[len('file://'):]) if uri.startswith('file://') else uri
+        name = uri_path(uri)
         if not Path(name).is_absolute():
             raise Refused(SpawnResult.NO_RESOURCE, f'{uri[:80]!r}: a uri is package://, file:// '
                                                    'or an absolute path')

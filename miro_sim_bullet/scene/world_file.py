@@ -37,9 +37,10 @@ memory or time:
 Pictures: a [[wall]] or [[ring]] puts a PNG on its panels' faces, a static [[box]] on
 one of its faces (``picture`` and ``picture_*`` keys). They become World.pictures:
 flat quads 1 mm in front of the surface, for the renderers to draw. A picture is a
-file name from the bundled pictures (worlds/pictures/, bundled_pictures()) or a path
-(relative to the world file's folder); a bare name that is no bundled picture is looked
-for next to the world file.
+file name from the bundled pictures (worlds/pictures/, bundled_pictures()) or a PNG in the
+world file's folder and below or in the simulator's world_folders (a relative path is looked
+for in each; nothing else is read: PICTURE_RULE). It is read once, here: Picture.png holds
+the bytes checked, which is what is drawn and sent.
 """
 import importlib.resources
 import math
@@ -48,10 +49,9 @@ import time
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from urllib.parse import unquote
 
 from miro_ball.common.files import allowed_path, FileRefused, MAX_FOLDERS, MAX_PATH, \
-    read_regular
+    read_regular, uri_path
 from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_sim_bullet.scene.png import PngError, png_size
 from miro_sim_bullet.scene.sounds import Hearing, parse_hearing, parse_sounds
@@ -79,8 +79,6 @@ MAX_PICTURE_SIDE = 2048
 MAX_PICTURE_PIXELS = 16_000_000  # all of a world's different pictures together
 PICTURE_LIFT = 0.001  # a picture floats 1 mm in front of its surface: no depth fight
 BOX_FACES = ('+x', '-x', '+y', '-y', '+z')
-# A panel's faces are its box's +x and -x: a [[ring]] turns +x outwards, a [[wall]] to the
-# left of the row (looking from 'from' to 'to').
 # The rule for files a client names (docs/limits.md), said whenever a name breaks it, whether
 # the file it names is absent, unreadable or elsewhere.
 WORLD_RULE = ('a bundled world ({}), or a .toml file in a folder the simulator was started '
@@ -88,6 +86,8 @@ WORLD_RULE = ('a bundled world ({}), or a .toml file in a folder the simulator w
 FOLDER_RULE = ('not a folder the simulator may list: the bundled worlds, or a folder in its '
                'world_folders parameter or below')
 PICTURE_RULE = "bundled ({}), the world's folder, world_folders"
+# A panel's faces are its box's +x and -x: a [[ring]] turns +x outwards, a [[wall]] to the
+# left of the row (looking from 'from' to 'to').
 PANEL_SIDES = {'ring': {'inside': '-x', 'outside': '+x'},
                'wall': {'left': '+x', 'right': '-x'}}
 
@@ -218,7 +218,7 @@ def load_world(name_or_path, sound_folders=(), world_folders=None):
     """A bundled world by name ('miro', 'empty', ...) or URI (world_uri()), or a user's
     .toml file by path or file:// URI. ``world_folders`` (resolved Paths) is None for a world
     this program chose (its command line, a script): any path; for one a client asked for, the
-    file must lie in those folders (requested_world). Its pictures may come from the bundled
+    file must lie in those folders (_read_requested). Its pictures may come from the bundled
     ones, its own folder and below, or ``world_folders``; its sound files from the bundled
     ones, its own folder and below, or ``sound_folders`` (scene.sounds)."""
     raw, source, folder = _read(str(name_or_path), world_folders)
@@ -362,17 +362,12 @@ def _source_folders(sources, world_folders, problems):
     bundled = Path(str(_bundled())).resolve()
     folders = {}
     for source in sources:
-        path = allowed_path(_file_name(source), (bundled, *world_folders))
+        path = allowed_path(uri_path(source), (bundled, *world_folders))
         if path is None or not path.is_dir():
             problems.append(f'{_show(source)}: {FOLDER_RULE}')
         elif not path.is_relative_to(bundled):
             folders[path] = None
     return list(folders)
-
-
-def _file_name(uri):
-    """The file name a path or file:// URI (%-escapes decoded) names."""
-    return unquote(uri[len('file://'):]) if uri.startswith('file://') else uri
 
 
 class WorldCache:
@@ -451,7 +446,7 @@ def _read(name, world_folders=None):
         if '/' in name:  # models/ are entities, not worlds
             raise WorldError(f'unknown world {_show(name)}: {_choices()}')
     else:
-        name = _file_name(name)
+        name = uri_path(name)
     path = Path(name)
     if path.suffix == '.toml' or path.parent != Path('.'):
         if world_folders is not None:
