@@ -1,9 +1,9 @@
-"""The one set of checks readers make of a message's numbers (common/checks.py)."""
+"""The one set of checks readers make of a message's numbers (miro/checks.py)."""
 import math
 
 import pytest
 
-from miro_ball.common.checks import finite, finite_values
+from miro_ball.miro.checks import finite, finite_values
 from miro_ball.miro.constants import JOINT_POSITIONS
 
 

@@ -5,7 +5,7 @@ Plain functions of the Animal's state and the percepts: no node, no clock.
 import math
 
 from miro_ball.animal.actions import ACTIONS
-from miro_ball.common.checks import finite
+from miro_ball.miro.checks import finite
 
 
 def animal_state(animal, stamp_s=None):

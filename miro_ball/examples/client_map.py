@@ -33,7 +33,7 @@ from miro_ball.examples._client import Client, heading, make_parser, number, run
 from miro_ball.mapping.floor_map import FloorMap, MAX_RANGE_M
 from miro_ball.miro.interface import EYE_QOS, frame_id
 from miro_ball.miro.kc import EYE_FRAMES, KinematicChain
-from miro_ball.common.checks import finite
+from miro_ball.miro.checks import finite
 from miro_ball.miro.kinematics import wrap
 
 TICK = 0.02  # s: MiRo's 50 Hz platform tick, the rate of the spin command

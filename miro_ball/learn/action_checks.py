@@ -1,14 +1,14 @@
 """What of a contract Action the robot takes: the checks its control topics make.
 
 The simulator's ROS handlers ignore a control message of the wrong length or with a
-non-finite number (common.checks), and the message types take only whole numbers in their
+non-finite number (miro.checks), and the message types take only whole numbers in their
 range (illum uint32, tone uint16, stream int16). The learning rig hands an Action to the
 robot without ROS, so it makes the same checks here: a part that fails them never reaches
 the physics (one NaN head target sank MiRo into the floor, for every later episode too).
 """
 import numpy as np
 
-from miro_ball.common.checks import finite_values
+from miro_ball.miro.checks import finite_values
 from miro_ball.miro.constants import JOINT_POSITIONS
 
 # part: (count, what): real numbers, as the ROS handlers check them.

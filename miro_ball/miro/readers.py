@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable, NamedTuple
 
-from miro_ball.common.checks import finite_values
+from miro_ball.miro.checks import finite_values
 from miro_ball.miro.constants import JOINT_POSITIONS
 from miro_ball.miro.hearing import mic_window
 from miro_ball.miro.interface import SENSOR, TOPIC

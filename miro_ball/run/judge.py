@@ -21,7 +21,7 @@ import collections
 import math
 from dataclasses import dataclass
 
-from miro_ball.common.checks import finite
+from miro_ball.miro.checks import finite
 from miro_ball.miro.constants import WHEEL_RADIUS_M
 
 KICK_DISTANCE_M = 0.3  # the ball has moved this far from where it was first touched

@@ -9,7 +9,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from miro_ball.common.checks import finite
+from miro_ball.miro.checks import finite
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
                                       KIN_CALIB_RAD, PLATFORM_TICK_S, TILT_RAD,

@@ -12,9 +12,9 @@ import math
 
 from std_msgs.msg import UInt16
 
-from miro_ball.common.checks import finite, finite_values
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
+from miro_ball.miro.checks import finite, finite_values
 from miro_ball.miro.body import optical_frame
 from miro_ball.miro.constants import JOINT_NAMES, JOINT_POSITIONS
 from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id, LATCHED,
