@@ -14,7 +14,7 @@ setup(
     package_data={'miro_sim_bullet.worlds': ['*.toml', 'models/*.toml', 'pictures/*.png',
                                             'sounds/*.ogg'],
                   'miro_ball.gui': ['static/*', 'static/vendor/three/*'],
-                  'miro_ball.learn': ['policies/*/*']},  # the trained policies bundled
+                  'miro_ball.policy': ['bundled/*/*']},  # the trained policies bundled
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),

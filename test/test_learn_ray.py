@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from miro_ball.bench.grade_bench import ray_cluster
-from miro_ball.learn.policy import LinearPolicy
+from miro_ball.policy.linear import LinearPolicy
 from miro_ball.learn.ray_rollouts import RayRollouts
 from miro_ball.learn.rollouts import evaluate_population
 

@@ -7,7 +7,7 @@ import os
 from miro_ball.controller.behaviour import BehaviourParams, make_behaviour
 from miro_ball.learn.controllers import run_controller
 from miro_ball.learn.env import MiroEnv
-from miro_ball.learn.policy_controller import POLICY_ENV, PolicyController
+from miro_ball.policy.controller import POLICY_ENV, PolicyController
 from miro_ball.learn.tasks import KickBall
 from miro_ball.run.episode import run_episode
 from miro_ball.run.placements import placements
@@ -19,7 +19,7 @@ EYES = (160, 90)
 # The ROS simulator's eyes are 640x360 JPEGs at 15 Hz; the environment's are drawn every
 # tick: a controller that decides every tick kicks a few ticks apart, never more.
 SAME_KICK_WITHIN_S = 0.5
-POLICY = 'miro_ball.learn.policy_controller:PolicyController'
+POLICY = 'miro_ball.policy.controller:PolicyController'
 
 
 def both(context, mode, controller, seed):

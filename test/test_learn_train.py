@@ -13,8 +13,8 @@ import pytest
 from miro_ball.learn import evaluate, rollouts, train
 from miro_ball.learn.bandit import EpsilonGreedy
 from miro_ball.learn.controllers import run_controller
-from miro_ball.learn.policy import load
-from miro_ball.learn.policy_controller import BUNDLED, POLICY_ENV, PolicyController
+from miro_ball.policy.linear import load
+from miro_ball.policy.controller import BUNDLED, POLICY_ENV, PolicyController
 from miro_ball.learn.registry import kick_ball
 from miro_ball.learn.trainers import held_out_seeds
 from program import Program

@@ -136,7 +136,7 @@ def measure_ray(nodes, population, seeds, episode_s):
     import psutil
 
     from miro_ball.bench.grade_bench import ray_cluster
-    from miro_ball.learn.policy import LinearPolicy
+    from miro_ball.policy.linear import LinearPolicy
     from miro_ball.learn.ray_rollouts import RayRollouts
     from miro_ball.learn.rollouts import evaluate_population
     from miro_ball.learn.trainers import TASKS

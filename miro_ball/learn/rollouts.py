@@ -38,7 +38,7 @@ def _env(settings):
 
 
 def _kick_ball_env(settings):
-    from miro_ball.learn.policy import OBSERVED
+    from miro_ball.policy.linear import OBSERVED
     from miro_ball.learn.registry import kick_ball
     from miro_ball.learn.wrappers import PickActions, PickObservations
 
@@ -55,7 +55,7 @@ def _k_bandit_env(settings):
 
 def kick_ball_episode(env, settings, params, seed):
     """One KickBall episode of the LinearPolicy of weights ``params``."""
-    from miro_ball.learn.policy import LinearPolicy
+    from miro_ball.policy.linear import LinearPolicy
 
     policy = LinearPolicy(params, settings)
     observation, _ = env.reset(seed=seed)
@@ -74,7 +74,7 @@ def kick_ball_demonstration(env, settings, params, seed):
     'improved'); its trace is, step by step, the policy's features of what the robot saw and
     the (forward, turn) the controller chose, each -1..1: examples to imitate."""
     from miro_ball.controller.behaviour import BehaviourParams, make_behaviour
-    from miro_ball.learn.policy import LinearPolicy
+    from miro_ball.policy.linear import LinearPolicy
     from miro_ball.miro.constants import WHEEL_MAX_SPEED_M_PER_S
 
     base = env.unwrapped

@@ -27,17 +27,15 @@ import numpy as np
 from gymnasium import spaces
 
 from miro_ball.controller.contract import Action
-from miro_ball.learn.action_checks import refusals, said
+from miro_ball.learn.action_parts import parts, said
 from miro_ball.miro.constants import (JOINT_LIMITS_RAD, MIC_BLOCK_SAMPLES, TILT_RAD,
                                       TONE_FREQUENCY_RANGE_HZ, TONE_VOLUME_MAX,
                                       WHEEL_MAX_SPEED_M_PER_S)
 from miro_ball.miro.touch import TOUCH_PADS
-from miro_sim_bullet.physics.model import SONAR_RANGE
-
-MICS = 4
-F32 = np.float32
-SONAR_FAR_M = SONAR_RANGE[1]
-INT16_FULL_SCALE = 32768.0
+# The observation itself is plain numpy, so that a controller node running a trained
+# policy makes it without Gymnasium: observation(percepts, observation_space(...)).
+from miro_ball.policy.observation import F32, MICS, observation, SONAR_FAR_M
+from miro_sim_bullet.physics.commands import refusals
 
 
 def _box(low, high, shape=None, dtype=F32):
@@ -89,42 +87,6 @@ def action_space():
         'tone': _box(np.array([0.0, 0.0], F32),
                      np.array([TONE_FREQUENCY_RANGE_HZ[1], TONE_VOLUME_MAX], F32)),
     })
-
-
-def _bits(mask):
-    return np.array([(int(mask or 0) >> pad) & 1 for pad in range(TOUCH_PADS)], np.int8)
-
-
-def _sighting(result):
-    """[seen, x, y, r] of one eye's detection (a Ball, or anything with x and y)."""
-    if result is None:
-        return (0.0, 0.0, 0.0, 0.0)
-    return (1.0, float(result.x), float(result.y), float(getattr(result, 'r', 0.0)))
-
-
-def observation(percepts, space, mics=None):
-    """The observation of ``space`` made from ``percepts`` (contract.Percepts); ``mics``
-    the latest microphone block (int16, (4, 500)) or None."""
-    sonar = percepts.sonar if percepts.sonar is not None else math.inf
-    obs = {
-        'joints': np.asarray(percepts.joints, F32),
-        'sonar': np.array([min(max(sonar, 0.0), SONAR_FAR_M)], F32),
-        'cliff': np.clip(np.asarray(percepts.cliff, F32), 0.0, 1.0),
-        'light': np.clip(np.asarray(percepts.light, F32), 0.0, 1.0),
-        'touch_head': _bits(percepts.touch_head),
-        'touch_body': _bits(percepts.touch_body),
-    }
-    if 'eyes' in space.spaces:
-        obs['eyes'] = np.stack([eye.image for eye in percepts.eyes])
-    if 'mics' in space.spaces:
-        block = np.zeros((MICS, MIC_BLOCK_SAMPLES), F32) if mics is None else \
-            np.asarray(mics, F32) / INT16_FULL_SCALE
-        obs['mics'] = block
-    for name in space.spaces:
-        if name not in obs:
-            obs[name] = np.clip(np.array([_sighting(found) for found in
-                                          percepts.found(name)], F32), -1.0, 1.0)
-    return obs
 
 
 def to_action(act, ticks=1):
@@ -203,10 +165,10 @@ def check_action(space, action, name='action'):
 def contract_action(action, space, ticks=1):
     """The contract's Action an environment's step takes: ``action`` of ``space`` (a Dict
     of parts, checked by check_action) or a contract Action, whose parts must be what the
-    robot's control topics take (action_checks: ValueError otherwise; values out of
+    robot's control topics take (physics.commands: ValueError otherwise; values out of
     MiRo's ranges are clamped, as there)."""
     if isinstance(action, Action):
-        refused = refusals(action)
+        refused = refusals(parts(action))
         if refused:
             raise ValueError(said(refused))
         return action

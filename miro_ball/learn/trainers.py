@@ -4,7 +4,7 @@ learn.train and learn.evaluate read.
 Seeds: training run ``--seed S`` places its episodes from seeds S * 10**6 on; evaluation
 uses seeds from 10**9 on, which no training run of S < 1000 ever sees (held out).
 
-- kick_ball: a LinearPolicy (learn.policy) first imitates a few episodes of the
+- kick_ball: a LinearPolicy (policy.linear) first imitates a few episodes of the
   hand-written 'improved' controller (least squares on the policy's own features of what the
   robot saw: a start that already kicks), then the cross-entropy method (learn.cem) searches
   its weights, each generation's population scored on the same few new seeds by the
@@ -25,8 +25,8 @@ import numpy as np
 from miro_ball.learn import curve, rollouts
 from miro_ball.learn.cem import CrossEntropy
 from miro_ball.learn.kbandit import EXPRESSION_NAMES
-from miro_ball.learn.policy import (FEATURES, FORWARD_FEATURES, LinearPolicy, load,
-                                   load_settings, SETTINGS_FILE)
+from miro_ball.policy.linear import (FEATURES, FORWARD_FEATURES, LinearPolicy, load,
+                                    load_settings, SETTINGS_FILE)
 
 TRAIN_STRIDE = 10 ** 6
 HELD_OUT_FROM = 10 ** 9

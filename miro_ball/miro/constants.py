@@ -55,8 +55,14 @@ CAM_HORI_HALF_FOV_RAD = math.radians(60.6)
 CAM_VERT_HALF_FOV_RAD = math.radians(31.8)
 FRAME_SIZES = ((1280, 720), (640, 360), (320, 240))
 
-# Cliff: a value below this is a drop.
+# Cliff: a value below this is a drop; a sensor sees the floor up to CLIFF_RANGE (m) along
+# its ray.
 CLIFF_THRESHOLD = 0.7
+CLIFF_RANGE = 0.5
+
+# Sonar: an echo from SONAR_RANGE (m) within a cone of radius 0.309 m at 1 m.
+SONAR_RANGE = (0.03, 1.0)
+SONAR_HALF_CONE = math.atan(0.309)  # rad
 
 # Flags
 UPSTREAM_FLAG_SIMULATOR = 1 << 15

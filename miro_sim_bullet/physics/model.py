@@ -7,20 +7,17 @@ gimbal, the head); the tail, eyelids, ears and LED patches are drawn-only parts
 (physics.drawn) whose masses ride in the body and the head. The other robots' eyes draw
 these shapes, so they see the MiRo the URDF describes.
 """
-import math
-
 import numpy as np
 
 from miro_ball.miro import body as desc
-from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT, PITCH, TILT_RAD, YAW
+# The sensors' reach is MiRo's (miro.constants); the physics casts its rays that far.
+from miro_ball.miro.constants import (CLIFF_RANGE, JOINT_LIMITS_RAD, LIFT, PITCH,
+                                      SONAR_HALF_CONE, SONAR_RANGE, TILT_RAD, YAW)
 from miro_ball.miro.kc import AXLE_HEIGHT_M as AXLE_HEIGHT
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.drawn import carried_mass, COSMETIC, DrawnParts, SOLVED
 
 CLIFF_IN_BODY, CLIFF_PITCH_DOWN = desc.CLIFF_IN_BODY, desc.CLIFF_PITCH_DOWN
-CLIFF_RANGE = 0.5
-SONAR_RANGE = (0.03, 1.0)
-SONAR_HALF_CONE = math.atan(0.309)  # cone radius 0.309 m at 1 m
 WHITE = desc.COLOURS['shell']  # an unlit LED
 
 # Link (= joint) indices of the physics body: drawn.SOLVED in order.

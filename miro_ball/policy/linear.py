@@ -1,8 +1,8 @@
 """A small numpy policy for KickBall: the ball detector's readings (and the sonar) to the
 wheels, through a linear layer and tanh. No deep-learning library: twelve numbers in all.
 
-The observation is the environment's (learn.spaces): ``ball`` (2, 4) rows [seen, x, y, r]
-per eye (left, right), ``sonar`` (1,) metres. The policy keeps two numbers of memory: on
+The observation is the environment's (policy.observation): ``ball`` (2, 4) rows
+[seen, x, y, r] per eye (left, right), ``sonar`` (1,) metres. The policy keeps two numbers of memory: on
 which side the ball was last seen, so that a ball lost from view is searched for on the
 side it left by (a policy without it can only spin one way), and how big it was then, so
 that a ball lost because it is close (below the eyes' view) is driven at, not searched
@@ -11,8 +11,8 @@ speeds.
 
 A policy is saved as a folder: ``policy.npz`` (its weights) and ``policy.json`` (the
 settings it was trained with: eyes, frame_skip, what it was trained on), read back by
-``load`` for evaluation and for the controller node (learn.policy_controller), through
-learn.policy_files: the folder may come from anyone, so its files are checked and bounded
+``load`` for evaluation and for the controller node (policy.controller), through
+policy.files: the folder may come from anyone, so its files are checked and bounded
 before they are read.
 """
 import json
@@ -20,9 +20,9 @@ import os
 
 import numpy as np
 
-from miro_ball.learn.policy_files import read_numbers, read_settings
 from miro_ball.miro.constants import WHEEL_MAX_SPEED_M_PER_S
-from miro_sim_bullet.physics.model import SONAR_RANGE
+from miro_ball.policy.files import read_numbers, read_settings
+from miro_ball.policy.observation import SONAR_FAR_M
 
 # MiRo is symmetric, so is the policy: what it does with a ball on the left it does,
 # mirrored, with the ball on the right. The forward command reads features that a mirror
@@ -73,7 +73,7 @@ class LinearPolicy:
             # Seen by the left eye only, or towards the left of the frames: on the left.
             self.side = 1.0 if seen_l - seen_r - (x_l + x_r) > 0 else -1.0
             self.seen_size = r_l + r_r
-        near = 1.0 - float(observation['sonar'][0]) / SONAR_RANGE[1]
+        near = 1.0 - float(observation['sonar'][0]) / SONAR_FAR_M
         remembered = lost * self.seen_size
         return (np.array([1.0, seen_l + seen_r, x_l - x_r, r_l + r_r, lost, remembered, near]),
                 np.array([seen_l - seen_r, x_l + x_r, r_l - r_r, lost * self.side,
