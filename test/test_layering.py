@@ -1,8 +1,11 @@
 """The layering rules, in one place: who may import whom.
 
+- Our modules stand on FLOORS (docs/development.md's Layering): a module imports only from
+  its own floor and those below it, never up.
 - The simulator loads no controller, GUI, example or lab code (nodes talk only over ROS).
 - MiRo's own library (miro_ball.miro), demo mode's parts and the simulator's control logic
-  (miro_sim_bullet.control) import neither rclpy nor PyBullet.
+  (miro_sim_bullet.control) import neither rclpy nor PyBullet; the trained-policy
+  controller (miro_ball.policy) neither Gymnasium nor PyBullet.
 - No import cycles between our modules, counting imports inside functions too (a cycle
   hidden in a function is still a cycle).
 """
@@ -15,6 +18,21 @@ ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ('miro_ball', 'miro_sim_bullet')
 # What the simulator may use of miro_ball: MiRo's facts and the shared plumbing.
 SIMULATOR_MAY_USE = ('miro_ball.miro', 'miro_ball.common')
+# The floors, from the ground up (docs/development.md, Layering): a package or module of
+# ours and everything in it stands on one floor.
+FLOORS = (
+    ('miro_ball.miro',),  # what MiRo is: its numbers, body, interface, readers
+    ('miro_ball.common',),  # what every node needs
+    # The simulator, and the nodes, parts and clients that talk to it over ROS.
+    ('miro_sim_bullet', 'miro_ball.controller', 'miro_ball.policy', 'miro_ball.animal',
+     'miro_ball.robot', 'miro_ball.examples', 'miro_ball.mapping', 'miro_ball.gui',
+     'miro_ball.recording', 'miro_ball.record', 'miro_ball.ros2', 'miro_ball.foxglove',
+     'miro_ball.build_interfaces', 'miro_ball.__main__'),
+    # What runs them together: episodes and processes, the grader, learning, launch files,
+    # the lab tools, the benchmarks.
+    ('miro_ball.run', 'miro_ball.grading', 'miro_ball.learn', 'miro_ball.launch',
+     'miro_ball.lab', 'miro_ball.grade', 'miro_ball.bench'),
+)
 
 
 def our_modules():
@@ -58,6 +76,29 @@ def loaded_by(module):
                           timeout=120, cwd=ROOT)
     assert done.returncode == 0, done.stderr
     return set(done.stdout.split())
+
+
+def floor_of(module):
+    """The floor ``module`` stands on (0: the ground), or None if FLOORS places it nowhere."""
+    for number, rooms in enumerate(FLOORS):
+        if any(module == room or module.startswith(room + '.') for room in rooms):
+            return number
+    return None
+
+
+def test_every_module_stands_on_a_floor_and_imports_nothing_above_it():
+    """miro.readers, on the ground floor, once imported common.checks from the floor above."""
+    modules = our_modules()
+    # The packages themselves hold no code: each module imports them on its way.
+    placed = {name: floor_of(name) for name in modules if name not in PACKAGES}
+    assert not [name for name, floor in placed.items() if floor is None], \
+        'put these in a floor of FLOORS (and docs/development.md): ' + \
+        ', '.join(sorted(name for name, floor in placed.items() if floor is None))
+    upwards = [f'{name} (floor {floor}) imports {target} (floor {placed[target]})'
+               for name, floor in sorted(placed.items())
+               for target in sorted(imports_of(name, modules[name], modules))
+               if target in placed and placed[target] > floor]
+    assert not upwards, '\n'.join(upwards)
 
 
 def test_our_modules_import_in_no_cycle():
@@ -126,6 +167,15 @@ def test_the_learning_environments_need_no_ros_and_nothing_else_needs_gymnasium(
     nodes = ('miro_sim_bullet.ros.node, miro_ball.controller.host, miro_ball.gui.server, '
              'miro_ball.lab, miro_ball.grade')
     assert 'gymnasium' not in {m.split('.')[0] for m in loaded_by(nodes)}
+
+
+def test_the_policy_controller_loads_neither_gymnasium_nor_pybullet():
+    """A controller node running a trained policy once loaded both (0.6 s a start): the
+    policy read the sonar's range from the simulator's physics, and lived in miro_ball.learn,
+    whose package registers its environments with Gymnasium."""
+    loaded = loaded_by('miro_ball.policy.controller')
+    assert 'miro_ball.policy.controller' in loaded
+    assert not {m.split('.')[0] for m in loaded} & {'gymnasium', 'pybullet'}
 
 
 def _private_methods(cls_node):
