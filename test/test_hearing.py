@@ -13,7 +13,8 @@ from miro_ball.miro.hearing import level_db, locate, mic_window
 from miro_sim_bullet.physics import model as rb
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.scene.sounds import bundled_sound, Sound
-from miro_sim_bullet.scene.world_file import load_world, RobotSpec
+from miro_sim_bullet.scene.world_file import load_world
+from miro_sim_bullet.scene.world_model import RobotSpec
 
 FS = MIC_SAMPLE_RATE_HZ
 EMPTY = dataclasses.replace(load_world('empty'), ball=None)

@@ -17,10 +17,10 @@ from miro_ball.miro.kc import CAML, CAMR, KinematicChain, WORLD
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.renderer import probe_egl
-from miro_sim_bullet.scene import world_file
 from miro_sim_bullet.scene.png import png_size, PngError, SIGNATURE
-from miro_sim_bullet.scene.world_file import (bundled_pictures, load_world, PICTURE_LIFT,
-                                              WorldError)
+from miro_sim_bullet.scene.world_checks import bundled_pictures, MAX_PICTURE_BYTES, PICTURE_LIFT
+from miro_sim_bullet.scene.world_file import load_world
+from miro_sim_bullet.scene.world_model import bundled_folder, WorldError
 
 RENDERERS = ['tiny', pytest.param('egl', marks=pytest.mark.skipif(
     not probe_egl()[0], reason='EGL unavailable: ' + probe_egl()[1]))]
@@ -58,7 +58,7 @@ def test_bundled_pictures_are_what_make_pictures_draws():
     tags exactly; the drawings but for anti-aliased edges (OpenCV versions differ there)."""
     drawn = make_pictures.pictures()
     assert sorted(drawn) == bundled_pictures()
-    folder = world_file._bundled() / 'pictures'
+    folder = bundled_folder() / 'pictures'
     for name, image in drawn.items():
         stored = cv2.imdecode(np.frombuffer((folder / name).read_bytes(), np.uint8),
                               cv2.IMREAD_UNCHANGED)
@@ -71,13 +71,13 @@ def test_bundled_pictures_are_what_make_pictures_draws():
 
 @pytest.mark.parametrize('name', bundled_pictures())
 def test_no_bundled_picture_looks_like_the_ball_to_the_controller(name):
-    image = cv2.imread(str(world_file._bundled() / 'pictures' / name), cv2.IMREAD_COLOR)
+    image = cv2.imread(str(bundled_folder() / 'pictures' / name), cv2.IMREAD_COLOR)
     assert BallDetector().mask(image).sum() == 0
 
 
 @pytest.mark.parametrize('tag_id', make_pictures.TAG_IDS)
 def test_tag_posters_are_found_by_opencvs_apriltag_detector(tag_id):
-    image = cv2.imread(str(world_file._bundled() / 'pictures' / f'apriltag36h11_{tag_id}.png'),
+    image = cv2.imread(str(bundled_folder() / 'pictures' / f'apriltag36h11_{tag_id}.png'),
                        cv2.IMREAD_GRAYSCALE)
     corners, ids = detect_tags(image)
     assert ids == [tag_id]
@@ -239,7 +239,7 @@ def test_an_unreadable_or_corrupt_png_fails_the_world_at_load_in_one_line(tmp_pa
         message = str(err.value)
         assert message.startswith(f"{path}: box[0].picture: '{name}': {why}"), message
         assert '\n' not in message
-    (tmp_path / 'big.png').write_bytes(SIGNATURE + bytes(world_file.MAX_PICTURE_BYTES))
+    (tmp_path / 'big.png').write_bytes(SIGNATURE + bytes(MAX_PICTURE_BYTES))
     with pytest.raises(WorldError, match=r"box\[0\].picture: 'big.png' is larger than 8000000"):
         load_world(write(tmp_path, '[[box]]\nsize = [1, 1, 1]\npicture = "big.png"\n'))
     (tmp_path / 'folder.png').mkdir()

@@ -18,9 +18,10 @@ from miro_sim_bullet.control.posix_regex import compile_ere, MAX_PATTERN, MAX_ST
 from miro_sim_bullet.control.spawning import (parse_spawn, resolve_uri, RobotSpawn,
                                               ShapeSpawn, SPAWNABLE_MIRO, spawnables)
 from miro_sim_bullet.control.states import transition
-from miro_sim_bullet.scene.world_file import (Ball, bundled_worlds, load_world, named_poses,
-                                              parse_world, world_catalogue, WorldCache,
-                                              WorldError)
+from miro_sim_bullet.scene.world_catalogue import world_catalogue, WorldCache
+from miro_sim_bullet.scene.world_checks import parse_world
+from miro_sim_bullet.scene.world_file import bundled_worlds, load_world
+from miro_sim_bullet.scene.world_model import Ball, named_poses, WorldError
 
 BOX_URI = 'package://miro_ball/worlds/models/box.toml'
 BALL_URI = 'package://miro_ball/worlds/models/ball.toml'

@@ -93,6 +93,21 @@ def test_load_world_reads_no_file_outside_and_says_the_same_whatever_is_there(ma
     still_works(node)
 
 
+def test_a_load_errors_code_is_its_kind_not_its_words(make_sim, folders):
+    """A file that breaks a rule is RESOURCE_PARSE_ERROR even when its name reads like a
+    missing one (the code was told by 'unknown world' or 'no world file' in the message)."""
+    allowed, _ = folders
+    node = make_sim(world_folders=str(allowed))
+    (allowed / 'no world file.toml').write_text('[robot]\npose = "unknown world"\n')
+    refused = serve(node, srv.LoadWorld, uri=str(allowed / 'no world file.toml'))
+    assert refused.result.result == srv.LoadWorld.Response.RESOURCE_PARSE_ERROR
+    assert 'robot.pose' in refused.result.error_message
+    missing = serve(node, srv.LoadWorld, uri='package://miro_ball/worlds/nowhere.toml')
+    assert missing.result.result == srv.LoadWorld.Response.NO_RESOURCE
+    assert ok(serve(node, srv.GetCurrentWorld)).world.name == 'miro'  # stays loaded
+    still_works(node)
+
+
 def test_a_worlds_picture_is_no_window_onto_other_files(make_sim, folders):
     """A box's picture = "/absolute/path.png" hung any PNG on a wall, in MiRo's eyes."""
     allowed, private = folders

@@ -29,7 +29,7 @@ from miro_ball.miro.constants import UPSTREAM_FLAG_SIMULATOR
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics, default_robot_name, robot_name
 from miro_ball.miro.stream_kinds import BLOCK
 from miro_sim_bullet.physics.world import PHYSICS_DT_S
-from miro_sim_bullet.scene.world_file import WorldError
+from miro_sim_bullet.scene.world_model import WorldError
 from rostools import Probe, drain, spin_until
 
 DEVELOPMENT = Path(__file__).resolve().parent.parent / 'docs' / 'development.md'

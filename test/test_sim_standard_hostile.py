@@ -24,7 +24,7 @@ from fuzzmsg import hostile
 from miro_ball.miro.interface import RobotTopics
 from miro_sim_bullet.ros import step_action
 from miro_sim_bullet.ros.step_action import MAX_GOALS, StepAction
-from miro_sim_bullet.scene.world_file import MAX_SHAPES, Shape
+from miro_sim_bullet.scene.world_model import MAX_SHAPES, Shape
 from rostools import advance_ticks, Probe, spin_until
 
 OK = si.Result.RESULT_OK

@@ -15,7 +15,9 @@ from miro_sim_bullet.acoustics.hearing import Acoustics
 from miro_sim_bullet.acoustics.loading import SoundLoads
 from miro_sim_bullet.acoustics.sound_files import SoundBank, SoundFileError
 from miro_sim_bullet.scene.sounds import MAX_SOUNDS, Sound
-from miro_sim_bullet.scene.world_file import load_sounds, load_world, WorldError
+from miro_sim_bullet.scene.world_checks import load_sounds
+from miro_sim_bullet.scene.world_file import load_world
+from miro_sim_bullet.scene.world_model import WorldError
 
 
 def wav(path, seconds=0.1, rate=8000, samples=None, subtype='PCM_16'):

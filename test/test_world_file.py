@@ -4,8 +4,8 @@ import time
 
 import pytest
 
-from miro_sim_bullet.scene.world_file import (MAX_ROBOTS, RobotSpec, WorldError,
-                                              bundled_worlds, load_world)
+from miro_sim_bullet.scene.world_file import bundled_worlds, load_world
+from miro_sim_bullet.scene.world_model import MAX_ROBOTS, RobotSpec, WorldError
 
 
 def is_blue(colour):
@@ -254,13 +254,22 @@ def test_an_endless_file_is_refused_fast_without_reading_it_all(tmp_path):
     assert time.monotonic() - start < 2.0
 
 
-def test_unknown_empty_and_missing_names():
-    with pytest.raises(WorldError, match="^unknown world 'nowhere'.*miro"):
-        load_world('nowhere')
-    with pytest.raises(WorldError, match='^empty world name: bundled worlds are .*miro'):
-        load_world('')
-    with pytest.raises(WorldError, match='cannot read world file'):
-        load_world('/no/such/world.toml')
+def test_unknown_empty_and_missing_names(tmp_path):
+    """Each says so, and its kind is MISSING; a file that is there and breaks a rule is
+    INVALID, whatever its name says (the simulator's load_world answers by the kind)."""
+    for name, said in (('nowhere', "^unknown world 'nowhere'.*miro"),
+                       ('', '^empty world name: bundled worlds are .*miro'),
+                       ('/no/such/world.toml', 'cannot read world file'),
+                       ('package://miro_ball/worlds/models/box.toml', '^unknown world'),
+                       (str(tmp_path / 'elsewhere.toml'), '^no world file')):
+        with pytest.raises(WorldError, match=said) as err:
+            load_world(name, world_folders=[tmp_path / 'allowed'] if 'elsewhere' in name
+                       else None)
+        assert err.value.kind == WorldError.MISSING, name
+    broken = write(tmp_path, '[robot]\npose = "no world file"\n', 'unknown world.toml')
+    with pytest.raises(WorldError, match='robot.pose') as err:
+        load_world(broken)
+    assert err.value.kind == WorldError.INVALID
 
 
 def test_a_world_plays_sound_files_tones_and_noise_from_where_it_says(tmp_path):

@@ -8,7 +8,8 @@ import numpy as np
 from hypothesis import given, HealthCheck, settings, strategies as st
 
 from miro_sim_bullet.physics.world import SimWorld
-from miro_sim_bullet.scene.world_file import load_world, WorldError
+from miro_sim_bullet.scene.world_file import load_world
+from miro_sim_bullet.scene.world_model import WorldError
 
 # Each key's value is mostly plausible, so that many generated worlds get past the checks
 # and are built, and sometimes hostile: NaN, inf, huge, of the wrong type or length.

@@ -45,7 +45,7 @@ from miro_ball.bench.report import machine, write_section
 from miro_ball.miro.interface import EYES, RobotTopics
 from miro_sim_bullet.render.renderer import probe_egl
 from miro_sim_bullet.ros.params import SimParams
-from miro_sim_bullet.scene.world_file import MAX_ROBOTS
+from miro_sim_bullet.scene.world_model import MAX_ROBOTS
 
 # (label, world, how many robots' eyes are subscribed, renderers)
 CASES = (('default world, 2 eyes', 'miro', 1, ('egl', 'tiny')),

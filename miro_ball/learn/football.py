@@ -38,7 +38,8 @@ from miro_ball.learn.tasks import (APPROACH_WEIGHT, FALL_PENALTY, KICK_REWARD, K
                                    play, settle)
 from miro_ball.miro.camera_model import PINHOLE
 from miro_ball.miro.constants import PLATFORM_TICK_S
-from miro_sim_bullet.scene.world_file import RobotSpec, World, load_world
+from miro_sim_bullet.scene.world_file import load_world
+from miro_sim_bullet.scene.world_model import RobotSpec, World
 
 PITCH = 'football_pitch'
 MAX_PLAYERS = 12  # every one of 10,000 seeds places 12 apart on the pitch; 14 not

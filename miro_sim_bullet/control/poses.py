@@ -9,7 +9,7 @@ import math
 from miro_ball.miro.interface import WORLD_FRAME
 from miro_ball.miro.rotations import multiply
 from miro_sim_bullet.control.codes import Refused, SpawnResult
-from miro_sim_bullet.scene.world_file import MAX_MAGNITUDE
+from miro_sim_bullet.scene.world_model import MAX_MAGNITUDE
 
 WORLD_FRAMES = ('', WORLD_FRAME, '/' + WORLD_FRAME)
 # A body set moving faster than this crosses a metre in one 2 ms physics step or more and

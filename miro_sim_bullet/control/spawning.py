@@ -19,8 +19,9 @@ from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_ball.miro.urdf import MAX_URDF_BYTES, urdf
 from miro_sim_bullet.control.codes import Refused, SpawnResult
 from miro_sim_bullet.control.entities import entity_bounds, ROBOT_BOX
-from miro_sim_bullet.scene.world_file import (Ball, BUNDLED_URI, load_entity, MAX_FILE_BYTES,
-                                              WorldError)
+from miro_sim_bullet.scene.world_checks import load_entity, MAX_FILE_BYTES
+from miro_sim_bullet.scene.world_file import BUNDLED_URI
+from miro_sim_bullet.scene.world_model import Ball, WorldError
 
 SPAWN_FORMATS = ('urdf', 'toml')
 PACKAGE_URI = 'package://miro_ball/'

@@ -11,14 +11,15 @@ import tempfile
 from dataclasses import replace
 
 from miro_ball.miro.constants import PLATFORM_TICK_S
-from miro_ball.miro.interface import default_robot_name
+from miro_ball.miro.interface import BALL_NAME, default_robot_name
 from miro_ball.miro.rotations import yaw_of
 from miro_sim_bullet.acoustics.hearing import Acoustics
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.robot import MiroRobot
 from miro_sim_bullet.physics.sensors import GRAVITY
-from miro_sim_bullet.scene.world_file import (BALL_NAME, MAX_ROBOTS, MAX_SHAPES, PICTURE_UV,
-                                              RobotSpec, Shape, World, load_world)
+from miro_sim_bullet.scene.world_file import load_world
+from miro_sim_bullet.scene.world_model import (MAX_ROBOTS, MAX_SHAPES, PICTURE_UV, RobotSpec,
+                                               Shape, World)
 
 # Collision groups. Bit 0 stays in every mask because Bullet's ray tests carry group 1.
 # Static bodies skip each other (a wall panel touching the floor is work for nothing);

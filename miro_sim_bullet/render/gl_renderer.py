@@ -23,7 +23,7 @@ import cv2
 import numpy as np
 
 from miro_sim_bullet.render.visuals import client_visuals
-from miro_sim_bullet.scene.world_file import PICTURE_UV
+from miro_sim_bullet.scene.world_model import PICTURE_UV
 
 SUN_DIRECTION = (-0.5, 0.5, -1.0)  # where the sun's light travels (MDK worlds)
 AMBIENT = 0.4

@@ -53,8 +53,8 @@ from miro_sim_bullet.ros.scene import SCENE_RATE_HZ
 from miro_sim_bullet.ros.scene_interface import SceneInterface
 from miro_sim_bullet.ros.sim_interface import SimInterface
 from miro_sim_bullet.ros.tf import TfInterface
-from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, World, world_uri, \
-    WorldError
+from miro_sim_bullet.scene.world_file import bundled_worlds, load_world, world_uri
+from miro_sim_bullet.scene.world_model import World, WorldError
 
 try:  # simulation_interfaces is built at set-up (python -m miro_ball.build_interfaces)
     from miro_sim_bullet.ros.sim_control import ControlInterface

@@ -31,8 +31,10 @@ from miro_sim_bullet.control.spawning import (body_bounds, MAX_RESOURCE_BYTES, p
 from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.sim_interface import SERVICE_QOS
-from miro_sim_bullet.scene.world_file import (Ball, named_poses, parse_world, world_catalogue,
-                                              WorldCache, WorldError, load_world)
+from miro_sim_bullet.scene.world_catalogue import world_catalogue, WorldCache
+from miro_sim_bullet.scene.world_checks import parse_world
+from miro_sim_bullet.scene.world_file import load_world
+from miro_sim_bullet.scene.world_model import Ball, named_poses, WorldError
 
 MAX_SPAWNS = 64  # entities one SpawnEntities request may ask for
 # A StepSimulation answers when its steps are done, and the simulator does nothing else
@@ -58,6 +60,9 @@ CUSTOM_INFO = ('miro_ball: MiRo-E robots in PyBullet. Spawn MiRo-E from its URDF
                'are TOML world files. A robot\'s pose is the point on its floor under the '
                'wheel axle, and its heading.')
 ROBOT_TAGS = ('miro', 'robot')
+# A world that does not load, by what is wrong: there is none, or it breaks a rule.
+LOAD_CODES = {WorldError.MISSING: codes.LoadWorld.NO_RESOURCE,
+              WorldError.INVALID: codes.LoadWorld.RESOURCE_PARSE_ERROR}
 
 
 def _result(code=Result.OK, message=''):
@@ -455,7 +460,6 @@ class ControlInterface:
         response.result = _result()
 
     def _load_world(self, request, response):
-        code = srv.LoadWorld.Response
         if self.host.state == codes.SimulationState.LOADING_WORLD:
             raise Refused(Result.INCORRECT_STATE, 'a world is loading already')
         try:
@@ -468,12 +472,12 @@ class ControlInterface:
                                     self.host.sound_folders, self.host.world_folders)
                 uri = ''
             else:
-                raise Refused(code.NO_RESOURCE, 'give a uri (a bundled world, a file) or a '
-                                                'resource_string (a world file\'s text)')
+                raise Refused(codes.LoadWorld.NO_RESOURCE,
+                              "give a uri (a bundled world, a file) or a resource_string (a "
+                              "world file's text)")
         except WorldError as err:
-            unknown = any(text in str(err) for text in ('unknown world', 'no world file'))
-            raise Refused(code.NO_RESOURCE if unknown else code.RESOURCE_PARSE_ERROR,
-                          f'{err} (the current world stays loaded)') from None
+            raise Refused(LOAD_CODES[err.kind], f'{err} (the current world stays loaded)') \
+                from None
         self.host.load(world, uri)
         response.world = _world_resource(world.name, uri, world.description, world.tags)
         response.result = _result()

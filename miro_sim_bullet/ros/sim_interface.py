@@ -20,7 +20,8 @@ from miro_sim_bullet.render.overhead import overhead_camera
 from miro_sim_bullet.render.eye_images import jpeg_bytes
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.endpoints import send_if_listened
-from miro_sim_bullet.scene.world_file import load_sounds, WorldError
+from miro_sim_bullet.scene.world_checks import load_sounds
+from miro_sim_bullet.scene.world_model import WorldError
 
 # ROS's default keeps 10 requests: a burst of 200 clients lost 190 answers.
 SERVICE_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
