@@ -3,7 +3,6 @@
 process; a process that ends stops the others, unless its file says respawn."""
 import signal
 import sys
-import time
 import urllib.request
 
 from geometry_msgs.msg import PointStamped
@@ -25,12 +24,11 @@ class Launch(Program):
         super().__init__('miro_ball.launch', *args, guard_s=UP_GUARD_S)
 
     def ctrl_c(self):
-        """One SIGINT; (exit code, seconds to exit, the descendants left, its whole output)."""
+        """One SIGINT; (exit code, the descendants left, its whole output)."""
         children = proc_tree.descendants(self.proc.pid)
-        sent = time.monotonic()
         self.proc.send_signal(signal.SIGINT)
         code, output = self.finish()
-        return code, time.monotonic() - sent, proc_tree.wait_gone(children, 0), output
+        return code, proc_tree.wait_gone(children, 0), output
 
 
 def test_football_comes_up_from_one_command_a_robot_kicks_and_one_ctrl_c_ends_it_all(
@@ -47,9 +45,10 @@ def test_football_comes_up_from_one_command_a_robot_kicks_and_one_ctrl_c_ends_it
         names = set(probe.node.get_fully_qualified_node_names())
         assert {f'/{robot}/{CONTROLLER}' for robot in ROBOTS} | {'/miro_sim'} <= names
     finally:
-        code, seconds, left, output = launch.ctrl_c()
-    assert code == 0 and left == [], output
-    assert seconds < 3.0, output  # every node stops within a second of its Ctrl+C
+        code, left, output = launch.ctrl_c()
+    # Every process stopped on its Ctrl+C: one that had not within the launcher's grace
+    # (runner.STOP_GRACE_S) would have been killed, said so, and made the exit code 1.
+    assert code == 0 and left == [] and 'killed' not in output, output
     assert 'Traceback' not in output and output.rstrip().endswith('[launch] stopped'), output
     for label in ('miro_sim', *(f'{robot}/kick_blue_ball' for robot in ROBOTS)):
         assert f'\n[{label}] ' in output, label
@@ -95,7 +94,7 @@ def test_a_process_whose_file_says_respawn_is_restarted(tmp_path):
                                             respawn_delay="0.1" cmd="{again}"/>'''))
     for _ in range(3):
         launch.line('[again] up')
-    code, _, left, output = launch.ctrl_c()
+    code, left, output = launch.ctrl_c()
     assert code == 0 and left == [], output
     assert output.count('[launch] again exited with code 0; respawning in 0.1 s') >= 2, output
     assert len(count.read_text()) >= 3  # each time, the program itself ran anew
@@ -117,7 +116,7 @@ print('up')
             launch.line('[starter] up')
         helpers = [int(pid) for pid in pids.read_text().split()]
         left_running = proc_tree.wait_gone(helpers[:2], 0)  # those of the ended runs
-        code, _, left, output = launch.ctrl_c()
+        code, left, output = launch.ctrl_c()
         assert left_running == [], output
         assert code == 0 and left == [] and output.rstrip().endswith('[launch] stopped'), output
         assert proc_tree.wait_gone([int(pid) for pid in pids.read_text().split()], 0) == []
