@@ -11,7 +11,7 @@ import pytest
 
 from miro_ball.launch import LaunchError
 from miro_ball.launch.executables import command, console_scripts
-from miro_ball.launch.exits import Restart, Stop, after_exit
+from miro_ball.launch.exits import after_exit, GoOn, Restart, Stop
 from miro_ball.launch.files import bundled, find, share_folder
 from miro_ball.launch.plan import Process, make_plan
 
@@ -35,7 +35,7 @@ XML = '''<launch>
     <node pkg="demo" exec="listener" namespace="/top" if="false"/>
   </group>
   <executable cmd="echo $(var robot)" name="say" unless="true"/>
-  <executable cmd="echo $(var robot)"/>
+  <executable cmd="echo $(var robot)" on_exit="shutdown"/>
   <include file="child.launch.xml">
     <arg name="who" value="$(var robot)"/>
   </include>
@@ -63,7 +63,7 @@ YAML = '''launch:
   - node: {pkg: demo, exec: listener, namespace: $(var robot)}
   - node: {pkg: demo, exec: listener, namespace: /top, if: false}
 - executable: {cmd: echo $(var robot), name: say, unless: true}
-- executable: {cmd: echo $(var robot)}
+- executable: {cmd: echo $(var robot), on_exit: shutdown}
 - include:
     file: child.launch.xml
     arg: [{name: who, value: $(var robot)}]
@@ -114,6 +114,7 @@ def test_each_element_means_in_xml_and_yaml_what_ros2_launch_makes_of_it(sample)
     assert [p.namespace for p in processes[1:3]] == ['/team', '/team/inner']
     # The group's let stays in the group; an include gets what it is given.
     assert processes[3].cmd == ('echo', 'miro01') and not processes[3].respawn
+    assert [p.shutdown_on_exit for p in processes] == [False, False, False, True, False]
     assert processes[4].name == 'heard_miro01' and processes[4].namespace is None
 
 
@@ -140,14 +141,21 @@ def test_an_argument_without_default_is_required(tmp_path):
     assert plan(path).missing == ['who'] and plan(path, who='a').missing == []
 
 
-def test_a_process_that_ends_is_restarted_only_if_its_file_says_respawn():
-    node = Process('miro01/kick_blue_ball', Path('x'))
+def test_a_process_that_ends_ends_the_run_is_restarted_or_leaves_the_others_as_its_file_says():
+    node = Process('miro01/kick_blue_ball', Path('x'), shutdown_on_exit=True)
     assert after_exit(node, 3, now=10.0) == Stop('miro01/kick_blue_ball exited with code 3; '
                                                  'stopping the others')
     assert after_exit(node, -9, 10.0).line.startswith('miro01/kick_blue_ball was killed by '
                                                        'SIGKILL;')
     again = after_exit(Process('a', Path('x'), respawn=True, respawn_delay=2.0), 0, now=10.0)
     assert again == Restart(12.0, 'a exited with code 0; respawning in 2 s')
+    # As in ROS 2's launch: shutdown wins over respawn; with neither, the others go on.
+    both = Process('a', Path('x'), respawn=True, shutdown_on_exit=True)
+    assert isinstance(after_exit(both, 0, 10.0), Stop)
+    assert after_exit(Process('a', Path('x')), 1, 10.0) == GoOn(
+        'a exited with code 1; the others go on (its file does not say on_exit="shutdown")')
+    assert after_exit(Process('a', Path('x')), 0, 10.0, others=False) == GoOn(
+        'a exited with code 0')
 
 
 def test_the_command_line_of_a_node_and_of_an_executable(sample):
@@ -180,6 +188,8 @@ def test_the_command_line_runs_the_console_script_as_its_own_would(tmp_path):
     ('<launch><executable cmd="$(env NOT_SET_HERE)"/></launch>', 'has no NOT_SET_HERE'),
     ('<launch><executable cmd="a" if="maybe"/></launch>', "true or false (or 1, 0), got 'maybe'"),
     ('<launch><executable cmd="a" respawn_delay="-1"/></launch>', 'respawn_delay'),
+    ('<launch><node pkg="a" exec="b" on_exit="restart"/></launch>',
+     '<node>: on_exit=\'restart\': the only value is "shutdown"'),
     ('<launch><node pkg="a" exec="b" args="\'open"/></launch>', 'quotation'),
     ('<launch><include file="child.launch.py"/></launch>', 'Python launch files need ros2'),
     ('<launch><include file="bad.launch.xml"/></launch>', 'include itself'),
@@ -339,6 +349,16 @@ def test_the_bundled_files_start_what_their_docs_say():
     assert make_plan(find('record'), {}, share_folder, os.environ).missing == ['bag']
 
 
+def test_every_node_of_the_bundled_files_ends_the_run_when_it_ends():
+    """on_exit="shutdown" on every node: a refused miro_sim (exit 2) left kick_blue_ball
+    driving another simulator on the domain under ros2 launch, which lets the others run
+    unless a file says so; both launchers read it."""
+    for path in bundled():
+        plan = make_plan(path, {'bag': 'b'} if path.name.startswith('record') else {},
+                         share_folder, os.environ)
+        assert all(p.shutdown_on_exit for p in plan.processes), path.name
+
+
 def run_cli(*args, env=None, cwd=None):
     return subprocess.run([sys.executable, '-m', 'miro_ball.launch', *args], capture_output=True,
                           text=True, env=env, cwd=cwd, timeout=60)  # a hang guard only
@@ -398,6 +418,37 @@ def test_ros2s_own_launch_reads_every_bundled_file():
     for path in bundled():
         entity, parser = Parser.load(str(path))
         assert parser.parse_description(entity).entities, path
+
+
+def ros2_nodes(entities):
+    """The node actions of a parsed launch description, groups' too (not includes': each
+    bundled file is read on its own)."""
+    from launch.actions import IncludeLaunchDescription
+    from launch_ros.actions import Node
+
+    for entity in entities:
+        if isinstance(entity, Node):
+            yield entity
+        elif not isinstance(entity, IncludeLaunchDescription):
+            yield from ros2_nodes(entity.get_sub_entities())
+
+
+def test_ros2s_own_launch_reads_on_exit_shutdown_on_every_bundled_node():
+    """Where ROS 2's launch is installed: its own frontend gives every node of our files a
+    Shutdown on exit, so ros2 launch stops the rest when one ends, as ours does."""
+    pytest.importorskip('launch_ros')
+    pytest.importorskip('launch_xml')
+    pytest.importorskip('launch_yaml')
+    from launch.actions import Shutdown
+    from launch.frontend import Parser
+
+    for path in bundled():
+        entity, parser = Parser.load(str(path))
+        nodes = list(ros2_nodes(parser.parse_description(entity).entities))
+        assert nodes, path.name
+        for node in nodes:
+            assert any(isinstance(action, Shutdown) for action in node.get_sub_entities()), \
+                path.name
 
 
 def test_docs_launch_md_lists_every_bundled_file_with_its_own_arguments():

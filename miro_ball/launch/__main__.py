@@ -46,8 +46,10 @@ def build_parser():
         description='Run a ROS 2 launch file (XML or YAML) in a pip install, as ros2 launch '
                     'runs it: every process it names, its output prefixed with the process\'s '
                     'name, until Ctrl+C stops them all. A process that ends stops the others '
-                    '(exit code 1), unless the file says respawn. The subset of the format it '
-                    'runs is in docs/launch.md.',
+                    'if its file says on_exit="shutdown" (as every node of miro_ball\'s '
+                    'files does), is restarted if it says respawn, and else leaves them '
+                    'running, as in ROS 2. Exit code 1 if a process failed. The subset of the '
+                    'format it runs is in docs/launch.md.',
         epilog=bundled_help())
     parser.add_argument('file', metavar='FILE_OR_NAME', nargs='?',
                         help='a launch file, or the name of one of miro_ball\'s (football)')
@@ -94,7 +96,7 @@ def main(argv=None):
     print(f'[launch] {path.name}: {", ".join(p.label for p in plan.processes)}; Ctrl+C stops '
           'them all', flush=True)
     code = run(plan.processes, commands, dict(os.environ, PYTHONUNBUFFERED='1'), stop)
-    print(f'[launch] {"stopped" if code == 0 else "ended"}', flush=True)
+    print(f'[launch] {"stopped" if stop.requested else "ended"}', flush=True)
     if stop.requested:  # all is stopped and said; the interpreter's teardown only costs
         end_process(code)
     return code

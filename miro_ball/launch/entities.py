@@ -23,7 +23,7 @@ MAX_NESTING = 12
 
 ACTIONS = ('arg', 'let', 'node', 'executable', 'group', 'include')
 CONDITIONS = ('if', 'unless')
-PROCESS = ('name', 'args', 'output', 'respawn', 'respawn_delay') + CONDITIONS
+PROCESS = ('name', 'args', 'output', 'respawn', 'respawn_delay', 'on_exit') + CONDITIONS
 # element: (attributes, child elements); an include's <arg> passes a value, so it has a
 # row of its own. launch_ros spells the namespace action both ways.
 SUBSET = {

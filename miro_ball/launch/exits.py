@@ -1,6 +1,7 @@
-"""What a run does when one of its processes ends on its own: restart it if its launch file
-says respawn (after respawn_delay), else end the run, said in one line. Pure: time passed
-in."""
+"""What a run does when one of its processes ends on its own, as ROS 2's launch does: end
+the run if its launch file says on_exit="shutdown"; else restart it if the file says
+respawn (after respawn_delay); else let the others go on. Said in one line. Pure: time
+passed in."""
 import signal
 from dataclasses import dataclass
 
@@ -13,6 +14,13 @@ class Restart:
 
 @dataclass(frozen=True)
 class Stop:
+    """The run ends: the others are stopped."""
+    line: str
+
+
+@dataclass(frozen=True)
+class GoOn:
+    """The others run on; the run ends when none is left."""
     line: str
 
 
@@ -26,10 +34,15 @@ def how_it_ended(code):
     return f'exited with code {code}'
 
 
-def after_exit(process, code, now):
-    """Restart or Stop, for process (plan.Process) that ended with code at time now."""
+def after_exit(process, code, now, others=True):
+    """Stop, Restart or GoOn, for process (plan.Process) that ended with code at time now
+    (others: whether other processes of the run are still there). on_exit="shutdown" wins
+    over respawn, as in ROS 2's launch (its shutdown cancels the respawn)."""
     ended = f'{process.label} {how_it_ended(code)}'
+    if process.shutdown_on_exit:
+        return Stop(f'{ended}; stopping the others')
     if process.respawn:
         delay = process.respawn_delay
         return Restart(now + delay, f'{ended}; respawning' + (f' in {delay:g} s' if delay else ''))
-    return Stop(f'{ended}; stopping the others')
+    return GoOn(f'{ended}; the others go on (its file does not say on_exit="shutdown")'
+                if others else ended)

@@ -39,6 +39,7 @@ class Process:
     remaps: tuple = ()  # (from, to) pairs
     respawn: bool = False
     respawn_delay: float = 0.0
+    shutdown_on_exit: bool = False  # on_exit="shutdown": its end ends the run
 
 
 @dataclass(frozen=True)
@@ -187,9 +188,15 @@ def _include(entity, scope, found):
 
 
 def _process(entity, scope):
-    """What a node and an executable share: name, args, respawn."""
+    """What a node and an executable share: name, args, respawn, on_exit."""
     values = {name: substitute(value, scope) for name, value in entity.attrs.items()}
     where = f'{entity.file}: <{entity.kind}>'
+    # Read as written, as ROS 2's launch reads it (no substitution), which knows no other
+    # value in XML or YAML
+    on_exit = entity.attrs.get('on_exit')
+    if on_exit not in (None, 'shutdown'):
+        raise LaunchError(f'{where}: on_exit={on_exit[:60]!r}: the only value is "shutdown" '
+                          '(the run ends when this process ends)')
     try:
         args = tuple(shlex.split(values.get('args', '')))
         delay = float(values.get('respawn_delay', 0))
@@ -199,7 +206,7 @@ def _process(entity, scope):
         raise LaunchError(f'{where}: respawn_delay is in seconds, 0 to 3600')
     return values, dict(args=args, source=entity.file, name=values.get('name'),
                         respawn=truth(values.get('respawn', 'false'), where),
-                        respawn_delay=delay)
+                        respawn_delay=delay, shutdown_on_exit=on_exit == 'shutdown')
 
 
 def _node(entity, scope, found):

@@ -1,7 +1,8 @@
 """The processes of a launch file, run: each in a process group (and session) of its own,
-its output printed line by line after its label; one that ends restarted or ending the run
-(``exits``); on Ctrl+C or SIGTERM, all told to stop at once as a terminal tells one, and
-killed if they have not after STOP_GRACE_S (``run.processes.stop_all``).
+its output printed line by line after its label; one that ends ends the run, is restarted
+or leaves the others running, as its file says (``exits``); on Ctrl+C or SIGTERM, all
+told to stop at once as a terminal tells one, and killed if they have not after
+STOP_GRACE_S (``run.processes.stop_all``).
 
 The children's own sessions keep a terminal's Ctrl+C from reaching them straight: the
 launcher tells each one itself, so that it knows which it told and waits for them all. What
@@ -13,7 +14,7 @@ import sys
 import threading
 import time
 
-from miro_ball.launch.exits import Restart, after_exit
+from miro_ball.launch.exits import after_exit, Restart, Stop
 from miro_ball.run.processes import stop_all, stop_group
 
 POLL_S = 0.05
@@ -62,28 +63,34 @@ def bounded_lines(pipe, limit):
 
 
 class Running:
-    """A process of the plan, started (proc, its output's reader) or waiting to restart."""
+    """A process of the plan: started (proc, its output's reader), waiting to restart, or
+    ended for good."""
 
     def __init__(self, process, command):
         self.process, self.command = process, command
         self.proc = self.reader = None
         self.restart_at = None
+        self.failed = False  # it ended on its own with a code other than 0 (or by a signal)
+
+    @property
+    def over(self):
+        return self.proc is None and self.restart_at is None
 
 
 def run(processes, commands, env, stop, output=None, clock=time.monotonic):
     """Run processes (plan.Process) with their commands until stop.requested (a
-    common.stopping.StopRequest) or one ends that is not to be restarted; every one is
-    stopped on the way out. The exit code: 0 after a stop, 1 if one ended or had to be
-    killed."""
+    common.stopping.StopRequest), one whose file says on_exit="shutdown" ends, or none is
+    left; every one still running is stopped on the way out. The exit code: 1 if one
+    ended on its own with a code other than 0 (or by a signal), or had to be killed; else
+    0."""
     output = output or Output()
     running = [Running(process, command) for process, command in zip(processes, commands)]
-    code = 0
+    killed = False
     try:
         for one in running:
             _start(one, env, output)
-        while not stop.requested and code == 0:
+        while not stop.requested and _look(running, env, output, clock()):
             time.sleep(POLL_S)
-            code = _look(running, env, output, clock())
     finally:
         started = [one for one in running if one.proc is not None]
         stopped = stop_all([one.proc for one in started], STOP_GRACE_S)
@@ -91,9 +98,9 @@ def run(processes, commands, env, stop, output=None, clock=time.monotonic):
             if not ok:
                 output.say('launch', f'{one.process.label} ignored Ctrl+C for '
                                      f'{STOP_GRACE_S:g} s: killed')
-                code = 1
+                killed = True
             one.reader.join(READER_WAIT_S)
-    return code
+    return int(killed or any(one.failed for one in running))
 
 
 def _start(one, env, output):
@@ -110,21 +117,25 @@ def _start(one, env, output):
 
 
 def _look(running, env, output, now):
-    """One look at every process: restart those due, deal with those that ended; 1 if the
-    run is to end."""
+    """One look at every process: restart those due, deal with those that ended; whether
+    the run goes on."""
     for one in running:
         if one.restart_at is not None:
             if now >= one.restart_at:
                 _start(one, env, output)
             continue
-        code = one.proc.poll()
+        code = None if one.proc is None else one.proc.poll()
         if code is None:
             continue
         stop_group(one.proc, 0)  # what it left running; they hold its output open too
         one.reader.join(READER_WAIT_S)  # its last words before ours
-        decision = after_exit(one.process, code, now)
+        one.failed = one.failed or code != 0
+        one.proc = None
+        others = not all(other.over for other in running)
+        decision = after_exit(one.process, code, now, others)
         output.say('launch', decision.line)
-        if not isinstance(decision, Restart):
-            return 1
-        one.proc, one.restart_at = None, decision.at
-    return 0
+        if isinstance(decision, Stop):
+            return False
+        if isinstance(decision, Restart):
+            one.restart_at = decision.at
+    return not all(one.over for one in running)
