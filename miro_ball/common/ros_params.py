@@ -101,14 +101,22 @@ def declare(node, group):
     ranges)."""
     from rcl_interfaces.msg import ParameterDescriptor
 
-    values = {}
-    prefix, cls = group_of(group)
+    given = {}
     for name, _, f in parameters(group):
         default = default_of(f)
         descriptor = ParameterDescriptor(description=f.metadata['help'], dynamic_typing=True)
         declared = list(default) if isinstance(default, tuple) else default
-        value = node.declare_parameter(name, declared, descriptor).value
-        values[f.name] = coerce(name, value, default)
+        given[name] = node.declare_parameter(name, declared, descriptor).value
+    return values_of(group, given)
+
+
+def values_of(group, given):
+    """A group's filled-in dataclass from {parameter name: value} (a name not given: its
+    default), checked as a node's declared values are: coerce, then the dataclass's ranges
+    and its own checks. ValueError in one line."""
+    prefix, cls = group_of(group)
+    values = {f.name: coerce(name, given.get(name, default_of(f)), default_of(f))
+              for name, _, f in parameters(group)}
     try:
         return cls(**values)
     except ValueError as err:

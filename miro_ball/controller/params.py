@@ -2,10 +2,11 @@
 import math
 from dataclasses import dataclass, field
 
-from miro_ball.common.ros_params import check_ranges
+from miro_ball.common.ros_params import check_overrides, check_ranges, ros_overrides, values_of
 from miro_ball.controller.behaviour import BehaviourParams
 from miro_ball.controller.controllers import BUILT_IN, controller_class
 from miro_ball.controller.detection import DetectionParams
+from miro_ball.controller.names import NODE_NAME
 from miro_ball.miro.constants import LIFT_RAD_CALIB, PLATFORM_TICK_S
 
 
@@ -36,3 +37,15 @@ class ControllerParams:
 
 
 GROUPS = (ControllerParams, DetectionParams, BehaviourParams)
+
+
+def detection_params(args=(), node_name=NODE_NAME, groups=GROUPS):
+    """The DetectionParams a controller host started with the command line ``args`` runs
+    its detectors with: the ``--ros-args`` part's ``-p name:=value`` and ``--params-file``
+    read as the host reads them (its node ``node_name``, with parameter ``groups``: default
+    kick_blue_ball's). So a learning environment's eyes (learn.rig.WorldRig's
+    ``detection``) can see as that host will. A name none of the groups has, or a value
+    that does not fit, is a ValueError in one line, as the host refuses it at start."""
+    overrides = ros_overrides(list(args), node_name)
+    check_overrides(overrides, *groups)
+    return values_of(DetectionParams, overrides)

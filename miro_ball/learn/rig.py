@@ -17,40 +17,46 @@ import numpy as np
 
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.contract import Eye, Percepts
-from miro_ball.controller.detection import DetectionParams
-from miro_ball.controller.detectors import make_detectors
 from miro_ball.learn.action_checks import refusals
+from miro_ball.learn.eyes import check_options, RigEyes
 from miro_ball.miro.camera_model import CameraModel, PINHOLE
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM
 from miro_ball.miro.hearing import locate
 from miro_ball.miro.kinematics import clamp_wheel_speeds, wheel_speed2cmd_vel
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
-from miro_sim_bullet.render.eye_images import to_bgr
-
-SIDES = (1, -1)  # left eye, right eye: EYES order
 
 
 class WorldRig:
     """A world (SimWorld or what SimWorld takes: a bundled name, a path, a World) with eyes
     of ``eyes`` = (width, height) pixels through ``lens`` (None: no image is ever drawn)
     and, for each robot, the detectors named in ``detectors`` run on its eyes' images.
-    ``hears``: the microphones are worked out and each robot's latest block kept."""
+    ``hears``: the microphones are worked out and each robot's latest block kept.
+
+    The eyes as the ROS door has them (learn.eyes): ``camera_rate`` (Hz; None: drawn at
+    each look()), ``jpeg_quality`` (1-100; None: uncompressed), ``latency_s`` (at most one
+    camera period) and ``detection`` (the detectors' DetectionParams, default its defaults;
+    controller.params.detection_params gives a controller host's). The defaults keep the
+    cheap eyes that replay exactly; ValueError in one line for an option the eyes can not
+    have, or any of the first three without eyes."""
 
     def __init__(self, world='miro', eyes=None, lens=PINHOLE, detectors=(), hears=False,
-                 renderer='auto'):
+                 renderer='auto', camera_rate=None, jpeg_quality=None, latency_s=0.0,
+                 detection=None):
+        if eyes is None and (camera_rate, jpeg_quality, latency_s) != (None, None, 0):
+            raise ValueError('camera_rate, jpeg_quality and latency_s are options of the '
+                             'eyes: give eyes=(w, h)')
+        check_options(camera_rate, jpeg_quality, latency_s, detection)  # before a build
         self.sim = world if isinstance(world, SimWorld) else SimWorld(world)
         self.camera = None if eyes is None else CameraModel(*eyes, lens, CAM_HFOV_DEG_SIM)
         self.renderer = renderer
         self.cameras = None
+        self.eyes = None
         if eyes is not None:
-            self._cameras()
-        self.detector_names = tuple(detectors)
+            self.eyes = RigEyes(self.sim, self._cameras(), self.camera, detectors, camera_rate,
+                                jpeg_quality, latency_s, detection)
         self.hears = hears
-        self.images = {}  # robot -> (left, right) BGR images of the latest look()
-        self.found = {}  # robot -> (left, right) {detector: result} in those images
         self.heard = {}  # robot -> the latest MicBlock
-        self._detectors = {}
         self._warn = Throttled(logging.getLogger(__name__).warning)
 
     # -- time ---------------------------------------------------------------------------------
@@ -69,11 +75,9 @@ class WorldRig:
         world holding a non-finite value: SimWorld.rewind)."""
         self.check_open()
         self.sim.rewind()
-        self.images.clear()
-        self.found.clear()
+        if self.eyes is not None:
+            self.eyes.restart()
         self.heard.clear()
-        self._detectors = {name: [make_detectors(self.detector_names, DetectionParams())
-                                  for _ in SIDES] for name in self.sim.robots}
 
     def tick(self, observe=None):
         """One platform tick (its physics steps); ``observe(sim)`` after each physics step
@@ -81,10 +85,14 @@ class WorldRig:
         self.check_open()
         sim = self.sim
         listening = sim.robots if self.hears else ()
+        # Eyes on the simulator's camera schedule are drawn at the physics step it says.
+        eyes = self.eyes if self.eyes is not None and self.eyes.scheduled else None
         for _ in range(sim.ticks_per_platform_tick):
             sim.step(listening=listening)
             if observe is not None:
                 observe(sim)
+            if eyes is not None:
+                eyes.after_step()
         if self.hears:
             for name, robot in sim.robots.items():
                 if robot.heard is not None:
@@ -92,19 +100,12 @@ class WorldRig:
 
     def look(self):
         """Draw every robot's eyes now (one pass for all) and run their detectors, once a
-        frame: the motion detector compares each frame with its eye's previous one."""
+        frame: the motion detector compares each frame with its eye's previous one. With a
+        camera_rate the eyes are drawn at their instants instead, as tick() steps through
+        them: nothing to do here."""
         self.check_open()
-        if self.camera is None:
-            return
-        requests = [(robot, side) for robot in self.sim.robots.values() for side in SIDES]
-        drawn = self.cameras.render_views(self.cameras.eye_views(requests), self.camera,
-                                          rgba=True)
-        for index, name in enumerate(self.sim.robots):
-            images = tuple(to_bgr(image) for image in drawn[2 * index:2 * index + 2])
-            self.images[name] = images
-            self.found[name] = tuple(
-                {key: detect(image, self.camera) for key, detect in detectors.items()}
-                for image, detectors in zip(images, self._detectors[name]))
+        if self.eyes is not None:
+            self.eyes.look()
 
     def _cameras(self):
         self.check_open()
@@ -125,15 +126,13 @@ class WorldRig:
 
     # -- the contract -------------------------------------------------------------------------
     def percepts(self, name):
-        """Robot ``name``'s Percepts now: its latest tick's readings, its eyes' images and
-        the detectors' results in them (as the latest look() made them)."""
+        """Robot ``name``'s Percepts now: its latest tick's readings, its eyes' latest
+        images in and the detectors' results in them (each Eye's stamp: the simulated time
+        its images are of)."""
         self.check_open()
         robot = self.sim.robots[name]
         sensors = robot.sensors
-        images = self.images.get(name, (None, None))
-        found = self.found.get(name, ({}, {}))
-        eyes = [Eye(self.camera, image, seen, None if image is None else self.t)
-                for image, seen in zip(images, found)]
+        eyes = (Eye(None),) * 2 if self.eyes is None else self.eyes.seen(name)
         heard = self.heard.get(name)
         sound = None if heard is None else locate(heard.samples, sensors.kinematic_positions)
         return Percepts(
