@@ -7,6 +7,8 @@ import pytest
 from geometry_msgs.msg import PoseStamped
 
 from miro_ball.miro.camera_model import CameraModel, Intrinsics
+from miro_sim_bullet.control.codes import Refused
+from miro_sim_bullet.control.poses import check_pose
 from miro_sim_bullet.physics.sensors import Sensors
 from miro_sim_bullet.render.eye_images import encode, EyeWants
 from miro_sim_bullet.ros import convert
@@ -84,7 +86,7 @@ def test_eye_images_keep_the_ball_blue_from_rgb_or_rgba(channels):
     assert encode(image, EyeWants(jpeg=False, raw=False), 90) == (None, None)
 
 
-def pose_msg(name, position, orientation=(0.0, 0.0, 0.0, 0.0)):
+def pose_msg(name, position, orientation=(0.0, 0.0, 0.0, 1.0)):
     msg = PoseStamped()
     msg.header.frame_id = name
     p, o = msg.pose.position, msg.pose.orientation
@@ -104,6 +106,17 @@ def test_pose_requests_are_normalised_and_checked():
                 pose_msg('ball', (0, 0, 0), (math.nan, 0, 0, 1))):
         with pytest.raises(ValueError):
             convert.pose_request(bad)
+
+
+def test_set_pose_refuses_a_zero_quaternion_as_every_request_does():
+    """One pose check: set_pose took a zero quaternion as upright, where set_entity_state
+    and spawn_entity (control.poses) refuse it; now each says the same line."""
+    with pytest.raises(Refused) as standard:
+        check_pose((0.6, 0.1, 0.1), (0.0, 0.0, 0.0, 0.0))
+    with pytest.raises(ValueError) as alias:
+        convert.pose_request(pose_msg('ball', (0.6, 0.1, 0.1), (0.0, 0.0, 0.0, 0.0)))
+    assert str(alias.value) == str(standard.value)
+    assert 'zero quaternion' in str(alias.value) and '\n' not in str(alias.value)
 
 
 def test_a_drag_keeps_height_and_orientation():

@@ -166,14 +166,18 @@ def test_the_set_pose_alias_moves_things_and_ground_truth_follows(pitch, probe, 
     setter = probe.publisher(PoseStamped, SIM.set_pose)
     spin_until(executor, lambda: setter.get_subscription_count() > 0)
 
-    def request(name, x, y, z=0.1):
+    def request(name, x, y, z=0.1, orientation=(0.0, 0.0, 0.0, 1.0)):
         msg = PoseStamped()
         msg.header.frame_id = name
         msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = x, y, z
+        o = msg.pose.orientation
+        o.x, o.y, o.z, o.w = orientation
         return msg
     setter.publish(request('ball', 1.0, 0.5))
     setter.publish(request('miro03', 1.2, -0.8, 0.0))
-    for garbage in (request('ball', float('nan'), 0.0), request('ball', 1e9, 0.0),
+    # A zero quaternion is refused as set_entity_state refuses it (it was taken as upright).
+    for garbage in (request('ball', 0.0, 0.0, orientation=(0.0, 0.0, 0.0, 0.0)),
+                    request('ball', float('nan'), 0.0), request('ball', 1e9, 0.0),
                     request('nobody', 0.0, 0.0)):
         setter.publish(garbage)
     run(pitch, executor, 0.1)
@@ -181,7 +185,12 @@ def test_the_set_pose_alias_moves_things_and_ground_truth_follows(pitch, probe, 
     assert pitch.sim.robots['miro03'].pose()[:2] == pytest.approx((1.2, -0.8), abs=0.01)
     assert (ball_point[-1].point.x, ball_point[-1].point.y) == pytest.approx((1.0, 0.5), abs=0.01)
     assert ball_pose[-1].pose.position.y == pytest.approx(0.5, abs=0.01)
-    assert len(warnings) == 2 and "'nobody'" in warnings[-1]
+    assert len(warnings) == 4 and "'nobody'" in warnings[-1]
+    assert warnings[:3] == [
+        'set_pose ignored: the orientation (0, 0, 0, 0) is no rotation (a zero quaternion: '
+        'give w = 1 for none)',
+        'set_pose ignored: the pose (nan, 0, 0.1, 0, 0, 0, 1) has a number that is not finite',
+        'set_pose ignored: the position (1e+09, 0, 0.1) is more than 1000 m from the origin']
 
 
 def test_ball_mover_moves_the_ball_on_a_smooth_sine(ros_context, executor, pitch):

@@ -1,7 +1,6 @@
 """Simulator state to ROS messages and back: plain functions, no node needed."""
 import math
 
-import numpy as np
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import PointStamped, Pose2D, PoseStamped, TransformStamped
 from nav_msgs.msg import Odometry
@@ -13,11 +12,10 @@ from miro_ball.miro.body import MOVABLE
 from miro_ball.miro.constants import JOINT_NAMES
 from miro_ball.miro.interface import frame_id, WORLD_FRAME
 from miro_ball.miro.rotations import yaw_quaternion
+from miro_sim_bullet.control.codes import Refused
+from miro_sim_bullet.control.poses import check_pose
 from miro_sim_bullet.physics import model as rb
 from miro_sim_bullet.render.eye_images import JPEG_FORMAT
-
-MAX_COORDINATE_M = 1000.0  # where set_pose may put things: far beyond any bundled world
-
 
 def stamp(seconds):
     nanoseconds = int(round(seconds * 1e9))
@@ -141,29 +139,21 @@ def robot_pose(x, y, z, yaw, when):
 
 
 def pose_request(msg):
-    """(name, position, orientation xyzw) asked for by a set_pose message, or ValueError.
-
-    The name is header.frame_id. An all-zero orientation (a message with only a
-    position filled in) means upright; any other is normalised. A NaN height (position.z)
-    keeps the object's height and four NaNs keep its orientation: those come back as None,
-    so a drag in a viewer moves a thing across its floor without knowing how it stands.
-    """
+    """(name, position, orientation xyzw) asked for by a set_pose message, or ValueError
+    in one line. The name is header.frame_id. The pose is checked as every request's pose
+    is (control.poses.check_pose: finite, within its bounds, the quaternion not zero, made
+    unit), with what a drag in a viewer sends besides: a NaN height (position.z) keeps the
+    object's height and four NaNs keep its orientation; those come back as None, so a drag
+    moves a thing across its floor without knowing how it stands."""
     name = msg.header.frame_id
     p, o = msg.pose.position, msg.pose.orientation
-    position = (p.x, p.y, None if math.isnan(p.z) else p.z)
-    orientation = np.array([o.x, o.y, o.z, o.w])
-    if not all(v is None or (math.isfinite(v) and abs(v) <= MAX_COORDINATE_M)
-               for v in position):
-        raise ValueError(f'position must be finite and within {MAX_COORDINATE_M:g} m '
-                         f'(z may be NaN: keep the height), got {(p.x, p.y, p.z)}')
-    if np.all(np.isnan(orientation)):
-        return name, position, None
-    if not np.all(np.isfinite(orientation)):
-        raise ValueError(f'orientation must be finite (or four NaNs: keep it), '
-                         f'got {tuple(orientation)}')
-    norm = float(np.linalg.norm(orientation))
-    if norm == 0.0:
-        return name, position, (0.0, 0.0, 0.0, 1.0)
-    if norm < 1e-6 or norm > 1e6:
-        raise ValueError(f'orientation is no rotation (norm {norm:g})')
-    return name, position, tuple(float(v) for v in orientation / norm)
+    keep_height = math.isnan(p.z)
+    keep_orientation = all(math.isnan(v) for v in (o.x, o.y, o.z, o.w))
+    try:
+        position, orientation = check_pose(
+            (p.x, p.y, 0.0 if keep_height else p.z),
+            (0.0, 0.0, 0.0, 1.0) if keep_orientation else (o.x, o.y, o.z, o.w))
+    except Refused as refused:
+        raise ValueError(str(refused)) from None
+    return (name, (*position[:2], None if keep_height else position[2]),
+            None if keep_orientation else orientation)
