@@ -293,6 +293,43 @@ def test_a_nan_that_reaches_the_rig_is_dropped_and_the_physics_stays_finite(capl
     env.close()
 
 
+def test_step_and_the_rig_refuse_a_bad_action_by_the_control_topics_own_checks():
+    """A NaN, a wrong length or a huge value meets one set of checks through every door
+    (physics.commands, the ROS control topics' too: test_sim_node): step() refuses the
+    whole action in one line naming those parts, before anything moves; the rig drops the
+    same parts for the same reasons and takes the rest. The robot keeps its last command,
+    a huge value is clamped as on ROS, and the world stays finite."""
+    env = MiroEnv(KickBall(), eyes=None, detectors=())
+    env.reset(seed=1)
+    robot = env.rig.sim.robot
+
+    def told():
+        return robot.wheel_cmd, list(robot.kin_targets), list(robot.cosmetic), robot.illum
+
+    env.step(Action(wheels=(0.1, 0.1), head=(0.0, 0.5, 0.25, 0.0), cosmetic=(0.5,) * 6))
+    kept = told()
+    bad = Action(wheels=(np.nan, 0.1), head=(0.0, 0.5), cosmetic=(1e9,) * 6, illum=(1, 2, 3),
+                 tone=(440,))
+    why = {'wheels': 'need 2 finite wheel speeds (m/s), got [nan, 0.1]',
+           'head': 'need 4 finite positions [tilt, lift, yaw, pitch], got [0.0, 0.5]',
+           'illum': 'need 6 whole numbers 0..4294967295, LED colours 0xAARRGGBB, got [1, 2, 3]',
+           'tone': 'need 3 whole numbers 0..65535, [frequency Hz, volume 0..255, duration in '
+                   'ticks], got [440]'}
+    with pytest.raises(ValueError) as refused:
+        env.step(bad)
+    assert str(refused.value) == '; '.join(f'action {part}: {text}' for part, text in why.items())
+    assert told() == kept  # nothing moved, not even the sound part
+    assert env.rig.act(env.robot, bad) == why
+    assert told() == (kept[0], kept[1], [1.0] * 6, kept[3])  # the cosmetic part clamped
+    env.step(Action(wheels=(1e9, 1e9)))
+    assert robot.wheel_cmd == (0.4, 0.4)  # as cmd_vel's 1e9 m/s on ROS
+    for _ in range(3):
+        obs, reward, *_ = env.step({'wheels': np.zeros(2)})
+        assert sound(obs) and np.isfinite(reward)
+    assert env.rig.sim.finite()
+    env.close()
+
+
 def test_a_world_holding_a_non_finite_value_is_rebuilt_at_reset():
     """A snapshot restored over a NaN did not mend it: MiRo sank into the floor at every
     reset after."""

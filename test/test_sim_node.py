@@ -167,6 +167,105 @@ def test_bad_control_messages_are_ignored_with_rate_limited_warnings(sim_node, p
     assert sim_node.sim.robot.pose()[0] > 0.02
 
 
+def _twist(linear, angular):
+    msg = TwistStamped()
+    msg.twist.linear.x, msg.twist.angular.z = linear, angular
+    return msg
+
+
+# One command through both doors: (its control topic, the message, the same command as a
+# contract Action's parts, what the robot does with it). The drive is cmd_vel on the topic
+# and wheels in the Action (the controller host sends wheels as cmd_vel).
+NAN, INF = math.nan, math.inf
+BOTH_DOORS = [
+    ('cmd_vel', _twist(0.1, 0.0), {'wheels': (0.1, 0.1)}, 'taken'),
+    ('kinematic_targets', JointState(position=[0.0, 0.5, 0.25, 0.0]),
+     {'head': (0.0, 0.5, 0.25, 0.0)}, 'taken'),
+    ('cosmetic_joints', Float32MultiArray(data=[0.5] * 6), {'cosmetic': (0.5,) * 6}, 'taken'),
+    ('illum', UInt32MultiArray(data=[0xFF00FF00] * 6), {'illum': (0xFF00FF00,) * 6}, 'taken'),
+    ('tone', UInt16MultiArray(data=[440, 100, 250]), {'tone': (440, 100, 250)}, 'taken'),
+    ('cmd_vel', _twist(NAN, 0.0), {'wheels': (NAN, 0.1)}, 'refused'),
+    ('cmd_vel', _twist(0.0, INF), {'wheels': (0.1, -INF)}, 'refused'),
+    ('kinematic_targets', JointState(position=[0.0, NAN, 0.0, 0.0]),
+     {'head': (0.0, NAN, 0.0, 0.0)}, 'refused'),
+    ('kinematic_targets', JointState(position=[0.0, 0.5]), {'head': (0.0, 0.5)}, 'refused'),
+    ('cosmetic_joints', Float32MultiArray(data=[INF] * 6), {'cosmetic': (INF,) * 6}, 'refused'),
+    ('cosmetic_joints', Float32MultiArray(data=[0.5] * 5), {'cosmetic': (0.5,) * 5}, 'refused'),
+    ('illum', UInt32MultiArray(data=[1, 2, 3]), {'illum': (1, 2, 3)}, 'refused'),
+    ('tone', UInt16MultiArray(data=[440]), {'tone': (440,)}, 'refused'),
+    ('cmd_vel', _twist(1e9, 0.0), {'wheels': (1e9, 1e9)}, 'clamped'),
+    ('kinematic_targets', JointState(position=[0.0, 1e9, -1e9, 0.0]),
+     {'head': (0.0, 1e9, -1e9, 0.0)}, 'clamped'),
+    ('cosmetic_joints', Float32MultiArray(data=[1e9] * 6), {'cosmetic': (1e9,) * 6}, 'clamped'),
+]
+
+
+def commanded(robot):
+    """What a robot was last told: wheels, head targets, cosmetic targets, LEDs, tone."""
+    tone = robot.speaker.tone
+    return (robot.wheel_cmd, tuple(robot.kin_targets), tuple(robot.cosmetic),
+            tuple(robot.illum), tone and (tone.frequency, tone.volume))
+
+
+def test_a_bad_command_is_refused_the_same_way_through_the_topics_and_the_learning_rig(
+        sim_node, probe, executor, monkeypatch):
+    """The learning rig re-made the control topics' path without their checks (a NaN wheel
+    speed became 0 m/s there, where the topic ignores it; a NaN head target sank MiRo).
+    Both doors hand a command to the robot by one function (physics.commands.take): the same parts refused for the same reasons (the
+    robot keeps its last command), the same clamped, and the two robots told the same."""
+    from miro_ball.controller.contract import Action
+    from miro_ball.learn import rig as rig_module
+    from miro_sim_bullet.physics import commands
+    from miro_sim_bullet.ros import robot_interface
+
+    warnings = []
+    sim_node.warn.log = warnings.append
+    doors = {'topic': [], 'rig': []}
+    for door, module in (('topic', robot_interface), ('rig', rig_module)):
+        monkeypatch.setattr(module, 'take', lambda robot, door=door, **parts: doors[door].append(
+            commands.take(robot, **parts)) or doors[door][-1])
+    rig = rig_module.WorldRig('empty')
+    name = next(iter(rig.sim.robots))
+    topics = {key: probe.publisher(type(msg), getattr(T, key))
+              for key, msg, _, _ in BOTH_DOORS}
+    assert spin_until(executor, lambda: all(p.get_subscription_count()
+                                            for p in topics.values()))
+    said = []
+    for index, (key, msg, parts, outcome) in enumerate(BOTH_DOORS):
+        before = commanded(rig.sim.robot)
+        topics[key].publish(msg)
+        assert spin_until(executor, lambda: len(doors['topic']) > index), key
+        rig.act(name, Action(**parts))
+        on_topic, in_rig = doors['topic'][-1], doors['rig'][-1]
+        assert commanded(sim_node.sim.robot) == commanded(rig.sim.robot), (key, parts)
+        if outcome == 'taken':
+            assert on_topic == in_rig == ({}, {})
+            continue
+        ros_why, rig_why = getattr(on_topic, outcome), getattr(in_rig, outcome)
+        assert len(ros_why) == len(rig_why) == 1, (on_topic, in_rig)
+        if key == 'cmd_vel':
+            assert (*ros_why, *rig_why) == ('cmd_vel', 'wheels')
+        else:
+            assert ros_why == rig_why  # the same part, the same words
+        if outcome == 'refused':
+            assert commanded(rig.sim.robot) == before  # the last command kept
+        topic = getattr(T, key)
+        said += [f'{topic} ignored: {why}' if outcome == 'refused' else f'{topic}: {why}'
+                 for why in ros_why.values()]
+    # The topic door said each, with the topic in front (rate-limited: a repeat of a cause
+    # within 5 s is not said again).
+    assert warnings and set(warnings) <= set(said)
+    assert {line.split()[0] for line in said} == {line.split()[0] for line in warnings}
+    wheels, head, cosmetic, *_ = commanded(sim_node.sim.robot)
+    assert (wheels, cosmetic) == ((0.4, 0.4), (1.0,) * 6)
+    assert head[1:] == pytest.approx((math.radians(60), math.radians(-55), 0.0))
+    run(sim_node, executor, 0.2)
+    for _ in range(10):
+        rig.tick()
+    assert sim_node.sim.finite() and rig.sim.finite()
+    rig.close()
+
+
 def test_the_old_reset_pause_and_step_aliases_still_work(sim_node, probe, executor):
     """Kept for old scripts; our tools use simulation_interfaces' services instead."""
     initial = sim_node.sim.robot.pose()

@@ -110,6 +110,22 @@ def test_a_non_finite_command_is_refused_by_the_clamps(empty):
     assert robot.height() == pytest.approx(0.045, abs=0.003)
 
 
+def test_a_nan_wheel_speed_is_passed_on_to_be_refused_never_made_full_speed(empty):
+    """clamp_wheel_speeds made a NaN wheel speed +0.4 m/s (min and max), so a controller
+    whose wheels went NaN drove at full speed: the host's wheels -> cmd_vel now carries
+    the NaN to the simulator, which refuses it and keeps the last command."""
+    from miro_ball.miro.kinematics import clamp_wheel_speeds, clamped_cmd_vel
+
+    assert clamp_wheel_speeds(9.0, -9.0) == (0.4, -0.4)
+    left, right = clamp_wheel_speeds(math.nan, 0.1)
+    assert math.isnan(left) and right == 0.1
+    assert clamp_wheel_speeds(math.inf, 0.1)[0] == math.inf
+    robot = empty.robot
+    robot.set_cmd_vel(*clamped_cmd_vel(0.2, 0.2))
+    assert robot.set_cmd_vel(*clamped_cmd_vel(math.nan, 0.1)) is False
+    assert robot.wheel_cmd == (0.2, 0.2)
+
+
 @pytest.fixture
 def on_table():
     """MiRo on the table at the origin of the tables world, facing its free edge at x -0.75

@@ -47,7 +47,7 @@ from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES,
 from miro_ball.miro.hearing import locate
 from miro_ball.miro.interface import (CLOCK, EYE_QOS, EYES, robot_namespace,
                                       robot_of_namespace, RobotTopics, SENSOR, TOPIC)
-from miro_ball.miro.kinematics import clamp_wheel_speeds, wheel_speed2cmd_vel
+from miro_ball.miro.kinematics import clamp_wheel_speeds, clamped_cmd_vel
 from miro_ball.miro.readers import PERCEPT_READINGS, read, Refused
 
 SIDES = ('left', 'right')  # of EYES, in order
@@ -453,11 +453,11 @@ class ControllerHost(Node):
         self.pub_joints.publish(msg)
 
     def drive(self, left, right):
-        """Publish wheel speeds (m/s) as a TwistStamped through the MDK's formula."""
-        left, right = clamp_wheel_speeds(left, right)
-        linear, angular = wheel_speed2cmd_vel((left, right))
-        self.pub_twist.publish(drive_command(self, self.robot, linear, angular))
-        self.last_command = (left, right)
+        """Publish wheel speeds (m/s) as a TwistStamped through the MDK's formula, each wheel
+        clamped to +-0.4 m/s. A non-finite speed is sent as it is: the simulator refuses it
+        (and says so), the robot keeping its last command, as the learning rig does."""
+        self.pub_twist.publish(drive_command(self, self.robot, *clamped_cmd_vel(left, right)))
+        self.last_command = clamp_wheel_speeds(left, right)
 
     def stop(self, timeout_s=0.5):
         """Send a zero twist and give it a moment to leave (used on shutdown)."""

@@ -22,8 +22,7 @@ from miro_ball.miro.constants import (COSMETIC_CALIB, DOWNSTREAM_FLAG_DISABLE_CL
                                       PLATFORM_TICK_S, TILT_RAD, WHEEL_MAX_SPEED_M_PER_S, YAW)
 from miro_ball.miro.body import MICS
 from miro_ball.miro.interface import TOUCH_PARTS, check_name
-from miro_ball.miro.kinematics import (clamp_wheel_speeds, cmd_vel2wheel_speed,
-                                       wheel_speed2cmd_vel)
+from miro_ball.miro.kinematics import clamp_wheel_speeds, clamped_cmd_vel, cmd_vel2wheel_speed
 from miro_ball.miro.touch import TOUCH_COLUMNS, TOUCH_ROWS
 
 # Image channels, in the order of their numbers on the wire.
@@ -199,10 +198,9 @@ def _drive(msg, clamped):
     linear = _number(msg, 'linear', -WHEEL_MAX_SPEED_M_PER_S, WHEEL_MAX_SPEED_M_PER_S, clamped)
     angular = _number(msg, 'angular', -MAX_TURN_RAD_S, MAX_TURN_RAD_S, clamped)
     wanted = cmd_vel2wheel_speed(linear, angular)
-    wheels = clamp_wheel_speeds(*wanted)
-    if wheels != wanted:
+    if clamp_wheel_speeds(*wanted) != wanted:
         clamped.append('wheel speed')
-        linear, angular = wheel_speed2cmd_vel(wheels)
+        linear, angular = clamped_cmd_vel(*wanted)
     return Drive(linear, angular)
 
 

@@ -7,22 +7,21 @@ The same SimWorld (robot model, worlds, physics, microphones) and the same Camer
 taken here from the robot's own tick (its ``sensors``), and an Action reaches the robot as
 the simulator's control topics hand it over, so that what is learnt here behaves the same
 there. A snapshot of the built world makes a reset cheap: restored, not rebuilt (unless
-the world holds a non-finite value). What the control topics would ignore of an Action (a
-NaN, a wrong length) never reaches the robot (learn.action_checks).
+the world holds a non-finite value). An Action takes the control topics' own path to the
+robot (physics.commands): what they would ignore (a NaN, a wrong length) never reaches it.
 """
-import dataclasses
 import logging
 
 import numpy as np
 
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.contract import Eye, Percepts
-from miro_ball.learn.action_checks import refusals
+from miro_ball.learn.action_parts import parts
 from miro_ball.learn.eyes import check_options, RigEyes
 from miro_ball.miro.camera_model import CameraModel, PINHOLE
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM
 from miro_ball.miro.hearing import locate
-from miro_ball.miro.kinematics import clamp_wheel_speeds, wheel_speed2cmd_vel
+from miro_sim_bullet.physics.commands import take
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
 
@@ -141,31 +140,15 @@ class WorldRig:
             light=tuple(sensors.light), joints=tuple(sensors.kinematic_positions), sound=sound)
 
     def act(self, name, action):
-        """Hand robot ``name`` each part of ``action`` that is set, as its control topics do
-        (wheels through the MDK's cmd_vel formula, as the controller host sends them). A
-        part they would ignore (a wrong length, a non-finite number: action_checks) is
-        dropped with a rate-limited warning, the robot keeping what it was told before;
-        returns {part: why} of those dropped."""
+        """Hand robot ``name`` each part of ``action`` that is set, by the path and checks of
+        its control topics (physics.commands: the wheels through the MDK's cmd_vel formula,
+        as the controller host sends them). A part they would ignore (a wrong length, a
+        non-finite number) is dropped with a rate-limited warning, the robot keeping what
+        it was told before; returns {part: why} of those dropped."""
         self.check_open()
-        robot = self.sim.robots[name]
-        refused = refusals(action)
+        refused = take(self.sim.robots[name], **parts(action)).refused
         for part, why in refused.items():
             self._warn(part, f'{name}: action {part} ignored: {why}')
-        action = dataclasses.replace(action, **dict.fromkeys(refused))
-        if action.wheels is not None:
-            left, right = (float(v) for v in action.wheels)
-            robot.set_cmd_vel(*wheel_speed2cmd_vel(clamp_wheel_speeds(left, right)))
-        if action.head is not None:
-            robot.set_kinematic_targets([float(v) for v in action.head])
-        if action.cosmetic is not None:
-            robot.set_cosmetic([float(v) for v in action.cosmetic])
-        illum = None if action.illum is None else [int(v) for v in action.illum]
-        if illum is not None and illum != robot.illum:
-            robot.set_illum(illum)
-        if action.tone is not None:
-            robot.play_tone(*(int(v) for v in action.tone))
-        if action.stream is not None:
-            robot.stream(np.asarray(action.stream, np.int16))
         return refused
 
     def close(self):

@@ -124,7 +124,8 @@ class MiroRobot:
     # Each command below is clamped to MiRo's ranges, and one holding a non-finite number is
     # refused whole (the robot keeps what it was told before): a clamp of min and max lets
     # NaN through, and one NaN target sank MiRo into the floor for good, a rewind later too.
-    # The doors (the ROS handlers, the learning rig) refuse such commands first, and say so.
+    # Both doors (the ROS handlers, the learning rig) hand commands over through
+    # physics.commands, which refuses such commands first and says why.
     def set_cmd_vel(self, linear, angular):
         """Wheel speeds by MiRo's formula, each clamped to the wheels' +-0.4 m/s;
         returns True when a wheel had to be clamped. Non-finite: refused (False)."""

@@ -1,26 +1,23 @@
 """MiRo's ROS interface for one robot of the simulated world, under /<name>/.
 
 It publishes the robot's sensor streams (each when the node says its kind is due) and its
-eyes, and turns control messages
-into platform commands after checking them: wrong lengths and non-finite values
-are ignored, finite values out of range are clamped, both with a rate-limited
-warning. The robot is looked up each time, so a world reset (which rebuilds
-every robot) needs nothing from here.
+eyes, and hands control messages to the robot through physics.commands, the learning rig's
+path too: wrong lengths and non-finite values are ignored, finite values out of range are
+clamped, both with a rate-limited warning. The robot is looked up each time, so a world
+reset (which rebuilds every robot) needs nothing from here.
 """
 import collections
-import math
 
 from std_msgs.msg import UInt16
 
 from miro_ball.common.messages import message_class
 from miro_ball.common.qos import profile
-from miro_ball.miro.checks import finite, finite_values
 from miro_ball.miro.body import optical_frame
-from miro_ball.miro.constants import JOINT_NAMES, JOINT_POSITIONS
 from miro_ball.miro.interface import (CAMERA, CONTROL, EYE_SIDE, EYES, frame_id, LATCHED,
                                       ROBOT_INTERFACE, RobotTopics, SimTopics, TOPIC,
                                       TOUCH_PARTS)
 from miro_ball.miro.touch import ALL_PADS
+from miro_sim_bullet.physics.commands import take
 from miro_sim_bullet.render.eye_images import EyeWants
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.endpoints import send_if_listened
@@ -28,6 +25,15 @@ from miro_sim_bullet.ros.streams import PRODUCERS
 
 # An eye's three rows, in the order of pub_eyes[eye].
 EYE_ROWS = ('eye_compressed', 'eye_raw', 'camera_info')
+# A command's control rows: row key -> (the part of physics.commands, its values in a message).
+COMMANDS = {
+    'cmd_vel': ('cmd_vel', lambda msg: (msg.twist.linear.x, msg.twist.angular.z)),
+    'kinematic_targets': ('head', lambda msg: msg.position),
+    'cosmetic_joints': ('cosmetic', lambda msg: msg.data),
+    'illum': ('illum', lambda msg: msg.data),
+    'tone': ('tone', lambda msg: msg.data),
+    'stream': ('stream', lambda msg: msg.data),
+}
 
 
 class RobotInterface:
@@ -45,10 +51,6 @@ class RobotInterface:
         self._robot = robot
         self._warn = lambda kind, message: warn(f'{name}:{kind}', message)
         self.topics = t = RobotTopics(name)
-        apply = {'cmd_vel': self._on_cmd_vel, 'kinematic_targets': self._on_kinematic,
-                 'cosmetic_joints': self._on_cosmetic, 'illum': self._on_illum,
-                 'tone': self._on_tone, 'stream': self._on_stream,
-                 'control_flags': self._on_flags}
         self.streams = {}  # kind -> [(row key, producer, fields, publisher)]
         self.sent = collections.Counter()  # messages published, by row key (in-process rigs
         #                                    wait until a listener has them all)
@@ -65,7 +67,9 @@ class RobotInterface:
             for fields, relative in row.names():
                 topic = t.topic(relative)
                 if row.direction == CONTROL:
-                    self.subs.append(ros.subscription(msg_type, topic, apply[row.key], qos))
+                    handler = (self._on_flags if row.key == 'control_flags' else
+                               self._command(topic, *COMMANDS[row.key]))
+                    self.subs.append(ros.subscription(msg_type, topic, handler, qos))
                     self.controls.append((topic, row.type))
                     continue
                 publisher = ros.publisher(msg_type, topic, qos)
@@ -94,56 +98,16 @@ class RobotInterface:
         return self._publishers[(key, *placeholder)]
 
     # -- control topics -----------------------------------------------------------------------
-    def _on_cmd_vel(self, msg):
-        linear, angular = msg.twist.linear.x, msg.twist.angular.z
-        if not finite(linear, angular):
-            self._warn('cmd_vel', f'{self.topics.cmd_vel} ignored: non-finite '
-                       f'({linear}, {angular})')
-            return
-        if self.robot.set_cmd_vel(linear, angular):
-            self._warn('cmd_vel_clamp', f'{self.topics.cmd_vel} ({linear:g} m/s, '
-                       f'{angular:g} rad/s) asks more than 0.4 m/s of a wheel: clamped')
-
-    def _on_kinematic(self, msg):
-        try:
-            positions = finite_values(msg.position, 4, JOINT_POSITIONS)
-        except ValueError as err:
-            self._warn('kin', f'{self.topics.kinematic_targets} ignored: {err}')
-            return
-        applied = self.robot.set_kinematic_targets(positions)
-        if any(abs(a - b) > 1e-9 for a, b in zip(applied[1:], positions[1:])):
-            self._warn('kin_clamp', f"{self.topics.kinematic_targets} clamped to MiRo's "
-                       'ranges: ' + ', '.join(f'{n} {math.degrees(a):.1f} deg' for n, a in
-                                              zip(JOINT_NAMES[1:], applied[1:])))
-
-    def _on_cosmetic(self, msg):
-        try:
-            values = finite_values(msg.data, 6, 'values')
-        except ValueError as err:
-            self._warn('cos', f'{self.topics.cosmetic_joints} ignored: {err}')
-            return
-        if any(not 0.0 <= v <= 1.0 for v in values):
-            self._warn('cos_clamp', f'{self.topics.cosmetic_joints} clamped to 0..1')
-        self.robot.set_cosmetic(values)
-
-    def _on_illum(self, msg):
-        if len(msg.data) != 6:
-            self._warn('illum', f'{self.topics.illum} ignored: need 6 ARGB values, got '
-                       f'{len(msg.data)}')
-            return
-        self.robot.set_illum(msg.data)
-
-    def _on_tone(self, msg):
-        if len(msg.data) != 3:
-            self._warn('tone', f'{self.topics.tone} ignored: need 3 values [frequency Hz, '
-                       f'volume 0..255, duration in ticks], got {len(msg.data)}')
-            return
-        self.robot.play_tone(*msg.data)
-
-    def _on_stream(self, msg):
-        if self.robot.stream(msg.data):
-            self._warn('stream', f"{self.topics.stream}: the speaker's buffer is full "
-                       '(more than the speaker plays): the rest dropped')
+    def _command(self, topic, part, values):
+        """The handler of a command's topic: the message's values of ``part`` to the robot
+        (physics.commands.take), what it refused or clamped said after the topic's name."""
+        def handle(msg):
+            taken = take(self.robot, **{part: values(msg)})
+            for refused, why in taken.refused.items():
+                self._warn(refused, f'{topic} ignored: {why}')
+            for clamped, why in taken.clamped.items():
+                self._warn(f'{clamped}_clamp', f'{topic}: {why}')
+        return handle
 
     def _on_touch(self, part, msg):
         if msg.data > ALL_PADS:
