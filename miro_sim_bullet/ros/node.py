@@ -64,8 +64,10 @@ except ModuleNotFoundError as missing:
         raise
     ControlInterface = StepAction = None
 
-# Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 TYPE_CHECK_PERIOD_S = 1.0  # wall seconds between looks for control publishers of a wrong type
+# The states a world runs or pauses in: pausing leaves the others as they are.
+_RUNNABLE = (SimulationState.PLAYING, SimulationState.PAUSED, SimulationState.STOPPED)
+# Made into the world, its robots, cameras and topics at start; the rest apply at run time.
 FIXED_PARAMS = ('world', 'sound_folders', 'world_folders', 'physics_dt', 'frame_width',
                 'frame_height', 'camera_rate', 'hfov_deg', 'lens', 'renderer', 'eye_workers',
                 'peer_check_s')
@@ -113,10 +115,9 @@ class SimNode(Node):
         self.sim = SimWorld(world, physics_dt=p.physics_dt, robot_name=unnamed_robot)
         self._make_cameras()
         self.camera = CameraModel(p.frame_width, p.frame_height, p.lens, p.hfov_deg)
-        self.paused = p.paused
-        # What the standard's simulation state adds to paused: a stop (reset and paused),
-        # no world, a world loading, a quit asked for.
-        self.stopped = self.no_world = self.loading = self.quitting = False
+        # The standard's simulation state (control.codes.SimulationState): playing, paused,
+        # stopped (reset and paused), no world, a world loading, quitting.
+        self.state = SimulationState.PAUSED if p.paused else SimulationState.PLAYING
         self.frames_published = 0
         # Seconds spent drawing and encoding each camera instant (summed over helper processes).
         self.render_seconds = []
@@ -214,7 +215,6 @@ class SimNode(Node):
             self.destroy_timer(self.timer)
             self.timer = self._make_timer()
         self.paused = params.paused
-        self.stopped = self.stopped and params.paused  # played: no longer stopped
         self._restart_schedule(keep_time=True)
         if params.paused:
             self._publish_eyes(wait=True)  # nothing drawn is held back while paused
@@ -239,23 +239,27 @@ class SimNode(Node):
 
     # -- what the simulator's services do to time ---------------------------------------------
     @property
-    def state(self):
-        """The standard's simulation state (control.codes.SimulationState)."""
-        if self.quitting:
-            return SimulationState.QUITTING
-        if self.loading:
-            return SimulationState.LOADING_WORLD
-        if self.no_world:
-            return SimulationState.NO_WORLD
-        if self.paused:
-            return SimulationState.STOPPED if self.stopped else SimulationState.PAUSED
-        return SimulationState.PLAYING
+    def paused(self):
+        """Whether the world stands still: in any state but PLAYING."""
+        return self.state != SimulationState.PLAYING
+
+    @paused.setter
+    def paused(self, paused):
+        """Run or pause the world there is (the parameter's change does; in-process code may,
+        as the benchmark does). A stopped world stays stopped while paused; with no world,
+        one loading or a quit asked for, the state stays what it is."""
+        if self.state not in _RUNNABLE:
+            return
+        if not paused:
+            self.state = SimulationState.PLAYING
+        elif self.state == SimulationState.PLAYING:
+            self.state = SimulationState.PAUSED
 
     def act(self, action):
         """'play', 'pause', 'stop' (reset and pause) or 'quit' (a program ends as on Ctrl+C,
         exit code 0; in-process, the spin ends with SystemExit(0) at the next turn)."""
         if action == 'quit':
-            self.quitting = True
+            self.state = SimulationState.QUITTING
             self.get_logger().info('quitting, as asked')
             if hasattr(self, 'request_stop'):  # run as a program (lifecycle.run_node)
                 self.request_stop()
@@ -263,7 +267,8 @@ class SimNode(Node):
         if action == 'stop':
             self.reset(0)
         self.pause(action != 'play')
-        self.stopped = action == 'stop'
+        if action == 'stop':
+            self.state = SimulationState.STOPPED
 
     def reset(self, scope):
         """ResetSimulation's scope (bits: 1 time, 2 state, 4 spawned; 0 or all three: the
@@ -305,20 +310,21 @@ class SimNode(Node):
 
     def load(self, world, uri):
         """Another world (a World) in place of this one, the node's interfaces with it; the
-        state is LOADING_WORLD meanwhile, and paused after."""
-        self.loading = True
+        state is LOADING_WORLD meanwhile, and paused after (as it was, if it fails)."""
+        before, self.state = self.state, SimulationState.LOADING_WORLD
         try:
             self._publish_eyes(wait=True)
             self.eyes.close()
             self.cameras.close()
             self.sim.load(world)  # built once, here
             self._make_cameras()
-            self.world_uri, self.no_world = uri, False
+            self.world_uri = uri
             self._rebuilt(keep_time=False)
             if self.sim_interface is not None:
                 self.sim_interface.world_loaded(self.cameras)
+            before = SimulationState.PAUSED
         finally:
-            self.loading = False
+            self.state = before
         self.pause(True)
         if uri or world.robots:  # not unload()'s empty world
             self.get_logger().info(f'world {world.source} loaded; robots '
@@ -327,7 +333,7 @@ class SimNode(Node):
     def unload(self):
         """No world: nothing in it, nothing to step, until load()."""
         self.load(World(name='', source='(no world)', robots=()), '')
-        self.no_world = True
+        self.state = SimulationState.NO_WORLD
         self.get_logger().info('world unloaded: no world until load_world')
 
     def pause(self, paused):
@@ -342,9 +348,10 @@ class SimNode(Node):
         if not self.paused:
             return False, ('stepping works only while paused: set the simulation state to '
                            'paused first')
-        if self.no_world or self.loading:
+        if self.state in (SimulationState.NO_WORLD, SimulationState.LOADING_WORLD):
             return False, 'no world is loaded'
-        self.stopped = False
+        if self.state == SimulationState.STOPPED:  # a step leaves the stop
+            self.state = SimulationState.PAUSED
         self.advance(steps)
         return True, f'stepped {steps}; time {self.sim.time:.3f} s'
 
@@ -361,11 +368,11 @@ class SimNode(Node):
             self._next_scene = 0.0
 
     def _on_timer(self):
-        if self.quitting:
+        if self.state == SimulationState.QUITTING:
             raise SystemExit(0)
         if self.step_action is not None and self.step_action.serve():
             return
-        if self.paused or self.no_world:
+        if self.paused:
             if self.eyes.pending:  # paused by in-process code, not by the parameter
                 self._publish_eyes(wait=True)
             return
