@@ -2,10 +2,10 @@
 
 Nothing of miro_ball is imported here: what a tool built for Gazebo, Isaac Sim or O3DE
 does, this client does, against `python -m miro_sim_bullet` as a process (started paused,
-stepped by the client: simulated time only).
+stepped by the client: simulated time only). The tests share the process, and each finds
+it as it started (`sim`): any one runs alone, or in any order.
 """
-import subprocess
-import sys
+import signal
 import time
 
 import pytest
@@ -18,6 +18,8 @@ from rclpy.qos import QoSProfile
 from simulation_interfaces import msg as si
 from simulation_interfaces import srv
 from simulation_interfaces.action import SimulateSteps
+
+from program import Program
 
 SIM = '/miro_sim'
 DT = 0.002  # the simulator's physics step (s)
@@ -57,20 +59,45 @@ class Client:
         rclpy.shutdown(context=self.context)
 
 
+class Simulator:
+    """The simulator as a process (its output read as it comes), started again when a test
+    has ended it; one client for whichever is running."""
+
+    def __init__(self):
+        self.client, self.program = Client(), None
+
+    def running(self):
+        if self.program is None or self.program.proc.poll() is not None:
+            # Named on the command line, as a launch file names it.
+            self.program = Program('miro_sim_bullet', '--robot', 'miro', '--ros-args',
+                                   '-r', '__node:=miro_sim', '-p', 'paused:=true', guard_s=60)
+        return self.program
+
+    def close(self):
+        self.client.close()
+        if self.program is not None and self.program.proc.poll() is None:
+            self.program.proc.send_signal(signal.SIGINT)
+            self.program.finish()
+
+
 @pytest.fixture(scope='module')
-def sim():
-    # Named on the command line, as a launch file names it.
-    proc = subprocess.Popen([sys.executable, '-m', 'miro_sim_bullet', '--robot', 'miro',
-                             '--ros-args', '-r', '__node:=miro_sim', '-p', 'paused:=true'],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    client = Client()
+def simulator():
+    simulator = Simulator()
     try:
-        yield proc, client
+        yield simulator
     finally:
-        client.close()
-        if proc.poll() is None:
-            proc.kill()
-        proc.wait(timeout=10)
+        simulator.close()
+
+
+@pytest.fixture
+def sim(simulator):
+    """(the simulator's Program, the client), the world as it started whatever the test
+    before did: paused, at time zero, nothing spawned, every entity where it began."""
+    program, client = simulator.running(), simulator.client
+    state = si.SimulationState  # already paused is fine
+    client.call(srv.SetSimulationState, state=state(state=state.STATE_PAUSED))
+    ok(client.call(srv.ResetSimulation, scope=srv.ResetSimulation.Request.SCOPE_ALL))
+    return program, client
 
 
 def ok(response):
@@ -167,16 +194,20 @@ def test_a_spawned_miro_drives_on_its_own_topics(sim):
     twice = client.call(srv.SpawnEntity, **request)
     assert twice.result.result == srv.SpawnEntity.Response.NAME_NOT_UNIQUE
     odom = []
-    client.node.create_subscription(Odometry, '/miro_b/sensors/odom', odom.append, 10)
+    heard = client.node.create_subscription(Odometry, '/miro_b/sensors/odom', odom.append, 10)
     drive = client.node.create_publisher(TwistStamped, '/miro_b/control/cmd_vel', 10)
     command = TwistStamped()
     command.twist.linear.x = 0.2
-    for _ in range(100):  # 10 s of simulated time at most, 0.1 s at a time
-        drive.publish(command)
-        ok(client.call(srv.StepSimulation, steps=50))
-        client.executor.spin_once(timeout_sec=0.01)
-        if odom and odom[-1].pose.pose.position.x > -0.5:
-            break
+    try:
+        for _ in range(100):  # 10 s of simulated time at most, 0.1 s at a time
+            drive.publish(command)
+            ok(client.call(srv.StepSimulation, steps=50))
+            client.executor.spin_once(timeout_sec=0.01)
+            if odom and odom[-1].pose.pose.position.x > -0.5:
+                break
+    finally:
+        client.node.destroy_subscription(heard)
+        client.node.destroy_publisher(drive)
     assert odom and odom[-1].pose.pose.position.x > -0.5  # moved 10 cm forwards
 
 
@@ -199,31 +230,39 @@ def test_a_box_is_spawned_and_deleted_and_the_ball_moved(sim):
 
 
 def test_each_reset_scope(sim):
+    """It spawns and moves what it resets (it once relied on an earlier test's miro_b)."""
     _, client = sim
     reset = srv.ResetSimulation.Request
-    ball = client.call(srv.GetEntityState, entity='ball').state.pose.position
+    home = client.call(srv.GetEntityState, entity='ball').state.pose.position
+    beside = PoseStamped()
+    beside.pose.position.x = beside.pose.position.y = 0.5
+    ok(client.call(srv.SpawnEntity, name='crate', initial_pose=beside,
+                   uri='package://miro_ball/worlds/models/box.toml'))
+    moved = si.EntityState()
+    moved.pose.position.x, moved.pose.position.y, moved.pose.position.z = 0.9, -0.4, 0.1
+    ok(client.call(srv.SetEntityState, entity='ball', state=moved))
     ok(client.call(srv.StepSimulation, steps=10))
     ok(client.call(srv.ResetSimulation, scope=reset.SCOPE_TIME))
     assert client.now() == 0.0
     still = client.call(srv.GetEntityState, entity='ball').state.pose.position
-    assert still.x == pytest.approx(ball.x, abs=1e-3)  # nothing moved back
+    assert (still.x, still.y) == pytest.approx((0.9, -0.4), abs=1e-3)  # nothing moved back
 
     ok(client.call(srv.StepSimulation, steps=10))
     ok(client.call(srv.ResetSimulation, scope=reset.SCOPE_STATE))
     assert client.now() == pytest.approx(10 * DT)  # time goes on
     start = client.call(srv.GetEntityState, entity='ball').state.pose.position
-    assert (start.x, start.y) != pytest.approx((ball.x, ball.y), abs=1e-3)  # back home
-    assert 'miro_b' in names(client)  # spawned entities stay
+    assert (start.x, start.y) == pytest.approx((home.x, home.y), abs=1e-3)  # back home
+    assert 'crate' in names(client)  # spawned entities stay
 
     ok(client.call(srv.ResetSimulation, scope=reset.SCOPE_SPAWNED))
-    assert 'miro_b' not in names(client) and 'miro' in names(client)
+    assert 'crate' not in names(client) and 'miro' in names(client)
 
     ok(client.call(srv.ResetSimulation, scope=reset.SCOPE_ALL))
     assert client.now() == 0.0
 
 
 def test_worlds_are_listed_and_loaded_and_quitting_ends_the_simulator(sim):
-    proc, client = sim
+    program, client = sim  # the next test that needs it starts another
     worlds = ok(client.call(srv.GetAvailableWorlds)).worlds
     assert {'miro', 'football_pitch', 'den'} <= {w.name for w in worlds}
     pitch = next(w for w in worlds if w.name == 'football_pitch')
@@ -236,9 +275,6 @@ def test_worlds_are_listed_and_loaded_and_quitting_ends_the_simulator(sim):
     assert ok(client.call(srv.GetCurrentWorld)).world.name == 'football_pitch'
     state = si.SimulationState
     ok(client.call(srv.SetSimulationState, state=state(state=state.STATE_QUITTING)))
-    deadline = time.monotonic() + 30
-    while proc.poll() is None and time.monotonic() < deadline:
-        client.executor.spin_once(timeout_sec=0.1)
-    assert proc.returncode == 0
-    log = proc.stdout.read()
+    code, log = program.finish()
+    assert code == 0, log
     assert 'Traceback' not in log and 'FATAL' not in log and 'quitting, as asked' in log
