@@ -19,9 +19,11 @@ from std_msgs.msg import (Float32MultiArray, Int16MultiArray, UInt16, UInt16Mult
 
 from miro_ball.controller.behaviour import BehaviourParams, DEFAULT_CAMERA
 from miro_ball.controller.contract import Action
+from miro_ball.controller.detection import DetectionParams
 from miro_ball.controller.host import ControllerHost
 from miro_ball.controller.command_line import build_parser
 from miro_ball.controller.kick_blue_ball import KICK_BLUE_BALL, main
+from miro_ball.controller.params import detection_params
 from miro_ball.bench.synthetic import Disc, jpeg, render
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_DIVERGENCE_RAD, COSMETIC_CALIB, JOINT_NAMES
@@ -553,6 +555,33 @@ def test_bad_parameter_is_refused(ros_context):
     with pytest.raises(ValueError, match='tick'):
         ControllerHost(KICK_BLUE_BALL, context=ros_context,
                        parameter_overrides=[Parameter('tick', value='fast')])
+
+
+def test_the_learning_rigs_detection_is_the_hosts_own_from_the_same_command_line(tmp_path):
+    """controller.params.detection_params, what a learning rig's detectors are given, reads
+    a command line as the host does: the DetectionParams the host runs its detectors with,
+    from the same -p overrides and --params-file."""
+    from rclpy.context import Context
+
+    params = tmp_path / 'kick.yaml'
+    # The last part is for a node kick_blue_ball in the root namespace: not the host's.
+    params.write_text('/**:\n  ros__parameters:\n    sat_min: 90\n'
+                      '/**/kick_blue_ball:\n  ros__parameters:\n    hough_param2: 14.0\n'
+                      'kick_blue_ball:\n  ros__parameters:\n    blur: 7\n')
+    args = ['kick_blue_ball', '--ros-args', '--params-file', str(params),
+            '-p', 'hue_window:=10', '-p', 'mode:=tutorial']
+    context = Context()
+    rclpy.init(args=args, context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
+    try:
+        node = ControllerHost(KICK_BLUE_BALL, context=context, args=args)
+        try:
+            assert node.detection_params == detection_params(args)
+            assert node.detection_params == DetectionParams(sat_min=90, hough_param2=14.0,
+                                                            hue_window=10)
+        finally:
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
 
 
 def test_a_controller_whose_parameters_are_not_there_is_refused_never_run_on_defaults(

@@ -11,16 +11,21 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import miro_ball.learn
+from miro_ball.common.jpeg import decode_jpeg
 from miro_ball.controller.behaviour import BehaviourParams, make_behaviour
 from miro_ball.controller.contract import Action
-from miro_ball.controller.detection import Ball
+from miro_ball.controller.detection import Ball, DetectionParams
 from miro_ball.controller.detectors import DETECTORS
+from miro_ball.controller.params import detection_params
+from miro_ball.learn import rig as rig_module
 from miro_ball.learn.controllers import run_controller
 from miro_ball.learn.env import MiroEnv
 from miro_ball.learn.kbandit import EXPRESSION_NAMES
+from miro_ball.learn.rig import WorldRig
 from miro_ball.learn.tasks import KickBall
 from miro_ball.learn.wrappers import FlattenActions, PickActions, PickObservations
 from miro_ball.run.placements import placements
+from miro_sim_bullet.render.eye_images import jpeg_bytes
 
 # Gymnasium's advice for Box actions (symmetric, normalised): MiRo's are in its own units,
 # m/s and rad, as the contract says; and check_env's note on checking a wrapped environment.
@@ -374,3 +379,108 @@ EXAMPLES = re.findall(r'^```python\n(.*?)^```$', LEARNING_MD.read_text(), re.M |
 @pytest.mark.parametrize('example', EXAMPLES, ids=[f'example{i}' for i in range(len(EXAMPLES))])
 def test_the_examples_of_docs_learning_md_run_as_written(example):
     exec(compile(example, str(LEARNING_MD), 'exec'), {})
+
+
+def eyes_over(rig, ticks, wheels=(0.1, -0.1)):
+    """{t: (stamp, left image)} of each tick of a rig turning on the spot from its reset."""
+    rig.restore()
+    name = rig.sim.robot.name
+    rig.act(name, Action(wheels=wheels))
+    seen = {}
+    for _ in range(ticks):
+        rig.tick()
+        rig.look()
+        eye = rig.percepts(name).eyes[0]
+        seen[round(rig.t, 6)] = (eye.stamp and round(eye.stamp, 6), eye.image)
+    rig.close()
+    return seen
+
+
+def test_the_rig_eyes_come_at_the_simulators_camera_instants_as_its_jpeg_and_late():
+    """WorldRig drew the eyes at every look, uncompressed, seen at once (still its default).
+    With the ROS simulator's options they are drawn at the instants of its own camera
+    schedule (15 Hz at a 2 ms step: the first step taken, then steps 33, 67, 100, ...), are
+    what the controller host decodes of the JPEG the simulator encodes, and arrive
+    ``latency_s`` after their instant."""
+    options = dict(eyes=(160, 90), camera_rate=15.0)
+    every = eyes_over(WorldRig(eyes=(160, 90)), 15)
+    raw = eyes_over(WorldRig(**options), 15)
+    sent = eyes_over(WorldRig(**options, jpeg_quality=80), 15)
+    late = eyes_over(WorldRig(**options, jpeg_quality=80, latency_s=1 / 15), 15)
+    assert all(stamp == t for t, (stamp, _) in every.items())
+    instants = sorted({stamp for stamp, _ in sent.values()})
+    assert instants == [0.002, 0.066, 0.134, 0.2, 0.266]
+    images = {}
+    for t, (stamp, image) in sent.items():
+        assert stamp == max(s for s in instants if s <= t)
+        images[stamp] = image
+        raw_stamp, raw_image = raw[t]
+        assert raw_stamp == stamp and not np.array_equal(image, raw_image)
+        assert np.array_equal(image, decode_jpeg(jpeg_bytes(raw_image[..., ::-1], 80)))
+    for t, (stamp, image) in late.items():
+        arrived = [s for s in instants if s + 1 / 15 <= t + 1e-9]
+        if not arrived:
+            assert stamp is image is None  # nothing in yet: as the host before its first frame
+            continue
+        assert stamp == max(arrived) and np.array_equal(image, images[stamp])
+
+
+@pytest.mark.parametrize('options, said', [
+    ({'camera_rate': 1000}, 'parameter camera_rate must be in [0.1, 100], not 1000'),
+    ({'camera_rate': 'fast'}, "parameter 'camera_rate' must be a number, not 'fast'"),
+    ({'camera_rate': math.nan}, "parameter 'camera_rate' must be finite, not nan"),
+    ({'jpeg_quality': 0}, 'parameter jpeg_quality must be in [1, 100], not 0'),
+    ({'jpeg_quality': 80.5}, "parameter 'jpeg_quality' must be an integer, not 80.5"),
+    ({'camera_rate': 15, 'latency_s': -1}, 'latency_s must be a finite number of seconds >= 0'),
+    ({'camera_rate': 15, 'latency_s': math.inf}, 'latency_s must be a finite number'),
+    ({'camera_rate': 15, 'latency_s': 0.5}, 'latency_s 0.5 is more than one camera period '
+                                            '(0.0666667 s at camera_rate 15)'),
+    ({'latency_s': 0.05}, 'latency_s needs camera_rate'),
+    ({'detection': {'hue_window': 10}}, 'detection must be a DetectionParams'),
+    ({'eyes': None, 'camera_rate': 15}, 'camera_rate, jpeg_quality and latency_s are options '
+                                        'of the eyes: give eyes=(w, h)'),
+], ids=['rate-range', 'rate-text', 'rate-nan', 'quality-range', 'quality-fraction',
+        'latency-negative', 'latency-inf', 'latency-long', 'latency-alone', 'detection-dict',
+        'no-eyes'])
+def test_the_rig_eyes_refuse_an_option_they_can_not_have_in_one_line_building_nothing(
+        options, said, monkeypatch):
+    def build(*_, **__):
+        raise AssertionError('a world was built for refused options')
+
+    monkeypatch.setattr(rig_module, 'SimWorld', build)
+    with pytest.raises(ValueError) as refused:
+        WorldRig(**{'eyes': (160, 90), **options})
+    assert str(refused.value).startswith(said) and '\n' not in str(refused.value)
+
+
+def test_the_rig_eyes_detect_with_the_parameters_a_controller_host_is_given(tmp_path):
+    """The detectors ran with DetectionParams() whatever the controller host was told: now
+    controller.params.detection_params reads the host's command line (-p, --params-file)
+    into what the rig's detectors get, refusing what the host refuses."""
+    params = tmp_path / 'kick.yaml'
+    params.write_text('/**:\n  ros__parameters:\n    sat_min: 90\n'
+                      '/**/kick_blue_ball:\n  ros__parameters:\n    target_rgb: [255, 0, 0]\n'
+                      '/other/kick_blue_ball:\n  ros__parameters:\n    blur: 7\n')
+    args = ['kick_blue_ball', '--ros-args', '--params-file', str(params),
+            '-p', 'hue_window:=10', '-p', 'mode:=tutorial']
+    red = detection_params(args)
+    assert red == DetectionParams(target_rgb=(255, 0, 0), sat_min=90, hue_window=10)
+    # A part of the file for another namespace is that namespace's, as rcl has it.
+    assert detection_params(args + ['-r', '__ns:=/other']).blur == 7 and red.blur == 5
+    for bad, said in ((['-p', 'hue_windw:=10'], "unknown parameter 'hue_windw' (did you mean "
+                                                 'hue_window?)'),
+                      (['-p', 'blur:=4'], 'blur must be odd'),
+                      (['-p', 'sat_min:=300'], 'parameter sat_min must be in [0, 255], not 300')):
+        with pytest.raises(ValueError, match=re.escape(said)):
+            detection_params(['--ros-args', *bad])
+    balls = []
+    for detection in (None, red):
+        rig = WorldRig(eyes=(320, 180), detectors=('ball',), detection=detection)
+        rig.restore()
+        rig.sim.robot.place(0.0, 0.0, 0.0)
+        rig.sim.place_ball(0.6, 0.1)  # blue, in view of both eyes
+        rig.tick()
+        rig.look()
+        balls.append(rig.percepts(rig.sim.robot.name).found('ball'))
+        rig.close()
+    assert balls[0] != (None, None) and balls[1] == (None, None)

@@ -13,7 +13,10 @@ from pettingzoo.test import api_test, parallel_api_test
 import miro_ball.learn
 from miro_ball.controller.contract import Action
 from miro_ball.learn import football
+from miro_ball.learn.env import MiroEnv
+from miro_ball.learn.parallel_env import MiroParallelEnv
 from miro_ball.learn.t_maze import TMaze, reached
+from miro_ball.learn.tasks import KICK_REWARD, Task
 
 gymnasium.register_envs(miro_ball.learn)  # registered on import: says why it is imported
 
@@ -69,6 +72,71 @@ def test_football_the_same_seed_gives_the_same_trajectories_bit_for_bit():
     env.close()
 
 
+@pytest.mark.filterwarnings('ignore:.*alternative render modes')
+def test_a_gymnasium_environment_plays_football_as_the_first_robot_of_the_parallel_one():
+    """MiroEnv(Football()) raised a TypeError at its first step (the task's reward was a
+    dict). Both doors are one core: the Gymnasium one drives miro01, and sees, is rewarded
+    and ends exactly as the PettingZoo one's miro01 with the others left standing."""
+    alone = MiroEnv(football.Football(robots=3, limit_s=0.4), eyes=None)
+    check_env(alone)
+    together = football.parallel_env(robots=3, limit_s=0.4, eyes=None)
+    assert alone.robot == together.possible_agents[0] == 'miro01'
+    obs, info = alone.reset(seed=4)
+    observations, infos = together.reset(seed=4)
+    assert data_equivalence((obs, info), (observations['miro01'], infos['miro01']), exact=True)
+    alone.action_space.seed(4)
+    steps = 0
+    while together.agents:
+        action = alone.action_space.sample()
+        mine = alone.step(action)
+        theirs = together.step({'miro01': action})
+        steps += 1
+        assert data_equivalence(mine, tuple(part['miro01'] for part in theirs), exact=True)
+        assert mine[1] == sum(value for key, value in mine[4].items()
+                              if key.startswith('reward_'))
+    assert mine[3] and steps == 20  # truncated at 0.4 s, both
+    alone.close()
+    together.close()
+
+
+class Waiting(Task):
+    """Nothing happens; truncated at limit_s."""
+    limit_s = 0.5
+
+
+@pytest.mark.parametrize('frame_skip, steps', [(1, 25), (2, 13), (3, 9)])
+def test_both_doors_truncate_at_the_first_step_that_reaches_the_limit(frame_skip, steps):
+    """The core measures an episode's time, once, for every face: 0.5 s is the step that
+    reaches it (0.52 s with steps of 0.04 s), for any task."""
+    for env in (MiroEnv(Waiting(), eyes=None, frame_skip=frame_skip),
+                MiroParallelEnv(Waiting(), eyes=None, frame_skip=frame_skip)):
+        env.reset(seed=1)
+        ended = []
+        for _ in range(steps + 2):
+            if isinstance(env, MiroEnv):
+                _, reward, terminated, truncated, _ = env.step({})
+            else:
+                if not env.agents:
+                    break
+                _, rewards, terminations, truncations, _ = env.step({})
+                reward, terminated, truncated = (part[env.possible_agents[0]] for part in
+                                                 (rewards, terminations, truncations))
+            assert (reward, terminated) == (0.0, False)
+            ended.append(truncated)
+        assert ended.index(True) == steps - 1, ended
+        env.close()
+
+
+def test_an_action_for_a_robot_that_is_not_playing_is_refused_in_one_line():
+    """It was dropped without a word."""
+    env = football.parallel_env(robots=2, eyes=None)
+    env.reset(seed=1)
+    with pytest.raises(ValueError, match=r"^no agent 'miro03' \(agents: miro01, miro02\)$"):
+        env.step({'miro03': {'wheels': np.zeros(2)}})
+    env.step({'miro01': {'wheels': np.zeros(2)}})  # and it plays on
+    env.close()
+
+
 def test_football_placements_are_seeded_apart_and_on_the_pitch():
     half = (1.65, 1.0)
     for seed in range(200):
@@ -100,7 +168,7 @@ def test_football_rewards_the_robot_that_drives_to_the_ball_and_the_kicker():
         for agent, reward in rewards.items():
             totals[agent] += reward
     assert infos[idle]['kicked'] and infos[idle]['kicker'] == chaser
-    assert totals[chaser] > football.KICK_REWARD
+    assert totals[chaser] > KICK_REWARD
     # The one standing still: only what the kick took the ball nearer it or away.
     assert totals[idle] == pytest.approx(start - idle_gap())
     env.close()
@@ -228,7 +296,7 @@ def test_the_t_maze_punishes_the_wrong_arm_and_can_hide_the_cue():
     env = gymnasium.make('miro_ball/TMaze-v0', eyes=None, detectors=(), frame_skip=5,
                          cue=False, arm='right')
     total, info = run_maze(env, 2, lambda robot, env: 'left')
-    assert total == -1.0 and info == {'arm': 'right', 'reached': 'left'}
+    assert total == -1.0 and info == {'arm': 'right', 'reached': 'left', 'reward_arm': -1.0}
     ball = env.unwrapped.rig.sim.ball_position()
     assert reached(ball) is None and ball[0] < -1.2  # parked behind the stem's foot
     env.close()

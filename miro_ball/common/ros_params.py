@@ -132,6 +132,9 @@ def _in_group(prefix, err):
 def ros_overrides(argv, node_name):
     """{name: value} of every parameter the ``--ros-args`` parts of argv set for a node called
     node_name: ``-p name:=value`` and the node's (or ``/**``'s) part of ``--params-file``.
+    A node_name with a leading '/' is the node's fully qualified name, and a part of the file
+    applies as rcl applies it (node_matches); a bare name: any part naming it, in any
+    namespace (what a command line's check may look at).
 
     rclpy keeps the overrides it parsed to itself (a private attribute of Node), and a node
     that never declares a name never sees it: so the command line is read here, as rcl reads
@@ -169,8 +172,41 @@ def _params_file(path, node_name):
         raise ValueError(f'--params-file {path!r}: {err}') from None
     found = {}
     for node, section in (content.items() if isinstance(content, dict) else ()):
-        if str(node) in ('/**', node_name, '/' + node_name) or str(node).endswith('/' + node_name):
+        key = str(node)
+        if node_matches(key, node_name) if node_name.startswith('/') else (
+                key in ('/**', node_name, '/' + node_name) or key.endswith('/' + node_name)):
             _flatten((section or {}).get('ros__parameters') or {}, '', found)
+    return found
+
+
+def node_matches(key, fqn):
+    """Whether the part ``key`` of a --params-file applies to the node of fully qualified
+    name ``fqn``, as rcl decides: a key is taken from the root ('kick_blue_ball' is
+    '/kick_blue_ball', not '/miro/kick_blue_ball'), '*' stands for one part of the name and
+    '**' for any number of parts."""
+    def match(pattern, name):
+        if not pattern:
+            return not name
+        if pattern[0] == '**':
+            return any(match(pattern[1:], name[i:]) for i in range(len(name) + 1))
+        return bool(name) and pattern[0] in ('*', name[0]) and match(pattern[1:], name[1:])
+
+    return match(key.strip('/').split('/'), fqn.strip('/').split('/'))
+
+
+def remapped_namespace(argv):
+    """The namespace the ``--ros-args`` parts of argv give a node (``-r __ns:=/ns``), or None."""
+    found, inside, tokens = None, False, iter(argv)
+    for token in tokens:
+        if token == '--ros-args':
+            inside = True
+        elif token == '--':
+            inside = False
+        elif inside and token in ('-r', '--remap'):
+            rule = next(tokens, '')
+            name, sep, value = rule.partition(':=')
+            if sep and name == '__ns':
+                found = value
     return found
 
 

@@ -2,12 +2,14 @@
 import math
 from dataclasses import dataclass, field
 
-from miro_ball.common.ros_params import check_overrides, check_ranges, ros_overrides, values_of
+from miro_ball.common.ros_params import check_overrides, check_ranges, remapped_namespace, \
+    ros_overrides, values_of
 from miro_ball.controller.behaviour import BehaviourParams
 from miro_ball.controller.controllers import BUILT_IN, controller_class
 from miro_ball.controller.detection import DetectionParams
 from miro_ball.controller.names import NODE_NAME
 from miro_ball.miro.constants import LIFT_RAD_CALIB, PLATFORM_TICK_S
+from miro_ball.miro.interface import robot_namespace
 
 
 @dataclass(frozen=True)
@@ -39,13 +41,17 @@ class ControllerParams:
 GROUPS = (ControllerParams, DetectionParams, BehaviourParams)
 
 
-def detection_params(args=(), node_name=NODE_NAME, groups=GROUPS):
+def detection_params(args=(), robot=None, node_name=NODE_NAME, groups=GROUPS):
     """The DetectionParams a controller host started with the command line ``args`` runs
     its detectors with: the ``--ros-args`` part's ``-p name:=value`` and ``--params-file``
-    read as the host reads them (its node ``node_name``, with parameter ``groups``: default
-    kick_blue_ball's). So a learning environment's eyes (learn.rig.WorldRig's
-    ``detection``) can see as that host will. A name none of the groups has, or a value
-    that does not fit, is a ValueError in one line, as the host refuses it at start."""
-    overrides = ros_overrides(list(args), node_name)
+    read as the host reads them (a part of the file applies to the node as rcl decides: its
+    namespace is ``-r __ns:=`` of args, else its robot's, ``robot`` defaulting as the host's
+    --robot does; the node is ``node_name`` with parameter ``groups``: kick_blue_ball's by
+    default). So a learning environment's eyes (learn.rig.WorldRig's ``detection``) can see
+    as that host will. A name none of the groups has, or a value that does not fit, is a
+    ValueError in one line, as the host refuses it at start."""
+    args = list(args)
+    namespace = remapped_namespace(args) or robot_namespace(robot)
+    overrides = ros_overrides(args, f'{namespace.rstrip("/")}/{node_name}')
     check_overrides(overrides, *groups)
     return values_of(DetectionParams, overrides)

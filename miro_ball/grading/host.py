@@ -35,7 +35,7 @@ from miro_ball.grading.warm_start import python_args
 from miro_ball.grading.watch import GraphWatch, verdict
 from miro_ball.miro.interface import RobotTopics
 from miro_ball.miro.rotations import yaw_quaternion
-from miro_ball.run.judge import Judge, SETTLE_S
+from miro_ball.run.judge import Judge, observe, SETTLE_S
 
 SCRATCH = 'scratch'  # a command's $HOME, in the host's folder: made anew for each command
 WARM_START = 'miro_ball.grading.warm_start'
@@ -68,17 +68,6 @@ def place(sim, name, robot, ball):
     sim.set_object_pose(name, (x, y, sim.description.robots[0].floor),
                         yaw_quaternion(yaw))
     sim.place_ball(*ball)
-
-
-def observe(judge, sim, name):
-    """What the world says now, to the judge (run/judge.py), after each physics step: what
-    the simulator's ground truth topics say to the lab run's, on the same instants (a touch
-    after any step, the ball and the robot on platform ticks)."""
-    if sim.touching(name):
-        judge.touch(name, sim.time, sim.ball_position())
-    if sim.step_index % sim.ticks_per_platform_tick == 0:
-        judge.ball(sim.time, sim.ball_position())
-        judge.robot(name, sim.time, sim.robots[name].ground_truth()[:3])
 
 
 def _key(spec):

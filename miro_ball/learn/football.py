@@ -29,15 +29,10 @@ import dataclasses
 import math
 import random
 
-from pettingzoo import ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec
 
-from miro_ball.learn import spaces
-from miro_ball.learn.rig import WorldRig
-from miro_ball.learn.tasks import (APPROACH_WEIGHT, FALL_PENALTY, KICK_REWARD, KickBall,
-                                   play, settle)
-from miro_ball.miro.camera_model import PINHOLE
-from miro_ball.miro.constants import PLATFORM_TICK_S
+from miro_ball.learn.parallel_env import MiroParallelEnv
+from miro_ball.learn.tasks import KickBall
 from miro_sim_bullet.scene.world_file import load_world
 from miro_sim_bullet.scene.world_model import RobotSpec, World
 
@@ -92,11 +87,22 @@ def pitch_world(world, robots):
 
 
 class Football(KickBall):
-    """KickBall for every robot on the pitch (see the module): ``reward`` is a dict, one
-    reward per robot."""
+    """KickBall for every robot on the pitch (see the module). ``robots``: how many MiRos
+    play (1 to MAX_PLAYERS), named miro01, ..."""
 
     name = 'football'
     world = PITCH
+
+    def __init__(self, robots=3, limit_s=20.0):
+        if isinstance(robots, bool) or not isinstance(robots, int) or \
+                not 1 <= robots <= MAX_PLAYERS:
+            raise ValueError(f'robots must be a whole number 1 to {MAX_PLAYERS}, '
+                             f'got {robots!r}')
+        super().__init__(limit_s=limit_s)
+        self.robots = robots
+
+    def build_world(self, world):
+        return pitch_world(self.world if world is None else world, self.robots)
 
     def start(self, rig, rng):
         sim = rig.sim
@@ -104,153 +110,21 @@ class Football(KickBall):
         for robot, pose in zip(sim.robots.values(), poses):
             robot.place(*pose)
         sim.place_ball(*ball)
-        settle(rig)
-        self.judge.start(sim.time)
-        self._look(sim)
-        self._gaps = self._distances(sim)
-        self._kick_paid = False
-        self._fell = set()
-
-    @staticmethod
-    def _distances(sim):
-        ball = sim.ball_position()[:2]
-        return {name: math.dist(robot.pose()[:2], ball) for name, robot in sim.robots.items()}
-
-    def reward(self, rig):
-        gaps = self._distances(rig.sim)
-        rewards = {name: APPROACH_WEIGHT * (self._gaps[name] - gap)
-                   for name, gap in gaps.items()}
-        self._gaps = gaps
-        judge = self.judge
-        if judge.kicked and not self._kick_paid:
-            rewards[judge.kicker] += KICK_REWARD
-            self._kick_paid = True
-        for name, track in judge.robots.items():
-            if track.fell and name not in self._fell:
-                rewards[name] += FALL_PENALTY
-                self._fell.add(name)
-        return rewards
+        self._judge_from(rig)
 
 
-class FootballEnv(ParallelEnv):
-    """``robots``: how many MiRos play (1 to MAX_PLAYERS), named miro01, ... ``world``: the
-    pitch (any world file with a ball and a [ground] at height 0 whose size is the pitch;
-    its robots are replaced by the players).
-    ``eyes``: (width, height) of each eye's image, or None for none (state only).
-    ``detectors``: their results in each observation (default: the ball's, with eyes).
-    ``frame_skip``: platform ticks per step. ``limit_s``: simulated seconds an episode
-    lasts at most. ``render_mode='rgb_array'``: render() gives an overhead picture."""
-
-    metadata = {'name': 'miro_ball_football_v0', 'render_modes': ['rgb_array'],
-                'render_fps': round(1 / PLATFORM_TICK_S)}
-
-    def __init__(self, robots=3, eyes=(64, 48), frame_skip=1, limit_s=20.0, world=PITCH,
-                 lens=PINHOLE, hears=False, detectors=None, render_mode=None,
-                 renderer='auto'):
-        if isinstance(robots, bool) or not isinstance(robots, int) or \
-                not 1 <= robots <= MAX_PLAYERS:
-            raise ValueError(f'robots must be a whole number 1 to {MAX_PLAYERS}, '
-                             f'got {robots!r}')
-        if not isinstance(frame_skip, int) or frame_skip < 1:
-            raise ValueError(f'frame_skip must be a whole number >= 1, got {frame_skip!r}')
-        if not (isinstance(limit_s, (int, float)) and 0 < limit_s < math.inf):
-            raise ValueError(f'limit_s must be a number of seconds > 0, got {limit_s!r}')
-        spaces.check_eyes(eyes)
-        if render_mode not in (None, *self.metadata['render_modes']):
-            raise ValueError(f'render_mode {render_mode!r}: only rgb_array or None')
-        if detectors is None:
-            detectors = ('ball',) if eyes is not None else ()
-        elif detectors and eyes is None:
-            raise ValueError(f'detectors {", ".join(detectors)} need eyes: give eyes=(w, h)')
-        self.render_mode = render_mode
-        self.frame_skip = frame_skip
-        self.task = Football(limit_s=float(limit_s))
-        self.rig = WorldRig(pitch_world(world, robots), eyes=eyes, lens=lens,
-                            detectors=detectors, hears=hears, renderer=renderer)
-        self.possible_agents = list(self.rig.sim.robots)
-        self.agents = []
-        # One space object per agent, the same one every call (seeding one seeds that agent).
-        self._observation_spaces = {agent: spaces.observation_space(eyes, detectors, hears)
-                                    for agent in self.possible_agents}
-        self._action_spaces = {agent: spaces.action_space() for agent in self.possible_agents}
-        self._placer = None
-
-    def observation_space(self, agent):
-        return self._observation_spaces[agent]
-
-    def action_space(self, agent):
-        return self._action_spaces[agent]
-
-    def reset(self, seed=None, options=None):
-        if seed is not None or self._placer is None:
-            self._placer = random.Random(seed)  # None: from the system's entropy
-        self.rig.restore()
-        self.task.start(self.rig, self._placer)
-        self._start = self.rig.t
-        self.agents = list(self.possible_agents)
-        self.rig.look()
-        info = self.task.info()
-        return self._observations(), {agent: dict(info) for agent in self.agents}
-
-    def step(self, actions):
-        """One step: each agent's action (of its action space, or a contract Action); an
-        agent left out keeps what it was last told. An action outside its space, or not
-        finite, is refused (ValueError naming the agent and the part) before anything
-        moves."""
-        self.rig.check_open()
-        if not self.agents:
-            return {}, {}, {}, {}, {}
-        checked = {}
-        for agent, action in actions.items():
-            if agent in self.agents:
-                try:
-                    checked[agent] = spaces.contract_action(action, self._action_spaces[agent],
-                                                            self.frame_skip)
-                except ValueError as err:
-                    raise ValueError(f'{agent}: {err}') from None
-        for agent, action in checked.items():
-            self.rig.act(agent, action)
-        task = self.task
-        terminated = play(self.rig, task, self.frame_skip)
-        self.rig.look()
-        rewards = task.reward(self.rig)
-        truncated = not terminated and task.truncated(self.rig.t - self._start)
-        info = task.info()
-        agents = self.agents
-        result = (self._observations(), {agent: float(rewards[agent]) for agent in agents},
-                  dict.fromkeys(agents, terminated), dict.fromkeys(agents, truncated),
-                  {agent: dict(info) for agent in agents})
-        if terminated or truncated:
-            self.agents = []
-        return result
-
-    def render(self):
-        self.rig.check_open()
-        return self.rig.overhead() if self.render_mode == 'rgb_array' else None
-
-    def close(self):
-        self.rig.close()
-
-    def _observations(self):
-        rig = self.rig
-        observations = {}
-        for agent in self.agents:
-            heard = rig.heard.get(agent)
-            observations[agent] = spaces.observation(
-                rig.percepts(agent), self._observation_spaces[agent],
-                None if heard is None else heard.samples)
-        return observations
-
-
-def parallel_env(**kwargs):
-    """Football as a PettingZoo ParallelEnv (FootballEnv's keywords)."""
-    return FootballEnv(**kwargs)
+def parallel_env(robots=3, limit_s=20.0, **options):
+    """Football as a PettingZoo ParallelEnv: ``robots`` MiRos (1 to MAX_PLAYERS), truncated
+    after ``limit_s`` simulated seconds; ``world``: the pitch (any world file with a ball and a
+    [ground] at height 0 whose size is the pitch; its robots are replaced by the players);
+    the other keywords are MiroEnv's (eyes, frame_skip, detectors, render_mode, ...)."""
+    return MiroParallelEnv(Football(robots=robots, limit_s=limit_s), **options)
 
 
 def env(**kwargs):
     """Football as a PettingZoo AEC environment: the agents act in turn, the world steps
     once they all have."""
-    return parallel_to_aec(FootballEnv(**kwargs))
+    return parallel_to_aec(parallel_env(**kwargs))
 
 
 raw_env = env

@@ -7,7 +7,7 @@ its head if the expression shown is the one this person likes, or pats its body 
 otherwise, through the touch pads, as a hand in the GUI's world view does. Which
 expression the person likes is hidden from the agent and drawn from the reset's seed; now
 and then (``mistakes``) the person gets it wrong. The reward is what MiRo feels: +1 when
-its head is stroked, -1 when its body is patted.
+its head is stroked (the reward term ``stroked``), -1 when its body is patted (``patted``).
 
 ``Expressions(env)`` turns the action into Discrete(4): the expression to show.
 """
@@ -52,6 +52,7 @@ class KBandit(Task):
     """The k-bandit lab's task (see the module). ``trials``: steps per episode."""
 
     name = 'k_bandit'
+    eyes = None  # what the person does is felt, not seen
     frame_skip = SHOW_TICKS
 
     def __init__(self, trials=30, mistakes=0.1):
@@ -78,9 +79,13 @@ class KBandit(Task):
         else:
             self.robot.touch('body', PAT)
 
-    def reward(self, rig):
-        sensors = rig.sim.robot.sensors
-        return float(bool(sensors.touch_head)) - float(bool(sensors.touch_body))
+    def measure(self, rig):
+        sensors = self.robot.sensors
+        return bool(sensors.touch_head), bool(sensors.touch_body)
+
+    def reward(self, before, after):
+        stroked, patted = after
+        return {self.robot.name: {'stroked': float(stroked), 'patted': -float(patted)}}
 
     def info(self):
         return {'liked': EXPRESSION_NAMES[self.liked] if self.liked is not None else None}

@@ -12,9 +12,10 @@ readings). With ``cue=False`` the ball is parked outside the maze, out of sight,
 rewarded arm must be found by trying (give ``arm=`` to keep it the same episode after
 episode, the classic place-learning maze).
 
-Reward: +1 for reaching the rewarded arm's end, -1 for reaching the other arm's end, 0
-otherwise (sparse). Terminated on reaching either arm's end (MiRo's axle ARM_END_M or more
-from the stem's middle line, inside an arm); truncated at ``limit_s`` simulated seconds.
+Reward (its one term, ``arm``): +1 for reaching the rewarded arm's end, -1 for reaching the
+other arm's end, 0 otherwise (sparse). Terminated on reaching either arm's end (MiRo's axle
+ARM_END_M or more from the stem's middle line, inside an arm); truncated at ``limit_s``
+simulated seconds.
 """
 import math
 
@@ -65,17 +66,17 @@ class TMaze(Task):
         settle(rig)
         self.robot = sim.robot
         self.at = None
-        self._paid = False
 
     def tick(self, rig):
         if self.at is None:
             self.at = reached(self.robot.pose())
 
-    def reward(self, rig):
-        if self.at is None or self._paid:
-            return 0.0
-        self._paid = True
-        return 1.0 if self.at == self.arm else -1.0
+    def measure(self, rig):
+        return self.at
+
+    def reward(self, before, after):
+        paid = before is None and after is not None
+        return {self.robot.name: {'arm': (1.0 if after == self.arm else -1.0) if paid else 0.0}}
 
     def terminated(self):
         return self.at is not None

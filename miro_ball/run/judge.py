@@ -1,10 +1,10 @@
 """The one judge of an episode: when the ball was kicked, by whom, whether a robot fell,
 how far the robots drove, and whether the episode is over. Plain Python, time passed in.
 
-Everyone asks it: the grading host feeds it from the world in its own process after each
-physics step (grading/host.py), the lab run, the scenario bench and the closed-loop tests from
-the simulator's ground truth topics (run/monitor.py). Both feed it the same facts on the
-same instants, so both judge an episode alike:
+Everyone asks it: the grading host and the learning tasks feed it from the world in their
+own process after each physics step (observe(), below), the lab run, the scenario bench and
+the closed-loop tests from the simulator's ground truth topics (run/monitor.py). Both feed it
+the same facts on the same instants, so both judge an episode alike:
 
 - ball(t, xy) and robot(name, t, xyz) on the platform ticks (50 Hz); xyz is the robot's
   foot frame, on the floor under its axle;
@@ -156,3 +156,16 @@ class Judge:
         if self.kicked and self.elapsed >= min(self.kick_time + settle_s, limit_s):
             return 'kicked'
         return 'limit' if self.elapsed >= limit_s else None
+
+
+def observe(judge, sim, *names):
+    """Tell ``judge`` what the world ``sim`` (a SimWorld) says now of robots ``names``; call
+    it after each physics step. A robot's touch of the ball after any step; the ball and the
+    robots on platform ticks, as the simulator's ground truth topics publish them."""
+    for name in names:
+        if sim.touching(name):
+            judge.touch(name, sim.time, sim.ball_position())
+    if sim.step_index % sim.ticks_per_platform_tick == 0:
+        judge.ball(sim.time, sim.ball_position())
+        for name in names:
+            judge.robot(name, sim.time, sim.robots[name].ground_truth()[:3])
