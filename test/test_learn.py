@@ -17,12 +17,13 @@ from miro_ball.controller.contract import Action
 from miro_ball.controller.detection import Ball, DetectionParams
 from miro_ball.controller.detectors import DETECTORS
 from miro_ball.controller.params import detection_params
+from miro_ball.learn import core
 from miro_ball.learn import rig as rig_module
 from miro_ball.learn.controllers import run_controller
 from miro_ball.learn.env import MiroEnv
 from miro_ball.learn.kbandit import EXPRESSION_NAMES
 from miro_ball.learn.rig import WorldRig
-from miro_ball.learn.tasks import KickBall
+from miro_ball.learn.tasks import KICK_REWARD, KickBall
 from miro_ball.learn.wrappers import FlattenActions, PickActions, PickObservations
 from miro_ball.run.placements import placements
 from miro_sim_bullet.render.eye_images import jpeg_bytes
@@ -144,10 +145,58 @@ def test_picking_what_does_not_exist_is_refused_in_one_line():
         PickActions(env, 'wheel')
     with pytest.raises(ValueError, match='no observation entry ball '):
         PickObservations(env, ('ball',))
-    with pytest.raises(ValueError, match='need eyes'):
-        MiroEnv(KickBall(), eyes=None)
+    with pytest.raises(ValueError, match='^detectors ball need eyes: give eyes=\\(w, h\\)$'):
+        MiroEnv(KickBall(), eyes=None, detectors=('ball',))
     with pytest.raises(ValueError, match='frame_skip'):
         MiroEnv(KickBall(), eyes=None, detectors=(), frame_skip=0)
+    env.close()
+
+
+def test_kick_ball_with_no_eyes_is_state_only_and_a_detector_asked_for_is_refused(
+        monkeypatch):
+    """gymnasium.make('miro_ball/KickBall-v0', eyes=None) said "detectors ball need eyes",
+    although eyes=None is the state-only case: with no eyes, no detector runs unless named."""
+    env = gymnasium.make('miro_ball/KickBall-v0', eyes=None, limit_s=1.0)
+    obs, _ = env.reset(seed=1)
+    assert set(obs) == {'joints', 'sonar', 'cliff', 'light', 'touch_head', 'touch_body'}
+    obs, reward, terminated, truncated, info = env.step({'wheels': np.zeros(2)})
+    assert env.observation_space.contains(obs) and not terminated and 'kicked' in info
+    env.close()
+
+    def build(*_, **__):
+        raise AssertionError('a world was built for a refused environment')
+
+    monkeypatch.setattr(core, 'WorldRig', build)
+    with pytest.raises(ValueError) as refused:
+        gymnasium.make('miro_ball/KickBall-v0', eyes=None, detectors=('ball',))
+    assert str(refused.value) == 'detectors ball need eyes: give eyes=(w, h)'
+
+
+def test_each_reward_term_is_in_info_and_the_task_says_the_same_when_asked_again():
+    """A step's reward is the sum of the terms in its info (reward_approach, reward_kick,
+    reward_fall), and the task's reward is a function of two measures: asking it again
+    changes nothing (it changed the task's state, and had to be asked once a step)."""
+    env = MiroEnv(KickBall(), eyes=None)
+    env.reset(seed=3)
+    rig, task, robot = env.rig, env.task, env.rig.sim.robot
+    ball = rig.sim.ball_position()[:2]
+    x, y, _ = robot.pose()
+    robot.place(x, y, math.atan2(ball[1] - y, ball[0] - x))  # facing the ball
+    approached, start = 0.0, task.measure(rig).gaps[env.robot]
+    while True:
+        before = task.measure(rig)
+        _, reward, terminated, truncated, info = env.step(Action(wheels=(0.4, 0.4)))
+        after = task.measure(rig)
+        terms = {key[len('reward_'):]: value for key, value in info.items()
+                 if key.startswith('reward_')}
+        assert set(terms) == {'approach', 'kick', 'fall'}
+        assert reward == sum(terms.values())
+        assert task.reward(before, after) == task.reward(before, after) == {env.robot: terms}
+        approached += terms['approach']
+        if terminated or truncated:
+            break
+    assert info['kicked'] and terms['kick'] == KICK_REWARD and terms['fall'] == 0.0
+    assert approached == pytest.approx(start - after.gaps[env.robot])  # metres nearer
     env.close()
 
 
