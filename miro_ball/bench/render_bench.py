@@ -38,7 +38,7 @@ def _pybullet_egl(sim):
     if spec is None or p.loadPlugin(spec.origin, '_eglRendererPlugin',
                                     physicsClientId=sim.client) < 0:
         raise RuntimeError('no eglRenderer plugin')
-    sim.reset()
+    sim.rebuild()  # the plugin sees the bodies made after it was loaded
 
     def render(views, intrinsics):
         w, h = intrinsics.width, intrinsics.height

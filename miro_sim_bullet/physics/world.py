@@ -233,8 +233,17 @@ class SimWorld:
                                  rgbaColor=(1, 1, 1, 1), **kw)
 
     def reset(self):
-        """Back to the world as loaded, time zero (rebuilt from scratch: deterministic):
-        what was spawned since is gone, what was deleted is back."""
+        """Back to the world as loaded, time zero: what was spawned since is gone, what was
+        deleted is back. Rewound (rewind(): the simulator's reset between episodes) when no
+        body came or went since the world was built, else built from scratch."""
+        if self.description is self.loaded:
+            self.rewind()
+        else:
+            self.rebuild()
+
+    def rebuild(self):
+        """Back to the world as loaded, time zero, every body made anew (a renderer plugin
+        loaded since sees them all)."""
         self.description, self.spawned = self.loaded, set()
         self._build()
 
@@ -250,7 +259,7 @@ class SimWorld:
     def load(self, world):
         """Another world in place of this one (a World), built from scratch, time zero."""
         self.loaded = world
-        self.reset()
+        self.rebuild()
 
     # -- entities added and removed at run time -----------------------------------------------
     def names(self):
@@ -406,9 +415,10 @@ class SimWorld:
 
     def rewind(self):
         """Back to the state right after the build without building anew (a learning
-        environment's reset: about 50 times cheaper than reset()): PyBullet's snapshot of
-        the built bodies restored, time from zero, each robot's platform and the world's
-        sound started again. Body ids stay, so renderers keep what they read. A world that
+        environment's reset, and reset()'s when it can: 1 ms where rebuild() took 100 ms for
+        the default world, 6 ms against 140 ms for the football pitch, medians of 15 here):
+        PyBullet's snapshot of the built bodies restored, time from zero, each robot's
+        platform and the world's sound started again. Body ids stay, so renderers keep what they read. A world that
         holds a non-finite value is built anew instead: a NaN that reached the physics
         spoils more than the state a snapshot restores (MiRo sank into the floor at every
         rewind after one NaN head target)."""

@@ -272,7 +272,8 @@ class SimNode(Node):
 
     def reset(self, scope):
         """ResetSimulation's scope (bits: 1 time, 2 state, 4 spawned; 0 or all three: the
-        world as loaded, time zero): the schedule follows the time."""
+        world as loaded, time zero, rewound when no body came or went since it was built:
+        SimWorld.reset): the schedule follows the time."""
         self._publish_eyes(wait=True)  # the instants before the reset come first
         bits = scope & 0b111
         if bits in (0, 0b111):
@@ -288,10 +289,12 @@ class SimNode(Node):
         self.said('reset', f'world reset (scope {scope})')
 
     def _rebuilt(self, keep_time):
-        """The world was reset or another loaded: what was said of the one before goes, the
-        interfaces follow its entities, the schedule its time."""
+        """The world was reset (rewound or rebuilt) or another loaded: what was said of the
+        one before goes, the interfaces follow its entities, the schedule its time."""
         if self.sim_interface is not None:
             self.sim_interface.forget_touches()
+        if self.scene is not None:
+            self.scene.world_reset()
         if self.control is not None:
             self.control.forget()
         self.world_changed()

@@ -36,6 +36,11 @@ class SceneInterface:
         self.pub_layout.publish(self.markers.layout())
         self.layout_sent = self.world.time
 
+    def world_reset(self):
+        """The world went back to its start, maybe rewound (its bodies kept, the generation
+        too): its layout goes out again at the next publish, as after a rebuild."""
+        self.generation = None
+
     def publish(self):
         """This instant's scene where it changed."""
         if self.generation != self.world.generation:
