@@ -1,8 +1,9 @@
 """The numbers of the standard simulation_interfaces (Jazzy 1.5.1) that the control logic
 uses, named as in its .msg and .srv files, grouped by the message that defines them (the
 same name means different numbers in different messages: SpawnEntity's NO_RESOURCE is
-104, LoadWorld's 102). Plain ints (SimulationState's an IntEnum, as the simulator keeps its state in one), so the
-logic needs no ROS; test_sim_control checks each against the built messages."""
+104, LoadWorld's 102). Plain ints (SimulationState an IntEnum: the simulator keeps its
+state as one), so the logic needs no ROS; test_sim_control checks each against the built
+messages."""
 import enum
 
 
