@@ -7,7 +7,7 @@ from geometry_msgs.msg import PoseArray, PoseWithCovariance, TwistStamped
 from sensor_msgs.msg import Image
 from std_msgs.msg import ByteMultiArray, Float32MultiArray, UInt8MultiArray
 
-from miro_ball.common.definitions import expanded
+from miro_ball.ros2.interface_text import shown
 from miro_ball.ros2.convert import field, fill, parse_yaml, to_data, to_yaml
 
 
@@ -59,10 +59,25 @@ def test_integer_ranges_array_sizes_and_list_items_are_checked(cls, values, says
 
 
 def test_interface_text_expands_nested_types_a_tab_in():
-    lines = expanded('geometry_msgs/msg/TwistStamped')
+    lines = shown('geometry_msgs/msg/TwistStamped')
     assert 'std_msgs/Header header' in lines and '\t\tint32 sec' in lines
     with pytest.raises(ValueError, match='not a type name'):
-        expanded('twist')
+        shown('twist')
+
+
+def test_interface_text_keeps_the_comments_ros2_keeps():
+    """As ros2 interface show reads a file (rosidl's parser, line by line): a nested type's
+    field comments go, but a constant's comment and a lone '#' stay; we dropped them all."""
+    lines = shown('action_msgs/msg/GoalInfo')
+    assert lines[:3] == ['# Goal ID', 'unique_identifier_msgs/UUID goal_id', '\t#']
+    battery = shown('miro2_msg/msg/SensorsPackage')
+    assert '\tuint8 POWER_SUPPLY_TECHNOLOGY_LION = 2    # Lithium-ion battery' in battery
+    voltage = '\tfloat32 voltage          # Voltage in Volts (Mandatory)'
+    assert voltage not in battery  # a field's comment, cut (to its '#', as ros2 cuts it)
+    assert voltage in shown('miro2_msg/msg/SensorsPackage', nested_comments=True)
+    bare = shown('action_msgs/msg/GoalInfo', comments=False)
+    assert bare == ['unique_identifier_msgs/UUID goal_id', '\t#', '\tuint8[16] uuid',
+                    'builtin_interfaces/Time stamp', '\tint32 sec', '\tuint32 nanosec']
 
 
 def test_values_nested_deeper_than_any_message_are_refused_as_they_are_read():

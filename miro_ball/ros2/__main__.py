@@ -96,6 +96,11 @@ def build_parser():
     v = verb(interface, 'show', "a type's fields", verbs.interface_show, needs_graph=False)
     v.add_argument('type', help='as miro2_msg/msg/SensorsPackage, std_srvs/srv/Trigger or '
                    'simulation_interfaces/action/SimulateSteps')
+    comments = v.add_mutually_exclusive_group()
+    comments.add_argument('--all-comments', action='store_true',
+                          help='the comments of the types it holds too')
+    comments.add_argument('--no-comments', action='store_true',
+                          help='no comments, and no blank lines')
 
     param = group('param', "a node's parameters: list, get, set")
     v = verb(param, 'list', "a node's parameter names", verbs.param_list)

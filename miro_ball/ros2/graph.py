@@ -19,6 +19,7 @@ from miro_ball.ros2.settling import incomplete_line, LIMIT_S, Settling
 
 DISCOVERY_INFO = 'ros_discovery_info'  # each process's own topic, of no node: not checked
 WAIT_S = 5.0  # wall seconds to wait for a topic, node or service that is asked for by name
+WAITING_LINE = 'waiting for service to become available...'  # ros2 service call's
 
 
 class CliError(Exception):
@@ -140,13 +141,19 @@ class Graph:
         return {name: types for name, types in self.node.get_service_names_and_types()
                 if not name.startswith(self.node.get_fully_qualified_name() + '/')}
 
-    def call(self, service, srv_class, request, seconds=WAIT_S):
-        """The response of one call; CliError if there is no such service or no answer."""
+    def call(self, service, srv_class, request, seconds=WAIT_S, say=None):
+        """The response of one call; CliError if there is no such service or no answer.
+        say: print ros2 service call's lines (WAITING_LINE if the service is not there at
+        once, then say(), once it is, before the request goes)."""
         client = self.node.create_client(srv_class, service)
         try:
+            if say is not None and not client.service_is_ready():
+                print(WAITING_LINE, flush=True)
             if not client.wait_for_service(timeout_sec=seconds):
                 raise CliError(f'no service {service} on ROS domain {self.domain} (the '
                                'services: python -m miro_ball.ros2 service list)')
+            if say is not None:
+                say()
             future = client.call_async(request)
             rclpy.spin_until_future_complete(self.node, future, timeout_sec=seconds)
             if not future.done():

@@ -5,13 +5,14 @@ status; bad input is a CliError (or ValueError) with one line, printed by __main
 """
 import importlib
 import statistics
+import sys
 import time
 
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import GetParameters, ListParameters, SetParameters
 from rclpy.node import NodeNameNonExistentError
 
-from miro_ball.common.definitions import expanded, prefixes, split_type
+from miro_ball.common.definitions import prefixes, split_type
 from miro_ball.ros2 import convert
 from miro_ball.ros2.graph import CliError
 
@@ -214,18 +215,18 @@ def _parameter_names(graph, node):
     return graph.call(service, ListParameters, ListParameters.Request()).result.names
 
 
-def _refuse_unknown(graph, node, name):
-    """CliError in one line, with the nearest names, if node has no parameter name (rclpy
-    would say 'Invalid access to undeclared parameter(s): []')."""
+def _unknown(graph, node, name):
+    """Why node has no parameter name, with the nearest names (rclpy would say 'Invalid
+    access to undeclared parameter(s): []'); None if it has."""
     import difflib
 
     known = _parameter_names(graph, node)
     if name in known:
-        return
+        return None
     near = difflib.get_close_matches(name, known, n=3)
     hint = ('; did you mean ' + ' or '.join(map(repr, near)) + '?' if near else
             f' (the parameters: python -m miro_ball.ros2 param list {node})')
-    raise CliError(f'no parameter {name!r} on {node}{hint}')
+    return f'no parameter {name!r} on {node}{hint}'
 
 
 def param_list(args, graph):
@@ -238,7 +239,8 @@ def param_get(args, graph):
     service = _parameter_service(graph, args.node, 'get_parameters')
     values = graph.call(service, GetParameters, GetParameters.Request(names=[args.name])).values
     if not values or values[0].type not in PARAMETER_VALUE:
-        _refuse_unknown(graph, args.node, args.name)
+        if (why := _unknown(graph, args.node, args.name)) is not None:
+            raise CliError(why)
         print('Parameter not set.')
         return 1
     field, word = PARAMETER_VALUE[values[0].type]
@@ -269,12 +271,14 @@ def param_set(args, graph):
     request = SetParameters.Request(parameters=[Parameter(name=args.name,
                                                           value=parameter_value(args.value))])
     result = graph.call(service, SetParameters, request).results[0]
-    if result.successful:
-        print('Set parameter successful')
-        return 0
-    _refuse_unknown(graph, args.node, args.name)
-    print(f'Setting parameter failed: {result.reason}')
-    return 1
+    # As ros2 param set says it: a refusal on stderr, and exit status 0 all the same (the
+    # request went through; the node said no)
+    reason = result.reason if result.successful else \
+        _unknown(graph, args.node, args.name) or result.reason
+    said = 'Set parameter successful' if result.successful else 'Setting parameter failed'
+    print(said + (f': {reason}' if reason else ''),
+          file=sys.stdout if result.successful else sys.stderr)
+    return 0
 
 
 # -- service, interface -----------------------------------------------------------------------
@@ -289,8 +293,8 @@ def service_call(args, graph):
     if not hasattr(srv_class, 'Request'):
         raise CliError(f'{args.type} is not a service type (package/srv/Name)')
     request = convert.fill(srv_class.Request(), convert.parse_yaml(args.values))
-    print(f'requester: making request: {request!r}\n')
-    response = graph.call(service, srv_class, request)
+    response = graph.call(service, srv_class, request, say=lambda: print(
+        f'requester: making request: {request!r}\n', flush=True))
     print(f'response:\n{response!r}\n')
     return 0
 
@@ -326,8 +330,14 @@ def interface_list(args, graph=None):
 
 
 def interface_show(args, graph=None):
+    from miro_ball.ros2.interface_text import shown
+
     try:
-        print('\n'.join(expanded(args.type)))
+        print('\n'.join(shown(args.type, comments=not args.no_comments,
+                               nested_comments=args.all_comments)))
     except ValueError as err:
         raise CliError(str(err)) from None
+    except ImportError as err:  # rosidl's parser: a full ROS 2 has it, pip's msgs extra too
+        raise CliError(f'interface show needs {err.name} (pip install \'miro_ball[msgs]\')') \
+            from None
     return 0
