@@ -557,27 +557,29 @@ def test_bad_parameter_is_refused(ros_context):
                        parameter_overrides=[Parameter('tick', value='fast')])
 
 
-def test_the_learning_rigs_detection_is_the_hosts_own_from_the_same_command_line(tmp_path):
+@pytest.mark.parametrize('remap', [[], ['-r', '__ns:=/other']], ids=['robot', 'remapped'])
+def test_the_learning_rigs_detection_is_the_hosts_own_from_the_same_command_line(
+        tmp_path, remap):
     """controller.params.detection_params, what a learning rig's detectors are given, reads
     a command line as the host does: the DetectionParams the host runs its detectors with,
-    from the same -p overrides and --params-file."""
+    from the same -p overrides and --params-file, whose parts apply to the host's node (in
+    its robot's namespace, or the one remapped) as ROS 2 applies them."""
     from rclpy.context import Context
 
     params = tmp_path / 'kick.yaml'
-    # The last part is for a node kick_blue_ball in the root namespace: not the host's.
     params.write_text('/**:\n  ros__parameters:\n    sat_min: 90\n'
                       '/**/kick_blue_ball:\n  ros__parameters:\n    hough_param2: 14.0\n'
-                      'kick_blue_ball:\n  ros__parameters:\n    blur: 7\n')
+                      'kick_blue_ball:\n  ros__parameters:\n    blur: 7\n'  # the root's
+                      '/other/kick_blue_ball:\n  ros__parameters:\n    hue_window: 30\n')
     args = ['kick_blue_ball', '--ros-args', '--params-file', str(params),
-            '-p', 'hue_window:=10', '-p', 'mode:=tutorial']
+            '-p', 'erode:=3', '-p', 'mode:=tutorial', *remap]
     context = Context()
     rclpy.init(args=args, context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
     try:
         node = ControllerHost(KICK_BLUE_BALL, context=context, args=args)
         try:
-            assert node.detection_params == detection_params(args)
-            assert node.detection_params == DetectionParams(sat_min=90, hough_param2=14.0,
-                                                            hue_window=10)
+            assert node.detection_params == detection_params(args) == DetectionParams(
+                sat_min=90, hough_param2=14.0, erode=3, hue_window=30 if remap else 20)
         finally:
             node.destroy_node()
     finally:

@@ -502,20 +502,14 @@ def test_the_rig_eyes_refuse_an_option_they_can_not_have_in_one_line_building_no
     assert str(refused.value).startswith(said) and '\n' not in str(refused.value)
 
 
-def test_the_rig_eyes_detect_with_the_parameters_a_controller_host_is_given(tmp_path):
+def test_the_rig_eyes_detect_with_the_parameters_a_controller_host_is_given():
     """The detectors ran with DetectionParams() whatever the controller host was told: now
-    controller.params.detection_params reads the host's command line (-p, --params-file)
-    into what the rig's detectors get, refusing what the host refuses."""
-    params = tmp_path / 'kick.yaml'
-    params.write_text('/**:\n  ros__parameters:\n    sat_min: 90\n'
-                      '/**/kick_blue_ball:\n  ros__parameters:\n    target_rgb: [255, 0, 0]\n'
-                      '/other/kick_blue_ball:\n  ros__parameters:\n    blur: 7\n')
-    args = ['kick_blue_ball', '--ros-args', '--params-file', str(params),
-            '-p', 'hue_window:=10', '-p', 'mode:=tutorial']
-    red = detection_params(args)
+    controller.params.detection_params reads the host's command line into what the rig's
+    detectors get (test_controller_node: the host's own, --params-file too), refusing what
+    the host refuses."""
+    red = detection_params(['kick_blue_ball', '--ros-args', '-p', 'target_rgb:=[255,0,0]',
+                            '-p', 'sat_min:=90', '-p', 'hue_window:=10', '-p', 'mode:=tutorial'])
     assert red == DetectionParams(target_rgb=(255, 0, 0), sat_min=90, hue_window=10)
-    # A part of the file for another namespace is that namespace's, as rcl has it.
-    assert detection_params(args + ['-r', '__ns:=/other']).blur == 7 and red.blur == 5
     for bad, said in ((['-p', 'hue_windw:=10'], "unknown parameter 'hue_windw' (did you mean "
                                                  'hue_window?)'),
                       (['-p', 'blur:=4'], 'blur must be odd'),

@@ -142,24 +142,32 @@ def ros_overrides(argv, node_name):
     """
     import yaml
 
-    found, inside, tokens = {}, False, iter(argv)
+    found = {}
+    for flag, rule in _ros_rules(argv):
+        if flag in ('-p', '--param'):
+            name, sep, text = rule.partition(':=')
+            if not sep or not name:
+                raise ValueError(f'{flag} {rule!r}: expected name:=value')
+            try:
+                found[name] = yaml.safe_load(text)
+            except yaml.YAMLError:
+                found[name] = text
+        elif flag == '--params-file':
+            found.update(_params_file(rule, node_name))
+    return found
+
+
+def _ros_rules(argv):
+    """(flag, the argument after it) of each -p, -r and --params-file in the ``--ros-args``
+    parts of argv, in order."""
+    inside, tokens = False, iter(argv)
     for token in tokens:
         if token == '--ros-args':
             inside = True
         elif token == '--':
             inside = False
-        elif inside and token in ('-p', '--param'):
-            rule = next(tokens, '')
-            name, sep, text = rule.partition(':=')
-            if not sep or not name:
-                raise ValueError(f'{token} {rule!r}: expected name:=value')
-            try:
-                found[name] = yaml.safe_load(text)
-            except yaml.YAMLError:
-                found[name] = text
-        elif inside and token == '--params-file':
-            found.update(_params_file(next(tokens, ''), node_name))
-    return found
+        elif inside and token in ('-p', '--param', '-r', '--remap', '--params-file'):
+            yield token, next(tokens, '')
 
 
 def _params_file(path, node_name):
@@ -196,17 +204,11 @@ def node_matches(key, fqn):
 
 def remapped_namespace(argv):
     """The namespace the ``--ros-args`` parts of argv give a node (``-r __ns:=/ns``), or None."""
-    found, inside, tokens = None, False, iter(argv)
-    for token in tokens:
-        if token == '--ros-args':
-            inside = True
-        elif token == '--':
-            inside = False
-        elif inside and token in ('-r', '--remap'):
-            rule = next(tokens, '')
-            name, sep, value = rule.partition(':=')
-            if sep and name == '__ns':
-                found = value
+    found = None
+    for flag, rule in _ros_rules(argv):
+        name, sep, value = rule.partition(':=')
+        if flag in ('-r', '--remap') and sep and name == '__ns':
+            found = value
     return found
 
 
