@@ -21,9 +21,9 @@ from miro_ball.learn import core
 from miro_ball.learn import rig as rig_module
 from miro_ball.learn.controllers import run_controller
 from miro_ball.learn.env import MiroEnv
-from miro_ball.learn.kbandit import EXPRESSION_NAMES
+from miro_ball.learn.tasks.k_bandit import EXPRESSION_NAMES
 from miro_ball.learn.rig import WorldRig
-from miro_ball.learn.tasks import KICK_REWARD, KickBall
+from miro_ball.learn.tasks.kick_ball import KICK_REWARD, KickBall
 from miro_ball.learn.wrappers import FlattenActions, PickActions, PickObservations
 from miro_ball.run.placements import placements
 from miro_sim_bullet.render.eye_images import jpeg_bytes

@@ -15,8 +15,11 @@ from miro_ball.controller.contract import Action
 from miro_ball.learn import football
 from miro_ball.learn.env import MiroEnv
 from miro_ball.learn.parallel_env import MiroParallelEnv
-from miro_ball.learn.t_maze import TMaze, reached
-from miro_ball.learn.tasks import KICK_REWARD, Task
+from miro_ball.learn.tasks import Task
+from miro_ball.learn.tasks.football import (BALL_GAP_M, Football, pitch_placement,
+                                            ROBOT_GAP_M)
+from miro_ball.learn.tasks.kick_ball import KICK_REWARD
+from miro_ball.learn.tasks.t_maze import reached, TMaze
 
 gymnasium.register_envs(miro_ball.learn)  # registered on import: says why it is imported
 
@@ -77,7 +80,7 @@ def test_a_gymnasium_environment_plays_football_as_the_first_robot_of_the_parall
     """MiroEnv(Football()) raised a TypeError at its first step (the task's reward was a
     dict). Both doors are one core: the Gymnasium one drives miro01, and sees, is rewarded
     and ends exactly as the PettingZoo one's miro01 with the others left standing."""
-    alone = MiroEnv(football.Football(robots=3, limit_s=0.4), eyes=None)
+    alone = MiroEnv(Football(robots=3, limit_s=0.4), eyes=None)
     check_env(alone)
     together = football.parallel_env(robots=3, limit_s=0.4, eyes=None)
     assert alone.robot == together.possible_agents[0] == 'miro01'
@@ -140,12 +143,12 @@ def test_an_action_for_a_robot_that_is_not_playing_is_refused_in_one_line():
 def test_football_placements_are_seeded_apart_and_on_the_pitch():
     half = (1.65, 1.0)
     for seed in range(200):
-        ball, poses = football.pitch_placement(random.Random(seed), 4, half)
-        assert (ball, poses) == football.pitch_placement(random.Random(seed), 4, half)
+        ball, poses = pitch_placement(random.Random(seed), 4, half)
+        assert (ball, poses) == pitch_placement(random.Random(seed), 4, half)
         spots = [pose[:2] for pose in poses]
         assert all(abs(x) <= half[0] and abs(y) <= half[1] for x, y in spots + [ball])
-        assert all(math.dist(ball, spot) >= football.BALL_GAP_M for spot in spots)
-        assert all(math.dist(a, b) >= football.ROBOT_GAP_M
+        assert all(math.dist(ball, spot) >= BALL_GAP_M for spot in spots)
+        assert all(math.dist(a, b) >= ROBOT_GAP_M
                    for i, a in enumerate(spots) for b in spots[i + 1:])
 
 

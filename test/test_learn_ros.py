@@ -14,7 +14,7 @@ from miro_ball.learn.controllers import run_controller
 from miro_ball.learn.env import MiroEnv
 from miro_ball.learn.rig import WorldRig
 from miro_ball.policy.controller import POLICY_ENV, PolicyController
-from miro_ball.learn.tasks import KickBall
+from miro_ball.learn.tasks.kick_ball import KickBall
 from miro_ball.run.episode import run_episode
 from miro_ball.run.placements import Placement, placements
 from miro_ball.run.stepped_rig import SteppedRig

@@ -15,7 +15,7 @@ from miro_ball.learn.bandit import EpsilonGreedy
 from miro_ball.learn.controllers import run_controller
 from miro_ball.policy.linear import load
 from miro_ball.policy.controller import BUNDLED, POLICY_ENV, PolicyController
-from miro_ball.learn.registry import kick_ball
+from miro_ball.learn.registry import make
 from miro_ball.learn.trainers import held_out_seeds
 from program import Program
 
@@ -38,8 +38,8 @@ def test_train_writes_the_policy_and_its_curve_and_evaluate_reads_them(tmp_path,
 
 def test_the_bundled_policy_kicks_as_a_controller_on_held_out_seeds():
     policy = load(BUNDLED)
-    env = kick_ball(limit_s=SHORT_S, eyes=tuple(policy.settings['eyes']),
-                    frame_skip=policy.settings['frame_skip'])
+    env = make('kick_ball', limit_s=SHORT_S, eyes=tuple(policy.settings['eyes']),
+               frame_skip=policy.settings['frame_skip'])
     try:
         kicks = [run_controller(env, PolicyController(), seed)[2]['kicked']
                  for seed in held_out_seeds(5)]
@@ -56,8 +56,8 @@ def test_the_controller_sees_what_the_training_episode_sees(monkeypatch, tmp_pat
                 'frame_skip': policy.settings['frame_skip'], 'limit_s': SHORT_S}
     seed = held_out_seeds(1)[0]
     trained = rollouts.run_episode((settings, policy.weights.ravel(), seed))
-    env = kick_ball(limit_s=SHORT_S, eyes=tuple(settings['eyes']),
-                    frame_skip=settings['frame_skip'])
+    env = make('kick_ball', limit_s=SHORT_S, eyes=tuple(settings['eyes']),
+               frame_skip=settings['frame_skip'])
     monkeypatch.setenv(POLICY_ENV, BUNDLED)
     try:
         _, steps, info = run_controller(env, PolicyController(), seed)

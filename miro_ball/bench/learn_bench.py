@@ -139,9 +139,9 @@ def measure_ray(nodes, population, seeds, episode_s):
     from miro_ball.policy.linear import LinearPolicy
     from miro_ball.learn.ray_rollouts import RayRollouts
     from miro_ball.learn.rollouts import evaluate_population
-    from miro_ball.learn.trainers import TASKS
+    from miro_ball.learn.tasks import named
 
-    training = TASKS['kick_ball']
+    training = named('kick_ball').training
     settings = training.settings(episode_s)
     rng = np.random.default_rng(SEED)
     params = [rng.normal(size=LinearPolicy.size()) for _ in range(population)]

@@ -5,18 +5,17 @@ import sys
 
 from miro_ball.common.cli import Parser
 from miro_ball.common.lifecycle import first_line
-from miro_ball.learn.trainers import HELD_OUT_FROM, TASKS
+from miro_ball.learn.trainers import HELD_OUT_FROM, trainable
 
 PROG = 'python -m miro_ball.learn.evaluate'
 
 
-def build_parser():
+def build_parser(tasks):
     parser = Parser(prog=PROG, description=__doc__.split('\n\n')[0], epilog=(
         f'Held-out seeds: episode i is placed from seed {HELD_OUT_FROM} + i; training '
-        '(--seed S < 1000) uses seeds S * 10**6 + i, which never reach them. kick_ball: '
-        'the share of episodes the judge says kicked; k_bandit: the share of people whose '
-        'liked expression the learner found (and kept) by the last trial, and how soon.'))
-    parser.add_argument('task', metavar='TASK', help='one of: ' + ', '.join(TASKS))
+        '(--seed S < 1000) uses seeds S * 10**6 + i, which never reach them. '
+        + '; '.join(f'{name}: {training.scores}' for name, training in tasks.items()) + '.'))
+    parser.add_argument('task', metavar='TASK', help='one of: ' + ', '.join(tasks))
     parser.add_argument('folder', metavar='DIR', help='the folder train wrote')
     parser.add_argument('--episodes', type=int, default=50,
                         help='held-out episodes (default 50)')
@@ -29,10 +28,11 @@ def build_parser():
 
 
 def main(argv=None):
-    parser = build_parser()
+    tasks = trainable()
+    parser = build_parser(tasks)
     options = parser.parse_args(argv)
-    if options.task not in TASKS:
-        parser.error(f"unknown task '{options.task}' (tasks: {', '.join(TASKS)})")
+    if options.task not in tasks:
+        parser.error(f"unknown task '{options.task}' (tasks: {', '.join(tasks)})")
     if not os.path.isdir(options.folder):
         parser.error(f'no folder {options.folder}')
     if not 1 <= options.episodes <= 100000:
@@ -45,7 +45,7 @@ def main(argv=None):
 
     from miro_ball.learn.rollouts import make_pool
 
-    task = TASKS[options.task]
+    task = tasks[options.task]
     try:
         prepared = task.prepare(options.folder)
     except ValueError as err:

@@ -1,21 +1,31 @@
-"""What each registered environment id makes (learn/__init__.py registers them)."""
+"""The tasks as Gymnasium environments: every task of the catalogue (learn.tasks) that
+declares a ``gym_id`` is registered as miro_ball/<gym_id> (learn/__init__.py does it on
+import), and made by make()."""
+import inspect
+
+import gymnasium
+
+from miro_ball.learn import tasks
 from miro_ball.learn.env import MiroEnv
-from miro_ball.learn.kbandit import Expressions, KBandit
-from miro_ball.learn.t_maze import TMaze
-from miro_ball.learn.tasks import KickBall
+
+NAMESPACE = 'miro_ball'
 
 
-def kick_ball(limit_s=20.0, **kwargs):
-    """miro_ball/KickBall-v0: lab 1, the ball detector's readings in the observation."""
-    return MiroEnv(KickBall(limit_s=limit_s), **kwargs)
+def make(task, **options):
+    """The environment of the task named ``task``: the task made of the options its class
+    takes (its ``__init__``'s keywords: KickBall's limit_s, ...), a MiroEnv of the others,
+    in the task's wrapper if it declares one."""
+    declared = tasks.named(task)
+    own = inspect.signature(declared).parameters
+    task_options = {name: options.pop(name) for name in list(options) if name in own}
+    env = MiroEnv(declared(**task_options), **options)
+    return env if declared.wrapper is None else declared.wrapper(env)
 
 
-def k_bandit(trials=30, mistakes=0.1, eyes=None, **kwargs):
-    """miro_ball/KBandit-v0: which expression does the person like? Discrete(4) actions."""
-    return Expressions(MiroEnv(KBandit(trials=trials, mistakes=mistakes), eyes=eyes,
-                               **kwargs))
-
-
-def t_maze(limit_s=20.0, cue=True, arm=None, **kwargs):
-    """miro_ball/TMaze-v0: up the stem and into the arm the ball marks (learn/t_maze.py)."""
-    return MiroEnv(TMaze(limit_s=limit_s, cue=cue, arm=arm), **kwargs)
+def register_tasks():
+    """Register every declared task's id that is not registered yet."""
+    for name, task in tasks.catalogue().items():
+        env_id = f'{NAMESPACE}/{task.gym_id}'
+        if task.gym_id is not None and env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, entry_point=f'{__name__}:make',
+                               kwargs={'task': name})

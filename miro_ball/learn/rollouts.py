@@ -8,14 +8,15 @@ Pool from ``make_pool(workers)``, one process per core; learn.ray_rollouts' RayR
 Ray cluster; or None: in this process). Each process builds its environment once, on its first
 episode, and keeps it: an episode starts with a reset (a snapshot restored), not a build.
 
-``settings`` (a JSON-able dict) says the task and how its environment is made: for
-``kick_ball`` its eyes, frame_skip and limit_s (the params are a LinearPolicy's weights);
-for ``k_bandit`` its trials and mistakes (the params are an EpsilonGreedy's settings).
+``settings`` (a JSON-able dict) names the task ('task') and says how its environment is
+made; the task's training (its declaration: learn.tasks) makes it and runs its episodes
+(for kick_ball its eyes, frame_skip and limit_s, the params a LinearPolicy's weights; for
+k_bandit its trials and mistakes, the params an EpsilonGreedy's settings).
 """
 import multiprocessing
 from typing import NamedTuple, Optional
 
-import numpy as np
+from miro_ball.learn import tasks
 
 
 class Outcome(NamedTuple):
@@ -29,106 +30,48 @@ class Outcome(NamedTuple):
 _ENVS = {}  # this process's environments, by their settings
 
 
+def training_of(settings):
+    """The training of the task ``settings`` name (tasks: its declaration)."""
+    task = tasks.named(settings['task'])
+    if task.training is None:
+        raise ValueError(f"task '{task.name}' has no training")
+    return task.training
+
+
 def _env(settings):
     key = tuple(sorted((name, str(value)) for name, value in settings.items()
                        if name != 'episode'))
     if key not in _ENVS:
-        _ENVS[key] = MAKERS[settings['task']](settings)
+        _ENVS[key] = training_of(settings).environment(settings)
     return _ENVS[key]
 
 
-def _kick_ball_env(settings):
-    from miro_ball.policy.linear import OBSERVED
-    from miro_ball.learn.registry import kick_ball
-    from miro_ball.learn.wrappers import PickActions, PickObservations
-
-    env = kick_ball(limit_s=float(settings['limit_s']), eyes=tuple(settings['eyes']),
-                    frame_skip=int(settings['frame_skip']))
-    return PickActions(PickObservations(env, OBSERVED), 'wheels')
-
-
-def _k_bandit_env(settings):
-    from miro_ball.learn.registry import k_bandit
-
-    return k_bandit(trials=int(settings['trials']), mistakes=float(settings['mistakes']))
-
-
-def kick_ball_episode(env, settings, params, seed):
-    """One KickBall episode of the LinearPolicy of weights ``params``."""
-    from miro_ball.policy.linear import LinearPolicy
-
-    policy = LinearPolicy(params, settings)
-    observation, _ = env.reset(seed=seed)
+def play_episode(env, act, seed=None, max_steps=None, hook=None):
+    """The one episode loop: ``env`` from reset(seed), each step's action ``act(observation)``
+    until the episode ends (or ``max_steps``); ``hook(observation, action, reward, info)``
+    after each step, the observation the action was chosen on. (total reward, steps, the
+    last info)."""
+    observation, info = env.reset(seed=seed)
     total, steps = 0.0, 0
-    while True:
-        observation, reward, terminated, truncated, info = env.step(policy.act(observation))
+    while max_steps is None or steps < max_steps:
+        action = act(observation)
+        seen, reward, terminated, truncated, info = env.step(action)
+        if hook is not None:
+            hook(observation, action, reward, info)
+        observation = seen
         total += reward
         steps += 1
         if terminated or truncated:
             break
-    return Outcome(total, bool(info['kicked']), steps, info['kick_time'])
-
-
-def kick_ball_demonstration(env, settings, params, seed):
-    """One KickBall episode of the hand-written controller ``params`` names (e.g.
-    'improved'); its trace is, step by step, the policy's features of what the robot saw and
-    the (forward, turn) the controller chose, each -1..1: examples to imitate."""
-    from miro_ball.controller.behaviour import BehaviourParams, make_behaviour
-    from miro_ball.policy.linear import LinearPolicy
-    from miro_ball.miro.constants import WHEEL_MAX_SPEED_M_PER_S
-
-    base = env.unwrapped
-    controller = make_behaviour(params, BehaviourParams(seed=seed))
-    features = LinearPolicy(np.zeros(LinearPolicy.size()), settings)  # its memory only
-    observation, _ = env.reset(seed=seed)
-    total, steps, trace = 0.0, 0, []
-    while True:
-        action = controller.act(base.percepts())
-        left, right = np.asarray(action.wheels) / WHEEL_MAX_SPEED_M_PER_S
-        trace.append((*np.concatenate(features.features(observation)),
-                      (left + right) / 2, (right - left) / 2))
-        observation, reward, terminated, truncated, info = env.step(
-            np.asarray(action.wheels, np.float32))
-        total += reward
-        steps += 1
-        if terminated or truncated:
-            break
-    return Outcome(total, bool(info['kicked']), steps, info['kick_time'], tuple(trace))
-
-
-def k_bandit_episode(env, settings, params, seed):
-    """One k-bandit episode (one person) of an EpsilonGreedy learner of settings ``params``;
-    its trace says, trial by trial, whether its belief is the liked expression."""
-    from miro_ball.learn.bandit import EpsilonGreedy
-    from miro_ball.learn.kbandit import EXPRESSION_NAMES
-
-    learner = EpsilonGreedy(len(EXPRESSION_NAMES), np.random.default_rng(seed), **params)
-    _, info = env.reset(seed=seed)
-    liked = EXPRESSION_NAMES.index(info['liked'])
-    total, right = 0.0, []
-    for _ in range(int(settings['trials'])):
-        arm = learner.choose()
-        _, reward, _, _, _ = env.step(arm)
-        learner.learn(arm, reward)
-        total += reward
-        right.append(int(learner.best_known() == liked))
-    wrong_after = [trial for trial, ok in enumerate(right, 1) if not ok]
-    when = (wrong_after[-1] + 1 if wrong_after else 1) if right and right[-1] else None
-    return Outcome(total, bool(right and right[-1]), len(right), when, tuple(right))
-
-
-MAKERS = {'kick_ball': _kick_ball_env, 'k_bandit': _k_bandit_env}
-# What an episode is: the task's own, unless the settings name another ('episode').
-EPISODES = {'kick_ball': kick_ball_episode, 'k_bandit': k_bandit_episode,
-            'kick_ball_demonstration': kick_ball_demonstration}
+    return total, steps, info
 
 
 def run_episode(job):
     """One episode of ``job`` = (settings, params, seed), in this process (a pool's worker
-    or the caller); the environment of those settings is made once per process."""
+    or the caller): the task's training's episode; the environment of those settings is made
+    once per process."""
     settings, params, seed = job
-    episode = EPISODES[settings.get('episode', settings['task'])]
-    return episode(_env(settings), settings, params, seed)
+    return training_of(settings).episode(_env(settings), settings, params, seed)
 
 
 def evaluate_population(settings, params_list, seeds, pool=None, done=None):

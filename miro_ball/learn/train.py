@@ -7,20 +7,19 @@ import sys
 import time
 
 from miro_ball.common.cli import Parser
-from miro_ball.learn.trainers import MAX_SEED, TASKS, TRAIN_STRIDE
+from miro_ball.learn.trainers import MAX_SEED, trainable, TRAIN_STRIDE
 
 PROG = 'python -m miro_ball.learn.train'
 MAX_MINUTES = 7 * 24 * 60
 
 
-def build_parser():
+def build_parser(tasks):
     parser = Parser(prog=PROG, description=__doc__.split('\n\n')[0], epilog=(
         f'Seeds: the episodes of --seed S are placed from seeds S * {TRAIN_STRIDE} on; '
         'python -m miro_ball.learn.evaluate uses seeds from 10**9 on, which training never '
-        "sees. kick_ball: a linear policy of the ball detector's readings imitates the "
-        "hand-written 'improved' controller, then the cross-entropy method improves it; "
-        'k_bandit: an epsilon-greedy learner, run person by person.'))
-    parser.add_argument('task', metavar='TASK', help='one of: ' + ', '.join(TASKS))
+        'sees. ' + '; '.join(f'{name}: {training.about}' for name, training in tasks.items())
+        + '.'))
+    parser.add_argument('task', metavar='TASK', help='one of: ' + ', '.join(tasks))
     parser.add_argument('--minutes', type=float, default=10.0,
                         help='training time budget, wall-clock minutes (default 10)')
     parser.add_argument('--seed', type=int, default=0, help=f'0..{MAX_SEED} (default 0)')
@@ -44,10 +43,10 @@ def build_parser():
     return parser
 
 
-def check(parser, options):
+def check(parser, options, tasks):
     """Refuse, in one line, what no training can take."""
-    if options.task not in TASKS:
-        parser.error(f"unknown task '{options.task}' (tasks: {', '.join(TASKS)})")
+    if options.task not in tasks:
+        parser.error(f"unknown task '{options.task}' (tasks: {', '.join(tasks)})")
     if not 0 < options.minutes <= MAX_MINUTES:
         parser.error(f'--minutes must be above 0 and at most {MAX_MINUTES}, '
                      f'got {options.minutes:g}')
@@ -70,9 +69,10 @@ def check(parser, options):
 
 
 def main(argv=None):
-    parser = build_parser()
+    tasks = trainable()
+    parser = build_parser(tasks)
     options = parser.parse_args(argv)
-    check(parser, options)
+    check(parser, options, tasks)
     from tqdm import tqdm
 
     from miro_ball.learn.rollouts import make_pool
@@ -89,7 +89,7 @@ def main(argv=None):
 
         try:
             started = time.monotonic()
-            summary = TASKS[options.task].train(
+            summary = tasks[options.task].train(
                 options.out, options.minutes, options.seed, pool, progress,
                 population=options.population, seeds=options.seeds_per_generation,
                 episode_s=options.episode_s, demonstrations=options.imitate)

@@ -44,6 +44,7 @@ class TMaze(Task):
     ``arm``: 'left' or 'right' every episode, or None to draw it from the seed."""
 
     name = 't_maze'
+    gym_id = 'TMaze-v0'
     world = 't_maze'
     detectors = ('ball',)
 
