@@ -211,8 +211,9 @@ def test_a_bad_command_is_refused_the_same_way_through_the_topics_and_the_learni
         sim_node, probe, executor, monkeypatch):
     """The learning rig re-made the control topics' path without their checks (a NaN wheel
     speed became 0 m/s there, where the topic ignores it; a NaN head target sank MiRo).
-    Both doors hand a command to the robot by one function (physics.commands.take): the same parts refused for the same reasons (the
-    robot keeps its last command), the same clamped, and the two robots told the same."""
+    Both doors hand a command to the robot by one function (physics.commands.take): the
+    same parts refused for the same reasons (the robot keeps its last command), the same
+    clamped, and the two robots told the same."""
     from miro_ball.controller.contract import Action
     from miro_ball.learn import rig as rig_module
     from miro_sim_bullet.physics import commands
