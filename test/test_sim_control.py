@@ -3,6 +3,7 @@ filters, spawn requests, state transitions, and the world file's tags, poses and
 import math
 import os
 import re
+from dataclasses import replace
 from importlib.resources import files
 
 import pytest
@@ -11,9 +12,11 @@ from hypothesis import given, settings, strategies as st
 from miro_ball.common.files import allowed_path, folders_parameter, read_regular
 from miro_ball.miro.urdf import urdf
 from miro_sim_bullet.control import codes
+from miro_sim_bullet.control.accelerations import Accelerations, STILL
 from miro_sim_bullet.control.codes import (Bounds, EntityCategory, Refused, SimulationState,
                                            SpawnResult, TagsFilter)
-from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter
+from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter, ROBOT_BOUNDS
+from miro_sim_bullet.control.placement import placed, reach
 from miro_sim_bullet.control.posix_regex import compile_ere, MAX_PATTERN, MAX_STATES
 from miro_sim_bullet.control.spawning import (parse_spawn, resolve_uri, RobotSpawn,
                                               ShapeSpawn, SPAWNABLE_MIRO, spawnables)
@@ -21,7 +24,7 @@ from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.scene.world_catalogue import world_catalogue, WorldCache
 from miro_sim_bullet.scene.world_checks import parse_world
 from miro_sim_bullet.scene.world_file import bundled_worlds, load_world
-from miro_sim_bullet.scene.world_model import Ball, named_poses, WorldError
+from miro_sim_bullet.scene.world_model import Ball, named_poses, Shape, WorldError
 
 BOX_URI = 'package://miro_ball/worlds/models/box.toml'
 BALL_URI = 'package://miro_ball/worlds/models/ball.toml'
@@ -143,13 +146,32 @@ def test_bounds_that_cannot_be_applied_are_refused(bounds, code):
 
 
 def test_entity_bounds_are_the_standards_shapes_round_the_origin():
-    assert entity_bounds('sphere', (0.1,)) == (Bounds.SPHERE, [(0, 0, 0), (0.1, 0, 0)])
-    assert entity_bounds('box', (0.2, 0.4, 0.6)) == \
+    away = (3.0, -2.0, 1.0)  # a shape's bounds are in its own frame, wherever it is
+    assert entity_bounds(Shape('sphere', away, radius=0.1)) == \
+        (Bounds.SPHERE, [(0, 0, 0), (0.1, 0, 0)])
+    assert entity_bounds(Ball((1.0, 2.0), 0.1, 0.4, (0, 0, 1), 0.5, 0.5)) == \
+        (Bounds.SPHERE, [(0, 0, 0), (0.1, 0, 0)])
+    assert entity_bounds(Shape('box', away, yaw=1.0, size=(0.2, 0.4, 0.6))) == \
         (Bounds.BOX, [(0.1, 0.2, 0.3), (-0.1, -0.2, -0.3)])
-    assert entity_bounds('cylinder', (0.05, 0.2)) == \
+    assert entity_bounds(Shape('cylinder', away, radius=0.05, length=0.2)) == \
         (Bounds.BOX, [(0.05, 0.05, 0.1), (-0.05, -0.05, -0.1)])
-    kind, (upper, lower) = entity_bounds('robot', ())
+    kind, (upper, lower) = ROBOT_BOUNDS
     assert kind == Bounds.BOX and lower[2] == 0.0 and upper[2] > 0.25  # on the floor, upright
+
+
+def test_an_acceleration_is_the_mean_over_the_last_platform_tick():
+    accelerations = Accelerations()
+    accelerations.tick(0.0, {'ball': ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))})
+    assert accelerations.of('ball') == STILL  # one tick seen: nothing to difference
+    accelerations.tick(0.02, {'ball': ((0.1, 0.0, -0.2), (0.0, 0.0, 0.1)), 'miro': STILL})
+    linear, angular = accelerations.of('ball')
+    assert linear == pytest.approx((5.0, 0.0, -10.0)) and angular == pytest.approx((0, 0, 5.0))
+    assert accelerations.of('miro') == STILL and accelerations.of('nobody') == STILL
+    accelerations.tick(0.04, {'miro': STILL})  # the ball deleted: forgotten
+    assert accelerations.of('ball') == STILL
+    accelerations.forget()
+    accelerations.tick(0.06, {'miro': ((1.0, 0.0, 0.0), (0.0, 0.0, 0.0))})
+    assert accelerations.of('miro') == STILL  # nothing before a reset counts
 
 
 # -- spawning ---------------------------------------------------------------------------
@@ -274,6 +296,20 @@ def test_garbage_requests_are_refused_never_crash(name, renaming, uri, text, nam
         assert error.code in range(101, 110) and '\n' not in str(error)
     else:
         assert made.name and made.name not in taken
+
+
+def test_a_spawned_body_asked_for_below_its_floor_stands_on_it():
+    ball = Ball((0.0, 0.0), 0.1, 0.4, (0, 0, 1), 0.5, 0.5, floor=0.2)
+    assert placed(ball, (1.0, 2.0, 0.0), 1.0, ground=0.0) == replace(ball, position=(1.0, 2.0))
+    assert placed(ball, (1.0, 2.0, 0.5), 1.0, ground=0.0).floor == pytest.approx(0.4)
+    box = Shape('box', (0.0, 0.0, 0.0), size=(0.2, 0.2, 0.4), mass=1.0)
+    low = placed(box, (1.0, 2.0, -3.0), 0.5, ground=0.1)
+    assert low.position == pytest.approx((1.0, 2.0, 0.3)) and low.yaw == 0.5
+    assert placed(box, (1.0, 2.0, 0.9), 0.5, ground=0.1).position == (1.0, 2.0, 0.9)
+    cylinder = Shape('cylinder', (0.0, 0.0, 0.0), radius=0.1, length=0.6)
+    assert placed(cylinder, (0.0, 0.0, 0.0), 0.0, ground=0.0).position[2] == pytest.approx(0.3)
+    low, high = reach(low)  # the box round it, a centimetre in on every side
+    assert (low[2], high[2]) == pytest.approx((0.11, 0.49))
 
 
 # -- states -----------------------------------------------------------------------------

@@ -22,6 +22,7 @@ from simulation_interfaces.action import SimulateSteps
 
 from fuzzmsg import hostile
 from miro_ball.miro.interface import RobotTopics
+from miro_sim_bullet.physics.sensors import GRAVITY
 from miro_sim_bullet.ros import step_action
 from miro_sim_bullet.ros.step_action import MAX_GOALS, StepAction
 from miro_sim_bullet.scene.world_model import MAX_SHAPES, Shape
@@ -195,6 +196,15 @@ def test_a_reset_rewinds_the_world_unless_a_body_came_or_went(paused_sim):
     assert node.sim.generation > built  # built anew: the crate is gone
     assert states() == fresh
     still_works(node)
+
+
+def test_a_falling_balls_acceleration_is_gravity(paused_sim):
+    node = paused_sim
+    ok(serve(node, srv.SetEntityState, entity='ball', state=entity_state(pose(0.5, 0.5, 1.0))))
+    ok(serve(node, srv.StepSimulation, steps=2 * node.sim.ticks_per_platform_tick))
+    falling = ok(serve(node, srv.GetEntityState, entity='ball')).state.acceleration.linear
+    # PyBullet's damping takes 0.015 m/s² off it at the default physics step.
+    assert (falling.x, falling.y, falling.z) == pytest.approx((0.0, 0.0, -GRAVITY), abs=0.05)
 
 
 def test_robots_are_limited_per_request_and_per_world(paused_sim):

@@ -1,17 +1,21 @@
-"""Entities as the standard sees them (name, category, description, tags) and the
+"""Entities as the standard sees them (name, category, description, tags, bounds) and the
 filters of GetEntities / GetEntitiesStates."""
 import math
 from dataclasses import dataclass
 
-from miro_sim_bullet.control.codes import (Bounds, CATEGORIES, Refused, Result,
+from miro_ball.miro.interface import BALL_NAME
+from miro_sim_bullet.control.codes import (Bounds, CATEGORIES, EntityCategory, Refused, Result,
                                            TagsFilter)
 from miro_sim_bullet.control.posix_regex import compile_ere
+from miro_sim_bullet.scene.world_model import Ball, half_extents, table_of
 
 # MiRo-E's bounds in its own frame (base_link: on the floor under the wheel axle), at rest
 # with its head at the calibration pose: the physics body's extent measured in PyBullet
 # (tail -0.16 m, nose +0.18 m, +-0.10 m, top of the ears 0.29 m) and a centimetre more.
 # The head reaches further when it turns or lifts.
 ROBOT_BOX = ((0.19, 0.11, 0.30), (-0.17, -0.11, 0.0))  # upper corner, lower corner
+ROBOT_BOUNDS = (Bounds.BOX, [tuple(corner) for corner in ROBOT_BOX])  # in its FOOT frame
+ROBOT_TAGS = ('miro', 'robot')
 
 
 @dataclass(frozen=True)
@@ -49,22 +53,27 @@ def entity_filter(pattern, categories, tags, tag_mode, bounds):
     return keep
 
 
-def entity_bounds(kind, size):
-    """The standard's Bounds (type, [(x, y, z), ...]) of a shape in its own frame: 'sphere'
-    (radius,), 'box' (full extents x, y, z), 'cylinder' (radius, length: a box round it),
-    'robot' (size unused: ROBOT_BOX). Boxes list the upper corner, then the lower."""
-    if kind == 'sphere':
-        return Bounds.SPHERE, [(0.0, 0.0, 0.0), (float(size[0]), 0.0, 0.0)]
-    if kind == 'robot':
-        return Bounds.BOX, [tuple(corner) for corner in ROBOT_BOX]
-    if kind == 'box':
-        half = tuple(float(extent) / 2 for extent in size)
-    elif kind == 'cylinder':
-        radius, length = size
-        half = (float(radius), float(radius), float(length) / 2)
-    else:
-        raise ValueError(f'no bounds for a {kind!r}')
+def entity_bounds(body):
+    """The standard's Bounds (type, [(x, y, z), ...]) of a world_file Shape or Ball in its
+    own frame (its centre): a sphere for the ball and a sphere, else the box round it
+    (upper corner, then lower). A MiRo's are ROBOT_BOUNDS."""
+    half = half_extents(body)
+    if isinstance(body, Ball) or body.kind == 'sphere':
+        return Bounds.SPHERE, [(0.0, 0.0, 0.0), (half[0], 0.0, 0.0)]
     return Bounds.BOX, [half, tuple(-h for h in half)]
+
+
+def default_entity(name, body=None):
+    """The Entity ``name`` is until set_entity_info says otherwise; ``body``: the world_file
+    Shape or Ball it was built from, None for a MiRo. A shape's tags are its kind and its
+    world-file table."""
+    if body is None:
+        return Entity(name, EntityCategory.ROBOT, 'MiRo-E', ROBOT_TAGS)
+    if isinstance(body, Ball):
+        return Entity(name, EntityCategory.DYNAMIC_OBJECT, 'the ball', (BALL_NAME,))
+    category = EntityCategory.DYNAMIC_OBJECT if body.mass > 0 else EntityCategory.STATIC_OBJECT
+    return Entity(name, category, f'a {body.kind} ({body.source})',
+                  tuple(dict.fromkeys((body.kind, table_of(body)))))
 
 
 def _name_test(pattern):

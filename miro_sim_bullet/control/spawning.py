@@ -7,7 +7,6 @@ cylinder from one table in the world file's TOML syntax (the bundled models in
 worlds/models/, or a text of one's own).
 """
 import importlib.resources
-import math
 import re
 from dataclasses import dataclass, replace
 from functools import cache
@@ -18,7 +17,7 @@ from miro_ball.common.files import allowed_path, FileRefused, read_regular, uri_
 from miro_ball.miro.interface import BALL_NAME, check_name
 from miro_ball.miro.urdf import MAX_URDF_BYTES, urdf
 from miro_sim_bullet.control.codes import Refused, SpawnResult
-from miro_sim_bullet.control.entities import entity_bounds, ROBOT_BOX
+from miro_sim_bullet.control.entities import entity_bounds, ROBOT_BOUNDS
 from miro_sim_bullet.scene.world_checks import load_entity, MAX_FILE_BYTES
 from miro_sim_bullet.scene.world_file import BUNDLED_URI
 from miro_sim_bullet.scene.world_model import Ball, WorldError
@@ -29,7 +28,6 @@ SPAWNABLE_MIRO = PACKAGE_URI + 'robots/miro.urdf'  # written from the body model
 MODELS = 'models'  # worlds/models/: the bundled spawnable shapes
 MIRO_DESCRIPTION = 'MiRo-E, with its whole ROS interface under its name'
 MAX_RESOURCE_BYTES = max(MAX_URDF_BYTES, MAX_FILE_BYTES)
-TOUCH_M = 0.01  # bodies this close only touch: one may be spawned on another
 _PACKAGE = re.compile(r'[A-Za-z][A-Za-z0-9_]*')  # a ROS package's name
 # What a uri may name (docs/limits.md), said whenever one breaks it, whether a file is there
 # or not, readable or not.
@@ -116,62 +114,13 @@ def spawnables():
     """[(uri, description, bounds)] of the bundled models: MiRo-E, then each
     worlds/models/*.toml; bounds as the standard's (type, points), in the model's frame."""
     models = importlib.resources.files('miro_sim_bullet.worlds') / MODELS
-    found = [(SPAWNABLE_MIRO, MIRO_DESCRIPTION, entity_bounds('robot', ()))]
+    found = [(SPAWNABLE_MIRO, MIRO_DESCRIPTION, ROBOT_BOUNDS)]
     for file in sorted(models.iterdir(), key=lambda f: f.name):
         if file.name.endswith('.toml'):
             uri = f'{BUNDLED_URI}{MODELS}/{file.name}'
             model = load_entity(file.read_text(encoding='utf-8'), uri)
-            found.append((uri, model.description, body_bounds(model.body)))
+            found.append((uri, model.description, entity_bounds(model.body)))
     return found
-
-
-def body_bounds(body):
-    """The standard's bounds of a world_file Shape or Ball in its own frame (its centre)."""
-    if isinstance(body, Ball) or body.kind == 'sphere':
-        return entity_bounds('sphere', (body.radius,))
-    if body.kind == 'box':
-        return entity_bounds('box', body.size)
-    return entity_bounds('cylinder', (body.radius, body.length))
-
-
-def robot_box(foot, yaw):
-    """(half extents, centre) of MiRo's box (ROBOT_BOX) when it stands at ``foot`` (the
-    point on its floor under the axle) turned by ``yaw``, a centimetre smaller on every
-    side: what a wall or a table must stay out of for MiRo to be put there. Standing on a
-    floor or a table top, or against a wall, it only touches them."""
-    top, bottom = ROBOT_BOX
-    half = tuple((t - b) / 2 - TOUCH_M for t, b in zip(top, bottom))
-    x, y, z = ((t + b) / 2 for t, b in zip(top, bottom))
-    c, s = math.cos(yaw), math.sin(yaw)
-    return half, (foot[0] + c * x - s * y, foot[1] + s * x + c * y, foot[2] + z)
-
-
-def robot_reach(foot, yaw):
-    """(low, high) corners of the upright box round robot_box(foot, yaw)."""
-    half, centre = robot_box(foot, yaw)
-    return _around(half, centre, yaw)
-
-
-def reach(body, centre, yaw):
-    """(low, high) corners of the box round a world_file Shape or Ball at ``centre`` turned
-    by ``yaw``, a centimetre smaller on every side: bodies that only touch do not reach
-    into each other."""
-    if isinstance(body, Ball) or body.kind == 'sphere':
-        half, yaw = (body.radius,) * 3, 0.0
-    elif body.kind == 'cylinder':
-        half, yaw = (body.radius, body.radius, body.length / 2), 0.0
-    else:
-        half = tuple(size / 2 for size in body.size)
-    return _around([max(0.0, h - TOUCH_M) for h in half], centre, yaw)
-
-
-def _around(half, centre, yaw):
-    """(low, high) corners of the upright box round a box of ``half`` extents at
-    ``centre`` turned by ``yaw`` about the vertical."""
-    c, s = abs(math.cos(yaw)), abs(math.sin(yaw))
-    extent = (c * half[0] + s * half[1], s * half[0] + c * half[1], half[2])
-    return (tuple(p - e for p, e in zip(centre, extent)),
-            tuple(p + e for p, e in zip(centre, extent)))
 
 
 # -- the resource -----------------------------------------------------------------------

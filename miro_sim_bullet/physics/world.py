@@ -18,8 +18,8 @@ from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.robot import MiroRobot
 from miro_sim_bullet.physics.sensors import GRAVITY
 from miro_sim_bullet.scene.world_file import load_world
-from miro_sim_bullet.scene.world_model import (MAX_ROBOTS, MAX_SHAPES, PICTURE_UV, RobotSpec,
-                                               Shape, World)
+from miro_sim_bullet.scene.world_model import (half_extents, MAX_ROBOTS, MAX_SHAPES,
+                                               PICTURE_UV, RobotSpec, Shape, table_of, World)
 
 # Collision groups. Bit 0 stays in every mask because Bullet's ray tests carry group 1.
 # Static bodies skip each other (a wall panel touching the floor is work for nothing);
@@ -41,11 +41,6 @@ ALL_GROUPS = (1 << (MAX_ROBOTS + 3)) - 1
 
 def robot_group(index):
     return 1 << (index + 3)
-
-
-def _table(shape):
-    """The world-file table an unnamed shape comes from: 'wall' for 'wall[2]'."""
-    return shape.source.split('[')[0] or shape.kind
 
 
 class SimWorld:
@@ -116,7 +111,7 @@ class SimWorld:
         loaded = {'ground': [None]}  # the ground is 'ground_0'
         for shape in self.loaded.shapes:
             if not shape.name and shape.mass <= 0:
-                loaded.setdefault(_table(shape), []).append(shape)
+                loaded.setdefault(table_of(shape), []).append(shape)
         looked = dict.fromkeys(loaded, 0)  # where the next of each table is looked for
         names = {}
         for body, shape in self.shape_of.items():
@@ -150,7 +145,7 @@ class SimWorld:
         else:
             if shape.name:
                 self.statics[shape.name] = body
-            self.body_labels[body] = (shape.name or _table(shape), 'static')
+            self.body_labels[body] = (shape.name or table_of(shape), 'static')
         return body
 
     def _add_robot(self, spec):
@@ -192,7 +187,7 @@ class SimWorld:
     def _shape(self, shape):
         kw = self._kw()
         if shape.kind == 'box':
-            dims = {'halfExtents': [s / 2 for s in shape.size]}
+            dims = {'halfExtents': half_extents(shape)}
             cdims = dims
         elif shape.kind == 'cylinder':
             dims = {'radius': shape.radius, 'length': shape.length}
@@ -276,6 +271,17 @@ class SimWorld:
             named.setdefault(name, body)
         return named
 
+    def built_from(self, name, bodies=None):
+        """The world_model Shape or Ball the entity ``name`` (of entities(), or ``bodies``
+        when the caller has it already) was built from; None for a robot."""
+        if name in self.robots:
+            return None
+        return self.shape_of[(self.entities() if bodies is None else bodies)[name]]
+
+    def movers(self):
+        """{name: body id} of everything that moves: the robots and the movable objects."""
+        return {**{name: robot.body_id for name, robot in self.robots.items()}, **self.objects}
+
     def body_state(self, body):
         """(position, orientation xyzw, linear velocity, angular velocity) of a body's base
         in the world frame."""
@@ -288,13 +294,11 @@ class SimWorld:
     def set_body_velocity(self, body, linear, angular):
         pb.resetBaseVelocity(body, linear, angular, **self._kw())
 
-    def spawn_ball(self, ball, x, y, z):
-        """The world's ball (world_file.Ball), its centre at (x, y, z) (z None: on its
-        floor); ValueError if it has one already."""
+    def spawn_ball(self, ball):
+        """The world's ball (a world_model.Ball: on its floor at its position); ValueError
+        if it has one already."""
         if self.ball_id is not None:
             raise ValueError('the world has its ball already')
-        floor = ball.floor if z is None else z - ball.radius
-        ball = replace(ball, position=(float(x), float(y)), floor=float(floor))
         self._add_ball(ball)
         pb.setCollisionFilterGroupMask(self.ball_id, -1, MOVABLE_GROUP, ALL_GROUPS,
                                        **self._kw())
@@ -333,8 +337,7 @@ class SimWorld:
         boxes reach into the box from corner ``low`` to corner ``high``."""
         found = pb.getOverlappingObjects(low, high, **self._kw()) or ()
         bodies = {body for body, _ in found}
-        movers = {**self.objects, **{name: r.body_id for name, r in self.robots.items()}}
-        return sorted(name for name, body in movers.items() if body in bodies)
+        return sorted(name for name, body in self.movers().items() if body in bodies)
 
     def statics_within(self, half, centre, yaw):
         """Names of the static bodies (walls, tables, the floor) that a box of ``half``

@@ -19,14 +19,16 @@ from geometry_msgs.msg import Vector3
 from simulation_interfaces import msg as si
 from simulation_interfaces import srv
 
-from miro_ball.miro.interface import BALL_NAME, SimTopics
+from miro_ball.miro.interface import SimTopics
 from miro_ball.miro.rotations import yaw_of, yaw_quaternion
 from miro_sim_bullet.control import codes
+from miro_sim_bullet.control.accelerations import Accelerations
 from miro_sim_bullet.control.codes import EntityCategory, Refused, Result
-from miro_sim_bullet.control.entities import Entity, entity_bounds, entity_filter, tag_filter
+from miro_sim_bullet.control.entities import (default_entity, entity_bounds, entity_filter,
+                                              ROBOT_BOUNDS, tag_filter)
+from miro_sim_bullet.control.placement import check_room, spawn_at
 from miro_sim_bullet.control.poses import check_pose, check_twist, in_world, WORLD_FRAMES
-from miro_sim_bullet.control.spawning import (body_bounds, MAX_RESOURCE_BYTES, parse_spawn,
-                                              reach, robot_box, robot_reach, RobotSpawn,
+from miro_sim_bullet.control.spawning import (MAX_RESOURCE_BYTES, parse_spawn, RobotSpawn,
                                               SPAWN_FORMATS, spawnables)
 from miro_sim_bullet.control.states import transition
 from miro_sim_bullet.ros import convert
@@ -59,7 +61,6 @@ CUSTOM_INFO = ('miro_ball: MiRo-E robots in PyBullet. Spawn MiRo-E from its URDF
                'balls, boxes, spheres and cylinders from a world file\'s TOML table; worlds '
                'are TOML world files. A robot\'s pose is the point on its floor under the '
                'wheel axle, and its heading.')
-ROBOT_TAGS = ('miro', 'robot')
 # A world that does not load, by what is wrong: there is none, or it breaks a rule.
 LOAD_CODES = {WorldError.MISSING: codes.LoadWorld.NO_RESOURCE,
               WorldError.INVALID: codes.LoadWorld.RESOURCE_PARSE_ERROR}
@@ -82,7 +83,7 @@ class ControlInterface:
     def __init__(self, ros, host, warn, errors):
         self.host, self._warn, self._errors = host, warn, errors
         self.info = {}  # entity name -> Entity (set_entity_info's, or its defaults)
-        self._velocity = {}  # entity name -> ((t, v, w) at the last platform tick, before)
+        self.accelerations = Accelerations()
         self._world_cache = WorldCache()  # what get_available_worlds read, asked again
         handlers = {
             srv.GetSimulatorFeatures: self._features, srv.GetSimulationState: self._get_state,
@@ -176,20 +177,7 @@ class ControlInterface:
         if name not in bodies:
             shown = ', '.join(sorted(bodies)[:12]) + (', ...' if len(bodies) > 12 else '')
             raise Refused(Result.NOT_FOUND, f'no entity {name[:80]!r}: there are {shown}')
-        return self.info.get(name) or self._default_info(name, bodies[name])
-
-    def _default_info(self, name, body):
-        sim = self.sim
-        if name in sim.robots:
-            return Entity(name, EntityCategory.ROBOT, 'MiRo-E', ROBOT_TAGS)
-        if name == BALL_NAME and body == sim.ball_id:
-            return Entity(name, EntityCategory.DYNAMIC_OBJECT, 'the ball', (BALL_NAME,))
-        shape = sim.shape_of[body]
-        category = EntityCategory.DYNAMIC_OBJECT if shape.mass > 0 \
-            else EntityCategory.STATIC_OBJECT
-        table = shape.source.split('[')[0] or shape.kind
-        return Entity(name, category, f'a {shape.kind} ({shape.source})',
-                      tuple(dict.fromkeys((shape.kind, table))))
+        return self.info.get(name) or default_entity(name, self.sim.built_from(name, bodies))
 
     def pose(self, name, bodies=None):
         """(position, orientation) of an entity in the world frame; a robot's is its
@@ -235,22 +223,15 @@ class ControlInterface:
         stamped = convert.pose(position, orientation, convert.stamp(self.sim.time))
         state = si.EntityState(header=stamped.header, pose=stamped.pose)
         state.twist.linear, state.twist.angular = _vector(linear), _vector(angular)
-        now, before = self._velocity.get(name, (None, None))
-        if now is not None and before is not None and now[0] > before[0]:
-            dt = now[0] - before[0]
-            state.acceleration.linear = _vector([(a - b) / dt for a, b in zip(now[1], before[1])])
-            state.acceleration.angular = _vector([(a - b) / dt
-                                                  for a, b in zip(now[2], before[2])])
+        state.acceleration.linear, state.acceleration.angular = map(
+            _vector, self.accelerations.of(name))
         return state
 
     def tick(self):
         """Each platform tick: every movable entity's velocity, for the accelerations."""
         sim = self.sim
-        bodies = {**{name: robot.body_id for name, robot in sim.robots.items()},
-                  **sim.objects}
-        self._velocity = {name: ((sim.time, *sim.body_velocity(body)),
-                                 self._velocity.get(name, (None,))[0])
-                          for name, body in bodies.items()}
+        self.accelerations.tick(sim.time, {name: sim.body_velocity(body)
+                                           for name, body in sim.movers().items()})
 
     def _set_entity_state(self, request, response):
         entity = self.entity(request.entity)
@@ -262,7 +243,7 @@ class ControlInterface:
         if entity.category == EntityCategory.STATIC_OBJECT:
             raise Refused(Result.OPERATION_FAILED, f'{entity.name} is static: it does not move')
         if entity.name in self.sim.robots:
-            self._check_room(entity.name, invalid, robot_at=(position, yaw_of(*orientation)))
+            check_room(self.sim, entity.name, invalid, robot_at=(position, yaw_of(*orientation)))
         self.sim.set_object_pose(entity.name, position, orientation)
         if entity.name not in self.sim.robots:  # a robot's wheels say how it moves
             self.sim.set_body_velocity(self.sim.entities()[entity.name], linear, angular)
@@ -301,11 +282,8 @@ class ControlInterface:
 
     def _get_bounds(self, request, response):
         self.entity(request.entity)
-        sim = self.sim
-        body = sim.entities()[request.entity]
-        kind, points = entity_bounds('robot', ()) if request.entity in sim.robots \
-            else body_bounds(sim.shape_of[body])
-        response.bounds = _bounds(kind, points)
+        body = self.sim.built_from(request.entity)
+        response.bounds = _bounds(*(ROBOT_BOUNDS if body is None else entity_bounds(body)))
         response.result = _result()
 
     # -- spawning and deleting ----------------------------------------------------------------
@@ -348,26 +326,9 @@ class ControlInterface:
         (x, y, z), orientation = self._world_pose(request.initial_pose.header.frame_id,
                                                   request.initial_pose.pose,
                                                   codes.SpawnResult.INVALID_POSE)
-        try:
-            if isinstance(spawn, RobotSpawn):
-                self._check_room(spawn.name, robot_at=((x, y, z), yaw_of(*orientation)))
-                sim.spawn_robot(spawn.name, x, y, yaw_of(*orientation), floor=z)
-            elif isinstance(spawn.body, Ball):
-                centre = (x, y, max(z, spawn.body.radius + spawn.body.floor))
-                self._check_room(spawn.name, box=reach(spawn.body, centre, 0.0))
-                sim.spawn_ball(spawn.body, *centre)
-            else:
-                shape = spawn.body
-                lowest = (sim.description.ground_height or 0.0) + _half_height(shape)
-                shape = dataclasses.replace(shape, position=(x, y, max(z, lowest)),
-                                            yaw=yaw_of(*orientation))
-                if shape.mass > 0:
-                    self._check_room(spawn.name, box=reach(shape, shape.position, shape.yaw))
-                sim.spawn_shape(shape)
-        except ValueError as err:  # the world is full
-            raise Refused(Result.OPERATION_FAILED, str(err)) from None
+        spawn_at(sim, spawn, (x, y, z), yaw_of(*orientation))
         if not isinstance(spawn, RobotSpawn) and (spawn.description or spawn.tags):
-            base = self._default_info(spawn.name, sim.entities()[spawn.name])
+            base = default_entity(spawn.name, self.sim.built_from(spawn.name))
             self.info[spawn.name] = dataclasses.replace(
                 base, description=spawn.description or base.description,
                 tags=spawn.tags or base.tags)
@@ -376,22 +337,6 @@ class ControlInterface:
             if isinstance(spawn.body, Ball) else f'a {spawn.body.kind}'
         self.host.said('spawn', f'spawned {spawn.name} ({what}) at ({x:.3f}, {y:.3f}, {z:.3f})')
         return spawn.name
-
-    def _check_room(self, name, code=codes.SpawnResult.INVALID_POSE, box=None, robot_at=None):
-        """Refused ``code`` if the movable body ``name`` put into ``box`` (low, high corners)
-        would be inside another movable object or robot: 64 boxes spawned on one spot took
-        15 s of physics for 50 steps, 2,500 forever; a MiRo on a MiRo threw both. A robot
-        (``robot_at``: its foot and heading) must also be clear of every static body by its
-        shape: one put into a wall panel was thrown 2.2 m up and out of the arena. On a
-        floor or a table top, or against a wall, it only touches them (robot_box)."""
-        statics = []
-        if robot_at is not None:
-            box = robot_reach(*robot_at)
-            statics = self.sim.statics_within(*robot_box(*robot_at), robot_at[1])
-        inside = [other for other in self.sim.movers_within(*box) if other != name] + statics
-        if inside:
-            raise Refused(code, f'{name} there would be inside {", ".join(inside[:3])}: '
-                                'put it elsewhere (or on top)')
 
     def _delete(self, request, response):
         self._need_world()
@@ -408,7 +353,7 @@ class ControlInterface:
     def forget(self):
         """The world was reset or another loaded: what was said about its entities goes."""
         self.info.clear()
-        self._velocity.clear()
+        self.accelerations.forget()
 
     # -- named poses, spawnables, worlds ------------------------------------------------------
     def _named_poses(self, request, response):
@@ -487,12 +432,6 @@ class ControlInterface:
             raise Refused(srv.UnloadWorld.Response.NO_WORLD_LOADED, 'no world is loaded')
         self.host.unload()
         response.result = _result()
-
-
-def _half_height(shape):
-    if shape.kind == 'box':
-        return shape.size[2] / 2
-    return shape.length / 2 if shape.kind == 'cylinder' else shape.radius
 
 
 def _vector(values):

@@ -165,6 +165,12 @@ def half_extents(body):
     return tuple(size / 2 for size in body.size)
 
 
+def table_of(shape):
+    """The world-file table a Shape comes from: 'wall' for 'wall[2]' (its kind when the
+    source says none)."""
+    return shape.source.split('[')[0] or shape.kind
+
+
 def bundled_folder():
     """The folder of the worlds, models and pictures installed with the package."""
     return importlib.resources.files('miro_sim_bullet.worlds')
