@@ -27,7 +27,7 @@ TIERS = {
               'test_animal_parts', 'test_throttle', 'test_sound_files', 'test_docs',
               'test_gui_pairing', 'test_faces', 'test_learn', 'test_learn_multi',
               'test_learn_train', 'test_learn_vector', 'test_launch_files',
-              'test_sim_control')),
+              'test_sim_control', 'test_posix_regex')),
     'ros': ('nodes in-process on executors of their own, a process or two beside them',
             ('test_clients', 'test_controller_node', 'test_fuzz_params', 'test_fuzz_topics',
              'test_gui_bridge', 'test_multi_robot', 'test_sim_executor', 'test_sim_node',

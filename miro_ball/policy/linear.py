@@ -2,12 +2,12 @@
 wheels, through a linear layer and tanh. No deep-learning library: twelve numbers in all.
 
 The observation is the environment's (policy.observation): ``ball`` (2, 4) rows
-[seen, x, y, r] per eye (left, right), ``sonar`` (1,) metres. The policy keeps two numbers of memory: on
-which side the ball was last seen, so that a ball lost from view is searched for on the
-side it left by (a policy without it can only spin one way), and how big it was then, so
-that a ball lost because it is close (below the eyes' view) is driven at, not searched
-for. Its outputs are a forward and a turn command, each -1..1, mixed into the two wheel
-speeds.
+[seen, x, y, r] per eye (left, right), ``sonar`` (1,) metres. The policy keeps two numbers
+of memory: on which side the ball was last seen, so that a ball lost from view is searched
+for on the side it left by (a policy without it can only spin one way), and how big it was
+then, so that a ball lost because it is close (below the eyes' view) is driven at, not
+searched for. Its outputs are a forward and a turn command, each -1..1, mixed into the two
+wheel speeds.
 
 A policy is saved as a folder: ``policy.npz`` (its weights) and ``policy.json`` (the
 settings it was trained with: eyes, frame_skip, what it was trained on), read back by
