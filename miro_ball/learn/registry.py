@@ -1,12 +1,15 @@
 """The tasks as Gymnasium environments: every task of the catalogue (learn.tasks) that
 declares a ``gym_id`` is registered as miro_ball/<gym_id> (learn/__init__.py does it on
-import), and made by make()."""
+import), and made by make().
+
+Registering reads the tasks' declarations and loads no world: the task modules import the
+simulator (PyBullet, the renderers, OpenCV) only when an environment is made or trained,
+so importing miro_ball.learn costs Gymnasium's import and little more."""
 import inspect
 
 import gymnasium
 
 from miro_ball.learn import tasks
-from miro_ball.learn.env import MiroEnv
 
 NAMESPACE = 'miro_ball'
 
@@ -15,6 +18,8 @@ def make(task, **options):
     """The environment of the task named ``task``: the task made of the options its class
     takes (its ``__init__``'s keywords: KickBall's limit_s, ...), a MiroEnv of the others,
     in the task's wrapper if it declares one."""
+    from miro_ball.learn.env import MiroEnv  # the world's build: not for a registration
+
     declared = tasks.named(task)
     own = inspect.signature(declared).parameters
     task_options = {name: options.pop(name) for name in list(options) if name in own}

@@ -17,7 +17,6 @@ import math
 import random
 
 from miro_ball.learn.tasks.kick_ball import KickBall
-from miro_sim_bullet.scene.world_file import load_world
 from miro_sim_bullet.scene.world_model import RobotSpec, World
 
 PITCH = 'football_pitch'
@@ -61,7 +60,10 @@ def free_half_size(world):
 def pitch_world(world, robots):
     """``world`` (a World, bundled name or path) with ``robots`` MiRos named miro01, ... in
     it, standing apart (a reset places them anew)."""
-    world = world if isinstance(world, World) else load_world(world)
+    if not isinstance(world, World):
+        from miro_sim_bullet.scene.world_file import load_world  # not for the catalogue
+
+        world = load_world(world)
     if world.ball is None or world.ground_height != 0.0:
         raise ValueError(f'world {world.name}: football needs a [ball] and a [ground] at '
                          'height 0, whose size is the pitch')

@@ -27,9 +27,8 @@ import numpy as np
 from gymnasium import spaces
 
 from miro_ball.controller.contract import Action
-from miro_ball.learn import curve, rollouts
+from miro_ball.learn import rollouts
 from miro_ball.learn.bandit import EpsilonGreedy
-from miro_ball.learn.env import MiroEnv
 from miro_ball.learn.rollouts import Outcome, play_episode
 from miro_ball.learn.spaces import check_action
 from miro_ball.learn.tasks import Task
@@ -119,6 +118,8 @@ class KBanditTraining:
                               for trial in range(1, self.trials + 1)] for o in outcomes],
                             np.float64)
         trials = np.arange(1, self.trials + 1)
+        from miro_ball.learn import curve  # OpenCV draws it: imported when needed
+
         curve.write_csv(os.path.join(out, CURVE_CSV), ('trial', 'belief_right', 'found_by'),
                         [(int(t), round(float(r), 4), round(float(f), 4)) for t, r, f in
                          zip(trials, right.mean(axis=0), found_by.mean(axis=0))])
@@ -136,6 +137,8 @@ class KBanditTraining:
                 f'{self.trials} for {percent(len(found), len(outcomes))}{median}')
 
     def environment(self, settings):
+        from miro_ball.learn.env import MiroEnv  # the simulator: imported when needed
+
         return Expressions(MiroEnv(KBandit(trials=int(settings['trials']),
                                            mistakes=float(settings['mistakes']))))
 

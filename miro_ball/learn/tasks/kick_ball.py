@@ -16,10 +16,8 @@ from typing import NamedTuple, Optional
 
 import numpy as np
 
-from miro_ball.controller.behaviour import BehaviourParams, make_behaviour
-from miro_ball.learn import curve, rollouts
+from miro_ball.learn import rollouts
 from miro_ball.learn.cem import CrossEntropy
-from miro_ball.learn.env import MiroEnv
 from miro_ball.learn.rollouts import Outcome, play_episode
 from miro_ball.learn.tasks import settle, Task
 from miro_ball.learn.trainers import (CURVE_CSV, CURVE_PNG, held_out_seeds, percent, smooth,
@@ -118,6 +116,8 @@ class KickBallTraining:
             longest = max(longest, clock() - began)
             if elapsed + longest > minutes * 60:
                 break
+        from miro_ball.learn import curve  # OpenCV draws it: imported when needed
+
         curve.write_csv(os.path.join(out, CURVE_CSV), columns, rows)
         table = np.array(rows, np.float64)
         start_with = f'{count} episodes imitated, then ' if count else ''
@@ -133,6 +133,8 @@ class KickBallTraining:
 
     def environment(self, settings):
         """What a training episode sees and does: the policy's observations, the wheels."""
+        from miro_ball.learn.env import MiroEnv  # the simulator: imported when needed
+
         env = MiroEnv(KickBall(limit_s=float(settings['limit_s'])),
                       eyes=tuple(settings['eyes']), frame_skip=int(settings['frame_skip']))
         return PickActions(PickObservations(env, OBSERVED), 'wheels')
@@ -149,6 +151,8 @@ class KickBallTraining:
         return Outcome(total, bool(info['kicked']), steps, info['kick_time'])
 
     def _demonstration(self, env, settings, controller_name, seed):
+        from miro_ball.controller.behaviour import BehaviourParams, make_behaviour
+
         base = env.unwrapped
         controller = make_behaviour(controller_name, BehaviourParams(seed=seed))
         features = LinearPolicy(np.zeros(LinearPolicy.size()), settings)  # its memory only
