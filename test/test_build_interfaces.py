@@ -59,3 +59,15 @@ def test_the_command_has_help_and_refuses_bad_options():
                                          timeout=60).stdout
     bad = subprocess.run(run + ['--jobs', '0'], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and 'Traceback' not in bad.stderr
+
+
+def test_no_comment_of_our_interfaces_opens_or_closes_a_c_comment():
+    """rosidl copies a definition's comments into the C headers it generates, inside /* */:
+    'sensors/* topics' in SensorsPackage.msg made gcc warn 13 times ('"/*" within comment'),
+    which colcon reports as the build's stderr; a '*/' would end the comment early."""
+    found = [f'{path.relative_to(b.sources())}:{number}'
+             for path in sorted(b.sources().rglob('*'))
+             if path.suffix in ('.msg', '.srv', '.action')
+             for number, line in enumerate(path.read_text().splitlines(), 1)
+             if '#' in line and any(mark in line.split('#', 1)[1] for mark in ('/*', '*/'))]
+    assert found == []
