@@ -78,3 +78,19 @@ def test_a_flood_of_changes_is_a_few_log_lines_and_each_is_applied(paused_sim, c
         assert node.params.jpeg_quality == quality
     said = [line for line in capfd.readouterr().err.splitlines() if 'set at run time' in line]
     assert 1 <= len(said) <= 2, said
+
+
+def test_an_integer_for_a_float_parameter_is_held_as_a_double(make_sim):
+    """-p real_time_factor:=0 is an integer to ROS: the parameter held it as one, and
+    ros2 param get said "Integer value is: 0" of a double parameter; so did a run-time set."""
+    node = make_sim(real_time_factor=0)
+    held, = node.get_parameters(['real_time_factor'])
+    assert (held.type_, held.value) == (Parameter.Type.DOUBLE, 0.0)
+    assert node.set_parameters([Parameter('real_time_factor', value=2)])[0].successful
+    held, = node.get_parameters(['real_time_factor'])
+    assert (held.type_, held.value, node.params.real_time_factor) == (Parameter.Type.DOUBLE,
+                                                                      2.0, 2.0)
+    # Not a bool, and not a parameter that is an integer: those stay as they are.
+    assert not node.set_parameters([Parameter('real_time_factor', value=True)])[0].successful
+    assert node.set_parameters([Parameter('jpeg_quality', value=60)])[0].successful
+    assert node.get_parameters(['jpeg_quality'])[0].type_ == Parameter.Type.INTEGER

@@ -100,14 +100,27 @@ def declare(node, group):
     filled-in dataclass (the command line's values checked: coerce, then the dataclass's
     ranges)."""
     from rcl_interfaces.msg import ParameterDescriptor
+    from rclpy.parameter import Parameter
 
     given = {}
     for name, _, f in parameters(group):
         default = default_of(f)
         descriptor = ParameterDescriptor(description=f.metadata['help'], dynamic_typing=True)
         declared = list(default) if isinstance(default, tuple) else default
-        given[name] = node.declare_parameter(name, declared, descriptor).value
+        value = given[name] = node.declare_parameter(name, declared, descriptor).value
+        stored = as_declared(value, default)
+        if stored is not value:  # -p x:=0 for a float: stored as the double it is
+            node.set_parameters([Parameter(name, value=stored)])
     return values_of(group, given)
+
+
+def as_declared(value, default):
+    """value as the parameter of that default holds it: a float's integer as a float (ROS
+    types the 0 of -p real_time_factor:=0 as an integer, and the parameter then said
+    "Integer value is: 0" to ros2 param get); any other value itself (coerce checks it)."""
+    if isinstance(default, float) and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    return value
 
 
 def values_of(group, given):
@@ -288,7 +301,21 @@ class LiveParams:
         self.fixed = set(fixed)
         self._owner = {name: (cls, f) for name, cls, f
                        in parameters(*(groups or list(self.values)))}
+        node.add_pre_set_parameters_callback(self._as_declared)
         node.add_on_set_parameters_callback(self._on_set)
+
+    def _as_declared(self, changes):
+        """The parameters to set, a float's integer made a float (as_declared)."""
+        from rclpy.parameter import Parameter
+
+        typed = []
+        for parameter in changes:
+            owner = self._owner.get(parameter.name)
+            value = parameter.value if owner is None else as_declared(parameter.value,
+                                                                      default_of(owner[1]))
+            typed.append(parameter if value is parameter.value
+                         else Parameter(parameter.name, value=value))
+        return typed
 
     def _on_set(self, parameters):
         from rcl_interfaces.msg import SetParametersResult
