@@ -3,6 +3,7 @@ a controller of the contract running in an environment unchanged, and docs/learn
 examples, run as written."""
 import math
 import re
+import sys
 from pathlib import Path
 
 import gymnasium
@@ -17,10 +18,11 @@ from miro_ball.controller.contract import Action
 from miro_ball.controller.detection import Ball, DetectionParams
 from miro_ball.controller.detectors import DETECTORS
 from miro_ball.controller.params import detection_params
-from miro_ball.learn import core
+from miro_ball.learn import core, train
 from miro_ball.learn import rig as rig_module
 from miro_ball.learn.controllers import run_controller
 from miro_ball.learn.env import MiroEnv
+from miro_ball.learn.parallel_env import MiroParallelEnv
 from miro_ball.learn.tasks.k_bandit import EXPRESSION_NAMES
 from miro_ball.learn.rig import WorldRig
 from miro_ball.learn.tasks.kick_ball import KICK_REWARD, KickBall
@@ -170,6 +172,19 @@ def test_kick_ball_with_no_eyes_is_state_only_and_a_detector_asked_for_is_refuse
     with pytest.raises(ValueError) as refused:
         gymnasium.make('miro_ball/KickBall-v0', eyes=None, detectors=('ball',))
     assert str(refused.value) == 'detectors ball need eyes: give eyes=(w, h)'
+
+
+def test_a_keyword_no_environment_takes_is_refused_in_one_line_naming_those_there_are():
+    """Any keyword the environment does not have goes to the rig (its eyes' options reach
+    both faces that way); one the rig does not take either is refused before a build."""
+    for make in (lambda: gymnasium.make('miro_ball/KickBall-v0', eyez=None),
+                 lambda: MiroParallelEnv(KickBall(), eyez=None)):
+        with pytest.raises(TypeError) as refused:
+            make()
+        said = str(refused.value)
+        assert said.startswith('unknown option eyez (options: world, eyes, detectors, hears, '
+                               'frame_skip, render_mode, lens, renderer, camera_rate')
+        assert '\n' not in said
 
 
 def test_each_reward_term_is_in_info_and_the_task_says_the_same_when_asked_again():
@@ -423,6 +438,64 @@ def test_an_environment_used_after_close_says_it_is_closed(make):
 
 
 EXAMPLES = re.findall(r'^```python\n(.*?)^```$', LEARNING_MD.read_text(), re.M | re.S)
+ADDED_TASK = re.search(r'^```python task\n(.*?)^```$', LEARNING_MD.read_text(),
+                       re.M | re.S).group(1)
+
+
+@pytest.fixture
+def reach_ball(tmp_path):
+    """docs/learning.md's "Adding a task", saved as written as a module of learn/tasks (in a
+    folder of the package's), and nothing else edited; then what importing miro_ball.learn
+    does, as in a process started with the module there."""
+    from miro_ball.learn import registry, tasks
+
+    (tmp_path / 'reach_ball.py').write_text(ADDED_TASK)
+    tasks.__path__.append(str(tmp_path))
+    try:
+        tasks.catalogue(again=True)
+        registry.register_tasks()
+        yield tasks.named('reach_ball')
+    finally:
+        tasks.__path__.remove(str(tmp_path))
+        tasks.catalogue(again=True)
+        gymnasium.registry.pop('miro_ball/ReachBall-v0', None)
+        sys.modules.pop('miro_ball.learn.tasks.reach_ball', None)
+
+
+def test_a_task_added_as_the_docs_say_is_one_module_that_everything_finds(reach_ball,
+                                                                          tmp_path, capsys):
+    """Adding a task meant editing learn/__init__.py, registry.py, rollouts.py, trainers.py
+    and a module, and Task.name was never read. Now its one module is found by name, its
+    Gymnasium id is registered, its options reach it, both faces take it, and learn.train
+    refuses it in one line for want of a training."""
+    env = gymnasium.make('miro_ball/ReachBall-v0', eyes=None, limit_s=5.0)
+    assert isinstance(env.unwrapped.task, reach_ball) and env.unwrapped.task.limit_s == 5.0
+    check_env(env)
+    env.reset(seed=2)
+    sim, base = env.unwrapped.rig.sim, env.unwrapped
+    x, y, _ = sim.robot.pose()
+    ball = sim.ball_position()[:2]
+    sim.robot.place(x, y, math.atan2(ball[1] - y, ball[0] - x))  # facing the ball
+    start, approached = base.task.gap(), 0.0
+    while True:
+        _, reward, terminated, truncated, info = env.step({'wheels': np.full(2, 0.3)})
+        assert reward == info['reward_approach'] + info['reward_reached']
+        approached += info['reward_approach']
+        if terminated or truncated:
+            break
+    assert terminated and info['reward_reached'] == 1.0 and info['gap_m'] < 0.3
+    assert approached == pytest.approx(start - info['gap_m'])
+    env.close()
+    parallel = MiroParallelEnv(reach_ball(limit_s=0.1), eyes=None)
+    observations, _ = parallel.reset(seed=2)
+    assert list(observations) == parallel.agents == [parallel.task.sim.robot.name]
+    parallel.close()
+    with pytest.raises(SystemExit) as ended:
+        train.main(['reach_ball', '--out', str(tmp_path / 'run')])
+    assert ended.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert "error: task 'reach_ball' has no training (tasks with one: k_bandit, kick_ball)" \
+        in err and len(err.splitlines()) == 1, err
 
 
 @pytest.mark.parametrize('example', EXAMPLES, ids=[f'example{i}' for i in range(len(EXAMPLES))])

@@ -5,7 +5,7 @@ import sys
 
 from miro_ball.common.cli import Parser
 from miro_ball.common.lifecycle import first_line
-from miro_ball.learn.trainers import HELD_OUT_FROM, trainable
+from miro_ball.learn.trainers import HELD_OUT_FROM, trainable, training_of
 
 PROG = 'python -m miro_ball.learn.evaluate'
 
@@ -28,11 +28,12 @@ def build_parser(tasks):
 
 
 def main(argv=None):
-    tasks = trainable()
-    parser = build_parser(tasks)
+    parser = build_parser(trainable())
     options = parser.parse_args(argv)
-    if options.task not in tasks:
-        parser.error(f"unknown task '{options.task}' (tasks: {', '.join(tasks)})")
+    try:
+        task = training_of(options.task)
+    except ValueError as err:
+        parser.error(str(err))
     if not os.path.isdir(options.folder):
         parser.error(f'no folder {options.folder}')
     if not 1 <= options.episodes <= 100000:
@@ -45,7 +46,6 @@ def main(argv=None):
 
     from miro_ball.learn.rollouts import make_pool
 
-    task = tasks[options.task]
     try:
         prepared = task.prepare(options.folder)
     except ValueError as err:

@@ -16,7 +16,7 @@ k_bandit its trials and mistakes, the params an EpsilonGreedy's settings).
 import multiprocessing
 from typing import NamedTuple, Optional
 
-from miro_ball.learn import tasks
+from miro_ball.learn.trainers import training_of
 
 
 class Outcome(NamedTuple):
@@ -30,19 +30,11 @@ class Outcome(NamedTuple):
 _ENVS = {}  # this process's environments, by their settings
 
 
-def training_of(settings):
-    """The training of the task ``settings`` name (tasks: its declaration)."""
-    task = tasks.named(settings['task'])
-    if task.training is None:
-        raise ValueError(f"task '{task.name}' has no training")
-    return task.training
-
-
 def _env(settings):
     key = tuple(sorted((name, str(value)) for name, value in settings.items()
                        if name != 'episode'))
     if key not in _ENVS:
-        _ENVS[key] = training_of(settings).environment(settings)
+        _ENVS[key] = training_of(settings['task']).environment(settings)
     return _ENVS[key]
 
 
@@ -71,7 +63,7 @@ def run_episode(job):
     or the caller): the task's training's episode; the environment of those settings is made
     once per process."""
     settings, params, seed = job
-    return training_of(settings).episode(_env(settings), settings, params, seed)
+    return training_of(settings['task']).episode(_env(settings), settings, params, seed)
 
 
 def evaluate_population(settings, params_list, seeds, pool=None, done=None):

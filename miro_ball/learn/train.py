@@ -7,7 +7,7 @@ import sys
 import time
 
 from miro_ball.common.cli import Parser
-from miro_ball.learn.trainers import MAX_SEED, trainable, TRAIN_STRIDE
+from miro_ball.learn.trainers import MAX_SEED, trainable, training_of, TRAIN_STRIDE
 
 PROG = 'python -m miro_ball.learn.train'
 MAX_MINUTES = 7 * 24 * 60
@@ -43,10 +43,12 @@ def build_parser(tasks):
     return parser
 
 
-def check(parser, options, tasks):
+def check(parser, options):
     """Refuse, in one line, what no training can take."""
-    if options.task not in tasks:
-        parser.error(f"unknown task '{options.task}' (tasks: {', '.join(tasks)})")
+    try:
+        training_of(options.task)
+    except ValueError as err:
+        parser.error(str(err))
     if not 0 < options.minutes <= MAX_MINUTES:
         parser.error(f'--minutes must be above 0 and at most {MAX_MINUTES}, '
                      f'got {options.minutes:g}')
@@ -72,7 +74,7 @@ def main(argv=None):
     tasks = trainable()
     parser = build_parser(tasks)
     options = parser.parse_args(argv)
-    check(parser, options, tasks)
+    check(parser, options)
     from tqdm import tqdm
 
     from miro_ball.learn.rollouts import make_pool

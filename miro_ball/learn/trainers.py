@@ -30,6 +30,17 @@ def trainable():
             if task.training is not None}
 
 
+def training_of(name):
+    """The training of the task called ``name``; ValueError (one line) if it has none."""
+    trainings = trainable()
+    if name in trainings:
+        return trainings[name]
+    if name in tasks.catalogue():
+        raise ValueError(f"task '{name}' has no training (tasks with one: "
+                         f"{', '.join(trainings)})")
+    raise ValueError(f"unknown task '{name}' (tasks: {', '.join(trainings)})")
+
+
 def training_seed(seed, index):
     return seed * TRAIN_STRIDE + index
 

@@ -84,8 +84,11 @@ def settle(rig, seconds=SETTLE_S):
 _found = {}  # the catalogue, once listed
 
 
-def catalogue():
-    """{name: Task subclass} of every task declared in a module of this package."""
+def catalogue(again=False):
+    """{name: Task subclass} of every task declared in a module of this package, as listed
+    first (``again``: listed anew, for a module added since)."""
+    if again:
+        _found.clear()
     if not _found:
         for module in pkgutil.iter_modules(__path__, f'{__name__}.'):
             for value in vars(importlib.import_module(module.name)).values():
@@ -98,8 +101,6 @@ def catalogue():
 def named(name):
     """The task called ``name``; ValueError (one line) naming those there are. A name not
     yet listed lists the package again (a module added since)."""
-    if name not in catalogue():
-        _found.clear()
-    if name not in catalogue():
+    if name not in catalogue() and name not in catalogue(again=True):
         raise ValueError(f"unknown task '{name}' (tasks: {', '.join(sorted(catalogue()))})")
     return catalogue()[name]
