@@ -54,7 +54,7 @@ def entity_filter(pattern, categories, tags, tag_mode, bounds):
 
 
 def entity_bounds(body):
-    """The standard's Bounds (type, [(x, y, z), ...]) of a world_file Shape or Ball in its
+    """The standard's Bounds (type, [(x, y, z), ...]) of a world_model Shape or Ball in its
     own frame (its centre): a sphere for the ball and a sphere, else the box round it
     (upper corner, then lower). A MiRo's are ROBOT_BOUNDS."""
     half = half_extents(body)
@@ -64,7 +64,7 @@ def entity_bounds(body):
 
 
 def default_entity(name, body=None):
-    """The Entity ``name`` is until set_entity_info says otherwise; ``body``: the world_file
+    """The Entity ``name`` is until set_entity_info says otherwise; ``body``: the world_model
     Shape or Ball it was built from, None for a MiRo. A shape's tags are its kind and its
     world-file table."""
     if body is None:

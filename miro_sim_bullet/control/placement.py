@@ -40,7 +40,7 @@ def spawn_at(world, spawn, position, yaw, code=SpawnResult.INVALID_POSE):
 
 
 def placed(body, position, yaw, ground):
-    """A world_file Ball or Shape centred at ``position``, or on its floor if that is
+    """A world_model Ball or Shape centred at ``position``, or on its floor if that is
     below it: the ball's own floor, a shape's the ground at height ``ground``; a shape
     turned by ``yaw`` (a ball has no heading)."""
     x, y, z = position
@@ -83,7 +83,7 @@ def robot_reach(foot, yaw):
 
 
 def reach(body):
-    """(low, high) corners of the upright box round a placed world_file Shape or Ball, a
+    """(low, high) corners of the upright box round a placed world_model Shape or Ball, a
     centimetre smaller on every side: bodies that only touch do not reach into each
     other. A ball, a sphere and a cylinder are the same turned any way about the
     vertical."""

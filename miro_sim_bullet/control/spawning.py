@@ -44,8 +44,8 @@ class RobotSpawn:
 
 @dataclass(frozen=True)
 class ShapeSpawn:
-    """A shape or the ball to build. body: a world_file.Shape (kind box, sphere or
-    cylinder; its name is ``name``) or the world_file.Ball (``name`` is 'ball'). The
+    """A shape or the ball to build. body: a world_model.Shape (kind box, sphere or
+    cylinder; its name is ``name``) or the world_model.Ball (``name`` is 'ball'). The
     request's pose replaces the body's position."""
     name: str
     body: object
@@ -81,7 +81,7 @@ def parse_spawn(name, allow_renaming, uri, resource_string, namespace, taken,
     - A URDF (text starting with '<', or a uri ending .urdf) must be MiRo-E's: not XML is
       RESOURCE_PARSE_ERROR, XML that is no <robot> UNSUPPORTED_FORMAT, another robot
       UNSUPPORTED_ASSETS. A TOML (a uri ending .toml, or any other text) holds one entity
-      (world_file.load_entity); a mistake in it is RESOURCE_PARSE_ERROR. Another file
+      (world_checks.load_entity); a mistake in it is RESOURCE_PARSE_ERROR. Another file
       type is UNSUPPORTED_FORMAT.
     - Names: empty takes the TOML table's name, else the namespace's, else with
       allow_renaming a fresh '<kind>N' (miro1, box1, ...), else NAME_INVALID. No ROS name,

@@ -78,7 +78,7 @@ class SimWorld:
         # body id -> (name or group, 'static' | 'mover' | 'robot'): what the scene calls it.
         self.body_labels = {}
         self._probes = {}  # half extents -> a collision shape for statics_within()
-        self.shape_of = {}  # body id -> the world_file Shape (or Ball) it was made from
+        self.shape_of = {}  # body id -> the world_model Shape (or Ball) it was made from
         if world.ground_height is not None:
             plane = Shape(kind='box', position=(0, 0, world.ground_height - 0.05),
                           size=(*world.ground_size, 0.1), colour=world.ground_colour,
@@ -318,7 +318,7 @@ class SimWorld:
         return robot
 
     def spawn_shape(self, shape):
-        """A named box, sphere or cylinder (world_file.Shape; mass 0 = static); ValueError
+        """A named box, sphere or cylinder (world_model.Shape; mass 0 = static); ValueError
         if the world has MAX_SHAPES already (a world file's limit too)."""
         if len(self.description.shapes) >= MAX_SHAPES:
             raise ValueError(f'the world has {MAX_SHAPES} shapes, the most it can hold')

@@ -6,11 +6,13 @@ tool written for Gazebo, Isaac Sim or O3DE drives this simulator through them: i
 (playing, paused, stopped, quitting), stepping, resetting by scope, its entities (list,
 state, info, bounds, spawn, delete), named poses, spawnable models and worlds.
 
-What the requests mean is decided by plain logic (control.*: filters, spawn requests, the
-state table, pose checks); what they do to time and to the node's interfaces (a robot
-spawned gets its topics, a world loaded gets new ones) belongs to the node, reached
-through ``host`` (node.SimNode). Every refusal is the standard's result code and one line,
-said as a rate-limited warning too.
+This module only turns messages into calls and back. What the requests mean is decided by
+plain logic (control.*: filters, entities' defaults and bounds, spawn requests, where a
+body goes, the state table, pose checks, accelerations) and the world (physics.world.
+SimWorld); what they do to time and to the node's interfaces (a robot spawned gets its
+topics, a world loaded gets new ones) belongs to the node, reached through ``host``
+(node.SimNode). Every refusal is the standard's result code and one line, said as a
+rate-limited warning too.
 """
 import dataclasses
 import traceback
