@@ -40,7 +40,7 @@ TIERS = {
              'test_record', 'test_restart', 'test_scenario_bench',
              'test_signals', 'test_sim_domain', 'test_soak', 'test_tutorial', 'test_grade_class',
              'test_grade_ray', 'test_refusals', 'test_learn_ros', 'test_learn_ray',
-             'test_sim_standard')),
+             'test_sim_standard', 'test_demo_mode_run')),
     'browser': ('the GUI in Debian\'s chromium through Playwright', ('test_gui_browser',)),
     'netns': ('hosts in network namespaces (root)', ('test_two_hosts',)),
 }

@@ -14,13 +14,14 @@ from miro_ball.animal.params import (ActionParams, AffectParams, Config, config_
                                      ExpressParams, FlagParams, letters_on, SleepParams,
                                      SpatialParams, AnimalNodeParams)
 from miro_ball.animal.selection import BasalGanglia, selector_class
-from miro_ball.animal.senses import Stimulus
+from miro_ball.animal.own_motion import KEEP_S, OwnMotion
+from miro_ball.animal.senses import Senses, Stimulus
 from miro_ball.animal.sleep import SleepModel
 from miro_ball.animal.voice import length_s, pitch_hz, vocalise
 from miro_ball.controller.behaviour import DEFAULT_CAMERAS
 from miro_ball.controller.contract import Eye, Percepts
 from miro_ball.controller.detection import Ball
-from miro_ball.miro.constants import KIN_CALIB_RAD, SPEAKER_SAMPLE_RATE_HZ
+from miro_ball.miro.constants import KIN_CALIB_RAD, SPEAKER_SAMPLE_RATE_HZ, YAW
 from miro_ball.miro.kc import CAML, CAMR, KinematicChain
 
 DT = 0.02
@@ -303,6 +304,33 @@ def test_a_ball_ahead_is_approached_and_a_rolling_one_does_not_make_it_dither():
     for start in range(0, len(chosen), 50):
         assert sum(start <= i < start + 50 for i in flips) <= 2
     assert len(set(chosen)) >= 2
+
+
+def test_a_sight_from_an_older_frame_is_placed_from_where_head_and_body_were_then():
+    """Issue 48: the face detector looks at one frame in six; what it found 0.4 s ago, with
+    the head then at rest, was placed from the head's pose now (turned 0.5 rad left), so it
+    landed 0.5 rad further left, while the body's own turn since was not taken off either:
+    orient chased it past the face."""
+    senses, motion = Senses(SpatialParams(), ActionParams()), OwnMotion()
+    ball = ball_at(0.5, 0.4)[0]  # the left eye's, with the head at rest
+    then = percepts(0.0, (ball, None))
+    motion.tick(0.0, KIN_CALIB_RAD)
+    fresh = senses.sights(then, include_motion=False, motion=motion)[0].azimuth
+    assert fresh == pytest.approx(math.atan2(0.4, 0.5), abs=0.1)
+    turning = list(KIN_CALIB_RAD)
+    for i in range(1, 21):  # 0.4 s turning left at 1 rad/s, the head yawing left
+        motion.told(1.0)
+        turning[YAW] = 0.025 * i
+        motion.tick(i * DT, turning)
+    eyes = (Eye(DEFAULT_CAMERAS[0], None, {'ball': ball}, 0.4, {'ball': 0.0}), then.eyes[1])
+    now = Percepts(0.4, eyes, joints=tuple(turning))
+    placed = senses.sights(now, include_motion=False, motion=motion)[0].azimuth
+    assert placed == pytest.approx(fresh - 0.4, abs=1e-6)
+    # From the head's pose now, as before: over 0.8 rad off, the wrong way.
+    assert senses.sights(now, include_motion=False)[0].azimuth > fresh + 0.4
+    # A stamp of another clock, or older than what is kept: the pose now is all there is.
+    assert motion.then(0.4 + 1e9) is None and motion.then(-KEEP_S) is None
+    assert motion.then(0.0).turned == pytest.approx(0.4)
 
 
 def test_asleep_the_wheels_stop_and_the_head_hangs():

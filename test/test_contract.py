@@ -14,7 +14,7 @@ from miro_ball.controller.contract import Action, Eye, Percepts
 from miro_ball.controller.controllers import controller_class, make_controller
 from miro_ball.controller.debug_folder import DebugFolder
 from miro_ball.controller.detection import Ball, DetectionParams
-from miro_ball.controller.detectors import DETECTORS, make_detectors, register
+from miro_ball.controller.detectors import DETECTORS, found_in, make_detectors, register
 from miro_ball.controller.params import ControllerParams
 from miro_ball.examples.controller_wag import Wag
 from miro_ball.miro.constants import COSMETIC_CALIB
@@ -42,6 +42,28 @@ def test_percepts_have_one_eye_per_eye_and_say_what_each_found():
     assert seen.cameras == DEFAULT_CAMERAS and seen.sonar == 0.3 and seen.touch_head is None
     with pytest.raises(ValueError, match='one Eye per eye'):
         Percepts(0.0, (Eye(DEFAULT_CAMERA),))
+
+
+def test_an_answer_handed_back_again_is_said_to_be_from_the_frame_it_was_found_in():
+    """A detector that looks at one frame in two hands back its last answer in between (as
+    the face detector does, face_every): the eye says it was found in the frame it looked
+    at; a fresh answer, or nothing found, is of its own frame."""
+    looks, answer = iter(range(100)), {}
+
+    def every_other():
+        look = next(looks)
+        if look % 2 == 0:
+            answer['last'] = ('a face', look)
+        return answer['last']
+    before, said = None, []
+    for stamp in (1.0, 1.1, 1.2, 1.3):
+        found = {'face': every_other(), 'ball': None}
+        carried = found_in(found, before)
+        eye = Eye(DEFAULT_CAMERA, None, found, stamp, carried)
+        said.append((eye.found_at('face'), eye.found_at('ball')))
+        before = (found, stamp, carried)
+    assert said == [(1.0, 1.0), (1.0, 1.1), (1.2, 1.2), (1.2, 1.3)]
+    assert Eye(DEFAULT_CAMERA).found_at('face') is None
 
 
 def test_the_ball_detector_is_one_by_name_among_others():

@@ -22,6 +22,7 @@ from miro_ball.animal.affect import AffectModel, Events
 from miro_ball.animal.attention import PriorityMap
 from miro_ball.animal.express import Expression
 from miro_ball.animal.feel import Feel
+from miro_ball.animal.own_motion import OwnMotion
 from miro_ball.animal.params import Config, FLAG_LETTERS
 from miro_ball.animal.selection import selector_class
 from miro_ball.animal.senses import Senses
@@ -30,7 +31,8 @@ from miro_ball.animal.voice import as_tone, length_s, vocalise
 from miro_ball.controller.contract import Action
 from miro_ball.miro.constants import (CLIFF_THRESHOLD, KIN_CALIB_RAD, LIFT_RAD_CALIB,
                                       PLATFORM_TICK_S, TILT_RAD)
-from miro_ball.miro.kinematics import cmd_vel2wheel_speed
+from miro_ball.miro.kinematics import (clamp_wheel_speeds, cmd_vel2wheel_speed,
+                                      wheel_speed2cmd_vel)
 
 SONAR_BAND_M = (0.10, 0.25)  # the MDK's sonar modulation: stop at the near end, free beyond
 SHUN_SPEED, SHUN_TURN = 0.1, 1.5  # backing off a drop, m/s and rad/s
@@ -65,6 +67,7 @@ class Animal:
         self.selector = selector_class(selector)(config.action, self.rng)
         self.express = Expression(config.express, config.flags, self.rng)
         self.senses = Senses(config.spatial, config.action)
+        self.own_motion = OwnMotion()
         self.selected, self.priorities = None, [0.0] * len(ACTIONS)
         self.peak = self.target = None
         self.stimuli = []
@@ -122,9 +125,11 @@ class Animal:
         self._last_t = t
         flags = self.config.flags
         joints = percepts.joints or KIN_CALIB_RAD
+        self.own_motion.tick(t, joints)
 
         still = t - self._moved_at >= self.config.spatial.motion_still_s
-        stimuli = [s for s in self.senses.sights(percepts, include_motion=still)
+        stimuli = [s for s in self.senses.sights(percepts, include_motion=still,
+                                                 motion=self.own_motion)
                    if self._noticed(s.kind)]
         heard = self.senses.sound(percepts.sound, joints)
         vocalising = t < self._vocalising_until
@@ -172,6 +177,7 @@ class Animal:
             action.stop(situation)  # (a pattern done sooner holds its end till then)
 
         wheels = self._reflexes(motor.forward, motor.turn, percepts, wakefulness)
+        self.own_motion.told(wheel_speed2cmd_vel(clamp_wheel_speeds(*wheels))[1])
         head = self._head_pose(motor, t, wakefulness)
         shown = self.express.step(t, dt, emotion.valence, emotion.arousal, wakefulness,
                                   touches.touched)

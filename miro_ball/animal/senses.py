@@ -3,9 +3,9 @@
 A Stimulus gives a direction in MiRo's body frame (azimuth 0 ahead, + to the left;
 elevation + up, both rad, seen from the head), the angle it spans and, for things of
 known size, its range. The eyes' detections go through each eye's camera model and the
-kinematic chain at the head's current joints, so what the left eye sees 27 degrees off
-its axis lands where it is; the ears' direction is in the head frame, turned by the
-head's yaw.
+kinematic chain at the head's joints of their frame's instant, and are turned by what the
+body turned since (own_motion.py), so what the left eye saw 27 degrees off its axis lands
+where it is now; the ears' direction is in the head frame, turned by the head's yaw.
 """
 import math
 from typing import NamedTuple, Optional
@@ -46,30 +46,35 @@ class Senses:
         self.spatial, self.action = spatial, action
         self.kc = KinematicChain(KIN_CALIB_RAD)
 
-    def sights(self, percepts, include_motion):
-        joints = percepts.joints or KIN_CALIB_RAD
-        self.kc.set_joints(*joints)
+    def sights(self, percepts, include_motion, motion=None):
+        """The stimuli of every eye's detections; motion (own_motion.OwnMotion) says where
+        head and body were when each was found (without it: where they are now)."""
+        now = percepts.joints or KIN_CALIB_RAD
         found = []
         for index, eye in enumerate(percepts.eyes):
-            frame = EYE_FRAMES[EYES[index]]
+            def seen(kind, sight, size, **more):
+                then = motion.then(eye.found_at(kind)) if motion is not None else None
+                return self._seen(kind, sight, size, eye.camera, EYE_FRAMES[EYES[index]],
+                                  index, then.joints if then else now,
+                                  then.turned if then else 0.0, **more)
             ball = eye.found('ball')
             if ball is not None:
-                found.append(self._seen('ball', ball, 2 * ball.r, eye.camera, frame, index,
-                                        self.action.ball_size_m))
+                found.append(seen('ball', ball, 2 * ball.r, known_size=self.action.ball_size_m))
             for face in eye.found('face') or ():
-                found.append(self._seen('face', face, face.size, eye.camera, frame, index,
-                                        self.action.face_size_m))
+                found.append(seen('face', face, face.size, known_size=self.action.face_size_m))
             for tag in eye.found('tag') or ():
-                found.append(self._seen('tag', tag, tag.size, eye.camera, frame, index,
-                                        tag_id=tag.id))
-            motion = eye.found('motion')
-            if motion is not None and include_motion:
-                found.append(self._seen('motion', motion, motion.size, eye.camera, frame,
-                                        index, strength=motion.conf))
+                found.append(seen('tag', tag, tag.size, tag_id=tag.id))
+            moving = eye.found('motion')
+            if moving is not None and include_motion:
+                found.append(seen('motion', moving, moving.size, strength=moving.conf))
         return found
 
-    def _seen(self, kind, sight, size, camera, frame, eye, known_size=None, strength=1.0,
-              tag_id=-1):
+    def _seen(self, kind, sight, size, camera, frame, eye, joints, turned, known_size=None,
+              strength=1.0, tag_id=-1):
+        """The Stimulus of a sight seen with the head at joints, the body having turned by
+        turned (rad, + left) since."""
+        if tuple(joints) != self.kc.joints:
+            self.kc.set_joints(*joints)
         u, v = _pixel(sight, camera)
         half = size * camera.width / 2
         centre = camera.pixel_to_direction(self.kc, frame, u, v, BODY)
@@ -80,7 +85,8 @@ class Senses:
         distance = None
         if known_size is not None and span > 1e-6:
             distance = known_size / (2 * math.tan(span / 2))
-        return Stimulus(kind, azimuth, elevation, span, distance, strength, eye, tag_id)
+        return Stimulus(kind, wrap(azimuth - turned), elevation, span, distance, strength, eye,
+                        tag_id)
 
     def sound(self, heard, joints):
         """A stimulus of a sound heard (miro.hearing.Heard), or None if too quiet."""

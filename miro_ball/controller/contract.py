@@ -28,10 +28,18 @@ class Eye:
     detections: Mapping[str, Any] = field(default_factory=dict)  # detector name -> result
     # The frame's header stamp (s): what is made of this frame (demo mode's overlays) says it.
     stamp: Optional[float] = None
+    # The stamp of an older frame a detector's result was found in, by detector name: one
+    # that looks at one frame in N (faces) hands back its last answer in between.
+    found_in: Mapping[str, float] = field(default_factory=dict)
 
     def found(self, name):
         """The named detector's result in this eye (None: nothing found, or not run)."""
         return self.detections.get(name)
+
+    def found_at(self, name):
+        """The stamp (s) of the frame the named detector's result was found in (None:
+        unknown). Where the head and body were then is where it was seen from."""
+        return self.found_in.get(name, self.stamp)
 
 
 @dataclass(frozen=True)

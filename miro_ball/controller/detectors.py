@@ -6,7 +6,10 @@ CameraModel at the frame's size). The result lands in ``Eye.detections[name]`` o
 the next Percepts. The node makes each detector once per eye (one may remember the
 eye's previous frame). "ball" is the tutorial's blue-ball detector (a Ball or None);
 "face" and "tag" find faces and AprilTags (tuples of sights.Sight), "motion" the
-largest moving region (a Sight or None).
+largest moving region (a Sight or None). A detector that looks at one frame in N (faces)
+returns its last answer, the very same object, for the frames in between: found_in()
+tells such an answer by that, and the node says which frame it was found in
+(``Eye.found_at``).
 """
 from typing import Any, Callable, Dict
 
@@ -50,3 +53,15 @@ register('ball', _ball)
 register('face', _sight('FaceDetector', with_camera=True))
 register('tag', _sight('TagDetector'))
 register('motion', _sight('MotionDetector'))
+
+
+def found_in(found, before):
+    """{name: stamp} of the results in ``found`` (this frame's, {name: result}) that their
+    detector handed back again: the very objects it gave for the eye's previous frame.
+    ``before``: (results, stamp, found_in) of that frame, or None. Such a result was found
+    in that frame, or in the one it was carried from in turn."""
+    if before is None:
+        return {}
+    results, stamp, carried = before
+    return {name: carried.get(name, stamp) for name, result in found.items()
+            if result is not None and result is results.get(name)}

@@ -40,7 +40,7 @@ from miro_ball.controller.behaviour import DEFAULT_CAMERAS
 from miro_ball.controller.contract import Eye, Percepts
 from miro_ball.controller.debug_folder import DebugFolder
 from miro_ball.controller.detection import annotate, DetectionParams
-from miro_ball.controller.detectors import make_detectors
+from miro_ball.controller.detectors import found_in, make_detectors
 from miro_ball.controller.names import DEBUG_TOPIC
 from miro_ball.miro.camera_model import CameraModel
 from miro_ball.miro.constants import CAM_HFOV_DEG_SIM, FRAME_SIZES, JOINT_NAMES, KIN_CALIB_RAD
@@ -317,7 +317,10 @@ class ControllerHost(Node):
         camera = self._frame_cameras[eye] = self.cameras[eye].scaled_to(width, height)
         found = {name: detect(frame, camera) for name, detect in self.detectors[eye].items()}
         self.frames_processed += 1
-        self.eyes[eye].set(now, (frame, found, taken))
+        # A face found in an older frame is placed from where the head was then.
+        previous = self.eyes[eye].value
+        self.eyes[eye].set(now, (frame, found, taken,
+                                 found_in(found, previous and previous[1:])))
         self._debug_image(eye, msg.header, frame, found.get('ball'))
 
     def _on_camera_info(self, eye, msg):
@@ -407,8 +410,8 @@ class ControllerHost(Node):
         stale = self.config.stale_s
         eyes = []
         for latest, camera in zip(self.eyes, self._frame_cameras):
-            frame, found, taken = latest.fresh(now, stale) or (None, {}, None)
-            eyes.append(Eye(camera, frame, found, taken))
+            frame, found, taken, carried = latest.fresh(now, stale) or (None, {}, None, {})
+            eyes.append(Eye(camera, frame, found, taken, carried))
         reading = {field: latest.fresh(now, stale) for field, latest in self.readings.items()}
         return Percepts(now, tuple(eyes), **reading)
 
