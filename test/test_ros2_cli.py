@@ -6,11 +6,12 @@ import sys
 import threading
 
 import pytest
+import rclpy
 import yaml
 
 from miro_ball.common.isolation import isolated_env
 from miro_ball.miro.interface import default_robot_name, RobotTopics, SIM_NODE_NAME
-from rostools import advance_until, kill_if_running
+from rostools import advance_until, kill_if_running, spin_until
 
 T = RobotTopics(default_robot_name())
 SIM = '/' + SIM_NODE_NAME
@@ -153,10 +154,31 @@ def test_params_and_services_of_the_simulator(paused_sim, executor):
     code, out, _ = ros2(['service', 'call', f'{SIM}/reset_simulation',
                          'simulation_interfaces/srv/ResetSimulation'], paused_sim, executor)
     assert code == 0 and 'Result(result=1,' in out.split('response:')[1]  # RESULT_OK
-    # ros2's line while a fresh node finds the service (it was never printed)
-    assert out.startswith('waiting for service to become available...\nrequester: making '
-                          'request: simulation_interfaces.srv.ResetSimulation_Request('), out
     assert abs(paused_sim.sim.robots[T.name].pose()[0]) < 0.01  # back where it started
+
+
+def test_a_service_call_says_it_waits_for_a_service_not_there_yet(ros_context, executor):
+    """ros2 service call's line while its service is not there (it was never printed); once
+    the service comes, the request goes and its answer is printed."""
+    from std_srvs.srv import Trigger
+
+    proc = subprocess.Popen([sys.executable, '-m', 'miro_ball.ros2', 'service', 'call',
+                             '/late/trigger', 'std_srvs/srv/Trigger'],
+                            env=isolated_env(int(os.environ['ROS_DOMAIN_ID'])),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline() == 'waiting for service to become available...\n'
+        node = rclpy.create_node('late', context=ros_context)
+        node.create_service(Trigger, '/late/trigger',
+                            lambda request, response: Trigger.Response(success=True))
+        executor.add_node(node)
+        spin_until(executor, lambda: proc.poll() is not None, 30.0, 'the call to end')
+        out, err = proc.communicate(timeout=10)
+    finally:
+        kill_if_running(proc)
+    assert (proc.returncode, err) == (0, ''), err
+    assert out.startswith('requester: making request: std_srvs.srv.Trigger_Request(')
+    assert 'response:\nstd_srvs.srv.Trigger_Response(success=True' in out
 
 
 @pytest.mark.parametrize('args,says', [
