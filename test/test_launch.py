@@ -1,6 +1,8 @@
 """python -m miro_ball.launch as a user runs it: the football pitch comes up from one command
 (the simulator, a controller per robot, the GUI), a robot kicks, and one Ctrl+C ends every
-process; a process that ends stops the others, unless its file says respawn."""
+process; a process whose file says on_exit="shutdown" (every node of ours) stops the others
+when it ends, one that says respawn is restarted, and any other leaves them running, as in
+ROS 2's launch."""
 import signal
 import sys
 import urllib.request
@@ -66,25 +68,59 @@ def script(folder, name, code):
     return f'{sys.executable} {folder / name}.py'
 
 
-def test_a_process_that_ends_is_said_in_one_line_and_the_others_are_stopped(tmp_path):
-    ready = tmp_path / 'ready'
-    waiter = script(tmp_path, 'waiter', f"""import pathlib, signal, sys, time
+def waiter_and_quitter(folder, quitter_says=''):
+    """A launch file: a waiter that stays until Ctrl+C or a file 'go' appears, and a
+    quitter that ends with code 3 once the waiter is up (its attributes: quitter_says)."""
+    ready, go = folder / 'ready', folder / 'go'
+    waiter = script(folder, 'waiter', f"""import os, pathlib, signal, sys, time
 signal.signal(signal.SIGINT, lambda *_: sys.exit(print('stopped by Ctrl+C')))
-pathlib.Path({str(ready)!r}).touch()
-time.sleep(99)
+pathlib.Path({str(ready)!r}).write_text(str(os.getpid()))
+while not os.path.exists({str(go)!r}):
+    time.sleep(0.01)
+print('still here')
 """)
-    quitter = script(tmp_path, 'quitter', f"""import os, sys, time
+    quitter = script(folder, 'quitter', f"""import os, sys, time
 while not os.path.exists({str(ready)!r}):  # the waiter is up
     time.sleep(0.01)
 print('bye')
 sys.exit(3)
 """)
-    launch = Launch(launch_file(tmp_path, f'''<executable name="waiter" cmd="{waiter}"/>
-                                            <executable name="quitter" cmd="{quitter}"/>'''))
-    code, output = launch.finish()
+    return launch_file(folder, f'''<executable name="waiter" cmd="{waiter}"/>
+                                  <executable name="quitter" cmd="{quitter}" {quitter_says}/>''')
+
+
+def test_a_process_whose_file_says_on_exit_shutdown_stops_the_others_when_it_ends(tmp_path):
+    code, output = Launch(waiter_and_quitter(tmp_path, 'on_exit="shutdown"')).finish()
     assert code == 1, output
     assert '[quitter] bye\n[launch] quitter exited with code 3; stopping the others\n' in output
     assert output.endswith('[waiter] stopped by Ctrl+C\n[launch] ended\n'), output
+    assert proc_tree.wait_gone([int((tmp_path / 'ready').read_text())], 0) == []
+
+
+def test_without_on_exit_the_others_go_on_and_the_run_ends_when_none_is_left(tmp_path):
+    """As under ros2 launch: a process that ends leaves the others running (ours stopped
+    them whatever its file said); the exit code says that one failed."""
+    launch = Launch(waiter_and_quitter(tmp_path))
+    launch.line('[launch] quitter exited with code 3; the others go on (its file does not '
+                'say on_exit="shutdown")')
+    (tmp_path / 'go').touch()
+    code, output = launch.finish()
+    assert code == 1, output
+    assert output.endswith('[waiter] still here\n[launch] waiter exited with code 0\n'
+                           '[launch] ended\n'), output
+
+
+def test_a_refused_simulator_stops_the_lab_it_was_launched_with():
+    """The lab of miro_ball's own files with a world that is not there: miro_sim refuses
+    it, and the controller is stopped with it rather than left driving another simulator
+    on the domain (which ros2 launch did before the files said on_exit="shutdown")."""
+    launch = Launch('lab', 'world:=/no/such/world.toml', 'gui:=false')
+    launch.line('[launch] miro_sim exited with code 2; stopping the others')
+    children = proc_tree.descendants(launch.proc.pid)  # the controller, unless it has gone
+    code, output = launch.finish()
+    assert code == 1, output
+    assert 'Traceback' not in output and output.endswith('[launch] ended\n'), output
+    assert proc_tree.wait_gone(children, 0) == []
 
 
 def test_a_process_whose_file_says_respawn_is_restarted(tmp_path):
@@ -134,7 +170,7 @@ sys.stdout.write('\\nend\\n')
     launch = Launch(launch_file(tmp_path, f'<executable name="hog" cmd="{hog}"/>'))
     code, output = launch.finish()
     lines = output.splitlines()
-    assert code == 1 and len(lines) == 5, [line[:80] for line in lines]  # the rest dropped
-    assert lines[1:] == [f'[hog] {"x" * MAX_LINE_BYTES} [cut at {MAX_LINE_BYTES} bytes]',
-                         '[hog] end', '[launch] hog exited with code 0; stopping the others',
-                         '[launch] ended'], [line[:80] for line in lines]
+    assert len(lines) == 5, [line[:80] for line in lines]  # the rest of the long line dropped
+    assert code == 0 and lines[1:] == [
+        f'[hog] {"x" * MAX_LINE_BYTES} [cut at {MAX_LINE_BYTES} bytes]', '[hog] end',
+        '[launch] hog exited with code 0', '[launch] ended'], [line[:80] for line in lines]
