@@ -14,6 +14,7 @@ from miro_ball.animal.params import (ActionParams, AffectParams, Config, config_
                                      ExpressParams, FlagParams, letters_on, SleepParams,
                                      SpatialParams, AnimalNodeParams)
 from miro_ball.animal.selection import BasalGanglia, selector_class
+from miro_ball.animal.map_view import map_in_eye
 from miro_ball.animal.own_motion import KEEP_S, OwnMotion
 from miro_ball.animal.senses import Senses, Stimulus
 from miro_ball.animal.sleep import SleepModel
@@ -154,6 +155,20 @@ def test_the_same_sight_each_tick_holds_its_salience_and_habituation_lowers_it()
     for _ in range(int(60 / DT)):
         late = attention.update(DT, [ball_ahead()]).height
     assert late < 0.7 * first
+
+
+def test_the_attention_view_of_an_older_frame_shows_the_map_where_it_was_then():
+    """The map is the body's now; a frame taken before the body turned 16 degrees left (four
+    of the map's cells) saw each thing 16 degrees further left: its view shows the map so."""
+    turned_since, now = PriorityMap(SpatialParams()), PriorityMap(SpatialParams())
+    turned_since.update(DT, [ball_ahead(math.radians(10))])
+    now.update(DT, [ball_ahead(math.radians(26))])
+    full = 4 * SpatialParams().peak_threshold
+    then = map_in_eye(turned_since.values, DEFAULT_CAMERAS[0], KC, CAML, full,
+                      turned=math.radians(16))
+    assert then.max() > 100
+    assert np.abs(then.astype(int) - map_in_eye(now.values, DEFAULT_CAMERAS[0], KC, CAML,
+                                                full)).max() <= 1
 
 
 # -- selection --------------------------------------------------------------------------------

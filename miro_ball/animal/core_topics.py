@@ -109,11 +109,13 @@ class CoreTopics:
     def _attention_view(self, seen, eye, joints):
         """The attention map as the eye ``seen`` (a contract Eye) sees it, stamped with its
         frame's stamp, so a viewer (the GUI) draws it, and the objects found in that frame,
-        on that very frame."""
-        self._kc.set_joints(*(joints or KIN_CALIB_RAD))
+        on that very frame: from where the head and body were when it was taken."""
         animal = self.host.controller
+        then = animal.own_motion.then(seen.stamp)
+        self._kc.set_joints(*(then.joints if then else joints or KIN_CALIB_RAD))
         picture = map_in_eye(animal.map.values, seen.camera, self._kc, EYE_FRAMES[eye],
-                             VIEW_FULL_SCALE * animal.config.spatial.peak_threshold)
+                             VIEW_FULL_SCALE * animal.config.spatial.peak_threshold,
+                             turned=then.turned if then else 0.0)
         msg = Image(height=picture.shape[0], width=picture.shape[1], encoding='mono8',
                     step=picture.shape[1], data=picture.tobytes())
         msg.header.stamp = (self.host.get_clock().now() if seen.stamp is None else
