@@ -273,3 +273,20 @@ def test_illum_is_kept(empty):
     empty.robot.set_illum([0xFF00FF00] * 6)
     empty.run(0.1)
     assert empty.robot.illum == [0xFF00FF00] * 6
+
+
+def test_a_reset_darkens_the_leds_a_command_lit(empty):
+    """A rewind restores bodies, not their colours: LEDs lit before a reset (the ROS
+    simulator's, a learning environment's) stayed lit in every eye and the overhead view
+    while the robot said they were dark, and a later 'all dark' changed nothing."""
+    from miro_ball.miro.body import ILLUM_NAMES
+    from miro_sim_bullet.bullet import pybullet as pb
+
+    def colours():
+        return [value for led in ILLUM_NAMES for value in pb.getVisualShapeData(
+            empty.robot.model.drawn.bodies[led], physicsClientId=empty.client)[0][7]]
+    fresh = colours()
+    empty.robot.set_illum([0xFFFF0000] * 6)
+    assert colours() != fresh
+    empty.reset()
+    assert empty.robot.illum == [0] * 6 and colours() == pytest.approx(fresh)

@@ -102,7 +102,12 @@ class MiroRobot:
         self.cosmetic_angles = self._cosmetic_targets()
         self.cosmetic_rates = [0.0] * len(self.cosmetic)
         self.flags = 0
-        self.illum = [0] * 6
+        dark = [0] * 6
+        # A rewind (SimWorld.rewind) restores the bodies but not their colours: LEDs lit
+        # before it stayed lit in every eye while the robot said they were dark.
+        if getattr(self, 'illum', dark) != dark:
+            self.model.show_illum(dark)
+        self.illum = dark
         self.speaker = Speaker()
         self.sound = None  # what the speaker sent into the world over the last tick
         # What the microphones heard (acoustics.hearing.MicBlock): the block that ended at the
