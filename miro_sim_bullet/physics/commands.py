@@ -26,8 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from miro_ball.miro.checks import finite_values
-from miro_ball.miro.constants import (JOINT_LIMITS_RAD, JOINT_NAMES, JOINT_POSITIONS,
-                                      WHEEL_MAX_SPEED_M_PER_S)
+from miro_ball.miro.constants import JOINT_NAMES, JOINT_POSITIONS, WHEEL_MAX_SPEED_M_PER_S
 from miro_ball.miro.kinematics import clamp_wheel_speeds, clamped_cmd_vel
 
 

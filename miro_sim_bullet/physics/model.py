@@ -10,9 +10,7 @@ these shapes, so they see the MiRo the URDF describes.
 import numpy as np
 
 from miro_ball.miro import body as desc
-# The sensors' reach is MiRo's (miro.constants); the physics casts its rays that far.
-from miro_ball.miro.constants import (CLIFF_RANGE, JOINT_LIMITS_RAD, LIFT, PITCH,
-                                      SONAR_HALF_CONE, SONAR_RANGE, TILT_RAD, YAW)
+from miro_ball.miro.constants import JOINT_LIMITS_RAD, LIFT, PITCH, TILT_RAD, YAW
 from miro_ball.miro.kc import AXLE_HEIGHT_M as AXLE_HEIGHT
 from miro_sim_bullet.bullet import pybullet as pb
 from miro_sim_bullet.physics.drawn import carried_mass, COSMETIC, DrawnParts, SOLVED

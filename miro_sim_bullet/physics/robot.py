@@ -10,9 +10,9 @@ from typing import NamedTuple
 import numpy as np
 
 from miro_ball.miro.checks import finite
-from miro_ball.miro.constants import (CLIFF_THRESHOLD, COSMETIC_CALIB,
+from miro_ball.miro.constants import (CLIFF_RANGE, CLIFF_THRESHOLD, COSMETIC_CALIB,
                                       DOWNSTREAM_FLAG_DISABLE_CLIFF_REFLEX, JOINT_LIMITS_RAD,
-                                      KIN_CALIB_RAD, PLATFORM_TICK_S, TILT_RAD,
+                                      KIN_CALIB_RAD, PLATFORM_TICK_S, SONAR_RANGE, TILT_RAD,
                                       WHEEL_RADIUS_M)
 from miro_ball.miro.body import LINK, MICS
 from miro_ball.miro.kc import camera_in_head, SONAR_IN_HEAD
@@ -244,9 +244,9 @@ class MiroRobot:
         cliff_starts, cliff_ends = self._cliff_rays()
         sonar_starts, sonar_ends = self._sonar_rays()
         hits = self._rays(cliff_starts + sonar_starts, cliff_ends + sonar_ends)
-        cliff = tuple(cliff_value(h[2] * rb.CLIFF_RANGE if h[0] >= 0 else math.inf)
+        cliff = tuple(cliff_value(h[2] * CLIFF_RANGE if h[0] >= 0 else math.inf)
                       for h in hits[:len(cliff_starts)])
-        lo, hi = rb.SONAR_RANGE
+        lo, hi = SONAR_RANGE
         found = [h[2] * hi for h in hits[len(cliff_starts):] if h[0] >= 0]
         return cliff, max(lo, min(found)) if found else math.inf
 
@@ -284,7 +284,7 @@ class MiroRobot:
         pos, rot = self.frames['body']
         ray_dir = rot @ _CLIFF_DIRECTION
         starts = [pos + rot @ where for where in _CLIFF_POINTS]
-        return [s.tolist() for s in starts], [(s + rb.CLIFF_RANGE * ray_dir).tolist()
+        return [s.tolist() for s in starts], [(s + CLIFF_RANGE * ray_dir).tolist()
                                               for s in starts]
 
     def _sonar_rays(self):
@@ -292,7 +292,7 @@ class MiroRobot:
         arrays)."""
         pos, rot = self.frames['head']
         start = pos + rot @ _SONAR_POINT
-        ends = start + rb.SONAR_RANGE[1] * SONAR_DIRECTIONS @ rot.T
+        ends = start + SONAR_RANGE[1] * SONAR_DIRECTIONS @ rot.T
         return [start.tolist()] * len(ends), ends.tolist()
 
     def _imu(self, orn, lin, ang, part):

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from miro_ball.miro.constants import TILT_RAD
+from miro_ball.miro.constants import CLIFF_RANGE, SONAR_HALF_CONE, TILT_RAD
 from miro_sim_bullet.physics import model as rb
 
 GRAVITY = 9.8
@@ -55,7 +55,7 @@ def cone_directions(half_angle, rings=(0.5, 1.0), per_ring=6):
     return np.array(directions)
 
 
-SONAR_DIRECTIONS = cone_directions(rb.SONAR_HALF_CONE)
+SONAR_DIRECTIONS = cone_directions(SONAR_HALF_CONE)
 
 
 def _nominal_cliff_distance():
@@ -71,8 +71,8 @@ NOMINAL_CLIFF_DISTANCE = _nominal_cliff_distance()
 def cliff_value(distance):
     """1 over floor at the resting distance, falling to 0 where the ray finds nothing,
     in the 1/15 steps the platform reports."""
-    span = rb.CLIFF_RANGE - NOMINAL_CLIFF_DISTANCE
-    value = min(max((rb.CLIFF_RANGE - distance) / span, 0.0), 1.0)
+    span = CLIFF_RANGE - NOMINAL_CLIFF_DISTANCE
+    value = min(max((CLIFF_RANGE - distance) / span, 0.0), 1.0)
     return round(value * 15) / 15
 
 

@@ -9,12 +9,11 @@ from sensor_msgs.msg import BatteryState, CameraInfo, CompressedImage, Image, Im
 from std_msgs.msg import Float32MultiArray
 
 from miro_ball.miro.body import MOVABLE
-from miro_ball.miro.constants import JOINT_NAMES
+from miro_ball.miro.constants import JOINT_NAMES, SONAR_HALF_CONE, SONAR_RANGE
 from miro_ball.miro.interface import frame_id, WORLD_FRAME
 from miro_ball.miro.rotations import yaw_quaternion
 from miro_sim_bullet.control.codes import Refused
 from miro_sim_bullet.control.poses import check_pose
-from miro_sim_bullet.physics import model as rb
 from miro_sim_bullet.render.eye_images import JPEG_FORMAT
 
 def stamp(seconds):
@@ -71,8 +70,8 @@ def floats(values):
 
 
 def sonar(s, when, robot):
-    lo, hi = rb.SONAR_RANGE
-    msg = Range(radiation_type=Range.ULTRASOUND, field_of_view=2 * rb.SONAR_HALF_CONE,
+    lo, hi = SONAR_RANGE
+    msg = Range(radiation_type=Range.ULTRASOUND, field_of_view=2 * SONAR_HALF_CONE,
                 min_range=lo, max_range=hi, range=s.sonar)
     msg.header.stamp, msg.header.frame_id = when, frame_id(robot, 'sonar')
     return msg
