@@ -174,6 +174,32 @@ def test_kick_ball_with_no_eyes_is_state_only_and_a_detector_asked_for_is_refuse
     assert str(refused.value) == 'detectors ball need eyes: give eyes=(w, h)'
 
 
+@pytest.mark.parametrize('env_id,options,says', [
+    ('KickBall', dict(frame_skip=2 ** 63),
+     'frame_skip must be a whole number 1 to 65535, got 9223372036854775808'),
+    ('KickBall', dict(detectors='ball'),
+     "detectors is a tuple of names, as ('ball',), not 'ball'"),
+    ('KickBall', dict(hears='no'), "hears must be True or False, not 'no'"),
+    ('KBandit', dict(trials=2.5), 'trials must be a whole number >= 1, got 2.5'),
+    ('KBandit', dict(trials=0), 'trials must be a whole number >= 1, got 0'),
+    ('KBandit', dict(mistakes=2), 'mistakes must be a probability 0 to 1, got 2'),
+    ('KBandit', dict(mistakes=math.nan), 'mistakes must be a probability 0 to 1, got nan'),
+    ('TMaze', dict(cue='no'), "cue must be True or False, got 'no'"),
+])
+def test_an_option_taken_as_something_else_is_refused_in_one_line_building_nothing(
+        env_id, options, says, monkeypatch):
+    """frame_skip=2**63 made a step that never ended; detectors='ball' was "no detector
+    named 'b', 'a', 'l', 'l'"; hears='no' and cue='no' were taken as True; KBandit ran
+    trials=2.5 as 3 and took mistakes=2 (always wrong) and NaN (never)."""
+    def build(*_, **__):
+        raise AssertionError('a world was built for a refused environment')
+
+    monkeypatch.setattr(core, 'WorldRig', build)
+    with pytest.raises(ValueError) as refused:
+        gymnasium.make(f'miro_ball/{env_id}-v0', **options)
+    assert str(refused.value) == says
+
+
 def test_a_keyword_no_environment_takes_is_refused_in_one_line_naming_those_there_are():
     """Any keyword the environment does not have goes to the rig (its eyes' options reach
     both faces that way); one the rig does not take either is refused before a build."""

@@ -140,6 +140,28 @@ def test_an_action_for_a_robot_that_is_not_playing_is_refused_in_one_line():
     env.close()
 
 
+def test_football_refuses_steps_and_seeds_that_are_none_in_one_line_and_replays_exactly():
+    """step(None) was "'NoneType' object has no attribute 'items'" from inside the core;
+    reset(seed=-1), ('x') and (1.5) were taken, where Gymnasium's face refuses them."""
+    env = football.parallel_env(robots=2, eyes=None)
+
+    def episode():
+        env.reset(seed=4)
+        for _ in range(5):
+            env.step({agent: {'wheels': np.array([0.3, 0.2])} for agent in env.agents})
+        return [robot.pose() for robot in env.rig.sim.robots.values()]
+    first = episode()
+    for actions in (None, [], 'miro01'):
+        with pytest.raises(ValueError, match=r'^actions is a dict \{agent: action\} \(agents: '
+                                             r'miro01, miro02\), got '):
+            env.step(actions)
+    for seed in (-1, 'x', 1.5, True):
+        with pytest.raises(ValueError, match='^seed must be a whole number >= 0 or None, got '):
+            env.reset(seed=seed)
+    assert episode() == first
+    env.close()
+
+
 def test_football_placements_are_seeded_apart_and_on_the_pitch():
     half = (1.65, 1.0)
     for seed in range(200):
@@ -180,7 +202,9 @@ def test_football_rewards_the_robot_that_drives_to_the_ball_and_the_kicker():
 @pytest.mark.parametrize('kwargs', [dict(robots=0), dict(robots='3'), dict(robots=13),
                                     dict(eyes=(3, 3)), dict(eyes='big'), dict(frame_skip=0),
                                     dict(limit_s=-1), dict(eyes=None, detectors=('ball',)),
-                                    dict(world='miro'), dict(world='nowhere')])
+                                    dict(world='miro'), dict(world='nowhere'),
+                                    dict(frame_skip=2 ** 63), dict(detectors='ball'),
+                                    dict(hears='yes')])
 def test_football_refuses_garbage_in_one_line(kwargs):
     with pytest.raises(ValueError) as refused:
         football.parallel_env(**kwargs)

@@ -39,6 +39,10 @@ from miro_ball.learn.tasks import Task
 RENDER_MODES = ('rgb_array',)
 TIME_EPS_S = 1e-9  # simulated time is a sum of steps: a limit reached is reached
 CORE_OPTIONS = ('world', 'eyes', 'detectors', 'hears', 'frame_skip', 'render_mode')
+# A step's tone sounds for the step: its duration is a uint16 of platform ticks (control/
+# tone), so a step is at most that long (21 min 50 s simulated). Without a bound,
+# frame_skip=2**63 made a step that never ended.
+MAX_FRAME_SKIP = 0xFFFF
 
 
 class Step(NamedTuple):
@@ -52,8 +56,9 @@ class Step(NamedTuple):
 
 def check_frame_skip(frame_skip):
     if isinstance(frame_skip, bool) or not isinstance(frame_skip, (int, np.integer)) \
-            or frame_skip < 1:
-        raise ValueError(f'frame_skip must be a whole number >= 1, got {frame_skip!r}')
+            or not 1 <= frame_skip <= MAX_FRAME_SKIP:
+        raise ValueError(f'frame_skip must be a whole number 1 to {MAX_FRAME_SKIP}, '
+                         f'got {frame_skip!r}')
     return int(frame_skip)
 
 
@@ -68,6 +73,9 @@ def resolve_detectors(task, eyes, detectors):
     eyes; ValueError (one line) for a detector named without eyes."""
     if detectors is None:
         return task.detectors if eyes is not None else ()
+    if isinstance(detectors, str):  # tuple('ball') was "no detector named 'b', 'a', ..."
+        raise ValueError(f'detectors is a tuple of names, as ({detectors!r},), not '
+                         f'{detectors!r}')
     detectors = tuple(detectors)
     if detectors and eyes is None:
         raise ValueError(f'detectors {", ".join(detectors)} need eyes: give eyes=(w, h)')
@@ -103,7 +111,10 @@ class EpisodeCore:
         eyes = options.pop('eyes', task.eyes)
         spaces.check_eyes(eyes)
         detectors = resolve_detectors(task, eyes, options.pop('detectors', None))
-        hears = bool(options.pop('hears', False))
+        hears = options.pop('hears', False)
+        if not isinstance(hears, (bool, np.bool_)):  # bool('no') is True
+            raise ValueError(f'hears must be True or False, not {hears!r}')
+        hears = bool(hears)
         self.rig = WorldRig(world, eyes=eyes, detectors=detectors, hears=hears,
                             **rig_options(options))
         self.agents = tuple(self.rig.sim.robots)
@@ -119,8 +130,12 @@ class EpisodeCore:
         """A new episode (see the module); each agent's info."""
         rig, task = self.rig, self.task
         rig.check_open()
+        # As Gymnasium's reset checks it, for both faces (PettingZoo's took -1, 'x' and 1.5).
+        if seed is not None and (isinstance(seed, bool) or
+                                 not isinstance(seed, (int, np.integer)) or seed < 0):
+            raise ValueError(f'seed must be a whole number >= 0 or None, got {seed!r}')
         if seed is not None or self._placer is None:
-            self._placer = random.Random(seed)  # None: from the system's entropy
+            self._placer = random.Random(None if seed is None else int(seed))  # None: entropy
         rig.restore()
         task.start(rig, self._placer)
         self._start = rig.t
@@ -136,6 +151,9 @@ class EpisodeCore:
         line (naming the agent when there are several) before anything moves."""
         rig, task = self.rig, self.task
         rig.check_open()
+        if not hasattr(actions, 'items'):  # None was "'NoneType' object has no attribute"
+            raise ValueError(f'actions is a dict {{agent: action}} (agents: '
+                             f'{", ".join(self.agents)}), got {type(actions).__name__}')
         checked = {}
         for agent, action in actions.items():
             if agent not in self.action_spaces:

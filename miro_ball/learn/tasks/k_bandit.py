@@ -195,6 +195,12 @@ class KBandit(Task):
     frame_skip = SHOW_TICKS
 
     def __init__(self, trials=30, mistakes=0.1):
+        # trials=2.5 ran 3; mistakes=2 made the person always wrong, NaN never.
+        if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
+            raise ValueError(f'trials must be a whole number >= 1, got {trials!r}')
+        if isinstance(mistakes, bool) or not isinstance(mistakes, (int, float)) or \
+                not 0.0 <= mistakes <= 1.0:
+            raise ValueError(f'mistakes must be a probability 0 to 1, got {mistakes!r}')
         self.limit_s = trials * SHOW_TICKS * 0.02
         self.mistakes = mistakes
         self.liked = None

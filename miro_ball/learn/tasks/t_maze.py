@@ -51,8 +51,10 @@ class TMaze(Task):
     def __init__(self, limit_s=20.0, cue=True, arm=None):
         if arm not in (None, *ARMS):
             raise ValueError(f"arm must be 'left', 'right' or None, got {arm!r}")
+        if not isinstance(cue, bool):  # bool('no') is True
+            raise ValueError(f'cue must be True or False, got {cue!r}')
         self.limit_s = limit_s
-        self.cue = bool(cue)
+        self.cue = cue
         self.fixed_arm = arm
         self.arm = self.at = None
 
