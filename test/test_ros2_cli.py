@@ -197,6 +197,13 @@ def test_a_service_call_says_it_waits_for_a_service_not_there_yet(ros_context, e
     (['topic', 'pub', '--once', '/bad topic', 'std_msgs/msg/String', '{data: hi}'],
      "'/bad topic' is not a ROS name"),
     (['service', 'call', '/a//b', 'std_srvs/srv/Trigger'], "'/a//b' is not a ROS name"),
+    # A traceback from inside rclpy; and "no service" for a service that is there
+    (['param', 'set', SIM, 'step_count', '9' * 23], "'" + '9' * 23 + "' is beyond an "
+     'integer parameter (64 bits: -9223372036854775808 to 9223372036854775807)'),
+    (['service', 'call', f'{SIM}/reset_simulation',
+      'simulation_interfaces/srv/GetSimulationState'],
+     f'{SIM}/reset_simulation is a simulation_interfaces/srv/ResetSimulation service, not '
+     'simulation_interfaces/srv/GetSimulationState'),
     (['topic', 'pub', '--once', T.cmd_vel, 'geometry_msgs/msg/TwistStamped',
       '{twist: ' + '[' * 5000 + ']' * 5000 + '}'], 'the values are nested too deeply'),
     (['topic', 'pub', '--once', '/x', 'std_msgs/msg/String', '{data: [&a0 [1, 2], '

@@ -150,6 +150,13 @@ class Graph:
             if say is not None and not client.service_is_ready():
                 print(WAITING_LINE, flush=True)
             if not client.wait_for_service(timeout_sec=seconds):
+                # A client of another type never finds it: that is not "no service". (The
+                # graph lists this client's own type under the name too.)
+                wanted = _type_name(srv_class)
+                served = [kind for kind in self.services().get(service, ()) if kind != wanted]
+                if served:
+                    raise CliError(f'{service} is a {", ".join(served)} service, not '
+                                   f'{wanted}')
                 raise CliError(f'no service {service} on ROS domain {self.domain} (the '
                                'services: python -m miro_ball.ros2 service list)')
             if say is not None:
@@ -161,6 +168,11 @@ class Graph:
             return future.result()
         finally:
             self.node.destroy_client(client)
+
+
+def _type_name(srv_class):
+    """'package/srv/Name' of a service class."""
+    return f'{srv_class.__module__.split(".")[0]}/srv/{srv_class.__name__}'
 
 
 def _join(namespace, name):

@@ -259,6 +259,10 @@ def parameter_value(text):
         value = text
     kinds = ((bool, ParameterType.PARAMETER_BOOL), (int, ParameterType.PARAMETER_INTEGER),
              (float, ParameterType.PARAMETER_DOUBLE), (str, ParameterType.PARAMETER_STRING))
+    if isinstance(value, int) and not isinstance(value, bool) and \
+            not -2 ** 63 <= value < 2 ** 63:  # was a traceback from inside rclpy
+        raise CliError(f'{text[:100]!r} is beyond an integer parameter (64 bits: '
+                       f'{-2 ** 63} to {2 ** 63 - 1})')
     for kind, code in kinds:
         if isinstance(value, kind):
             field = PARAMETER_VALUE[code][0]
