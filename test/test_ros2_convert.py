@@ -32,6 +32,16 @@ def test_a_list_of_messages_is_filled_from_a_list_of_mappings():
     assert [p.position.x for p in msg.poses] == [1.0, 0.0]
 
 
+def test_a_number_yaml_1_1_reads_as_text_fills_a_float_field_as_ros2_does():
+    """PyYAML reads 1e-3 (no dot) as text: {x: 1e-3} was 'give a number, not '1e-3''."""
+    msg = fill(TwistStamped(), parse_yaml('{twist: {linear: {x: 1e-3, y: -2E+2, z: .5e1}}}'))
+    assert (msg.twist.linear.x, msg.twist.linear.y, msg.twist.linear.z) == (0.001, -200.0, 5.0)
+    assert list(fill(Float32MultiArray(), parse_yaml('{data: [1e2]}')).data) == [100.0]
+    for text in ('1e', 'e5', '1e5x', '0x10', 'inf'):
+        with pytest.raises(ValueError, match='give a number'):
+            fill(TwistStamped(), {'twist': {'linear': {'x': text}}})
+
+
 @pytest.mark.parametrize('values,says', [
     ({'twist': {'linar': {}}}, "no field 'twist.linar'"),
     ({'twist': {'linear': {'x': 'fast'}}}, 'give a number'),

@@ -10,6 +10,7 @@ SLOT_TYPES; rosidl_runtime_py, which does this for ``ros2``, is not on PyPI).
 - field(msg, path): the value of 'twist.linear.x' (``--field``).
 """
 import math
+import re
 from array import array
 
 import numpy as np
@@ -142,6 +143,9 @@ def _sequence(msg, name, value, where):
 
 
 FLOATS = ('float', 'double', 'long double')
+# A float as YAML 1.2 writes it. PyYAML reads YAML 1.1, where 1e-3 (no dot) is text, and
+# ros2 makes a float field of that text all the same: so do we ('give a number, not 1e-3').
+FLOAT_TEXT = re.compile(r'[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)([eE][-+]?[0-9]+)?')
 INTEGERS = {'octet': (0, 255), **{f'int{bits}': (-2 ** (bits - 1), 2 ** (bits - 1) - 1)
                                   for bits in (8, 16, 32, 64)},
             **{f'uint{bits}': (0, 2 ** bits - 1) for bits in (8, 16, 32, 64)}}
@@ -156,6 +160,8 @@ def _scalar(value, type_name, where):
             raise ValueError(f'{where} is a bool: give true or false')
         return value
     if type_name in FLOATS:
+        if isinstance(value, str) and FLOAT_TEXT.fullmatch(value):
+            value = float(value)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ValueError(f'{where} is a {type_name}: give a number, not {value!r}')
         return float(value)
