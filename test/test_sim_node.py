@@ -197,6 +197,7 @@ BOTH_DOORS = [
     ('kinematic_targets', JointState(position=[0.0, 1e9, -1e9, 0.0]),
      {'head': (0.0, 1e9, -1e9, 0.0)}, 'clamped'),
     ('cosmetic_joints', Float32MultiArray(data=[1e9] * 6), {'cosmetic': (1e9,) * 6}, 'clamped'),
+    ('tone', UInt16MultiArray(data=[440, 65535, 250]), {'tone': (440, 65535, 250)}, 'clamped'),
 ]
 
 

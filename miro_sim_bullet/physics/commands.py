@@ -26,7 +26,8 @@ from typing import NamedTuple
 import numpy as np
 
 from miro_ball.miro.checks import finite_values
-from miro_ball.miro.constants import JOINT_NAMES, JOINT_POSITIONS, WHEEL_MAX_SPEED_M_PER_S
+from miro_ball.miro.constants import (JOINT_NAMES, JOINT_POSITIONS, TONE_VOLUME_MAX,
+                                      WHEEL_MAX_SPEED_M_PER_S)
 from miro_ball.miro.kinematics import clamp_wheel_speeds, clamped_cmd_vel
 
 
@@ -153,7 +154,11 @@ def _illum(robot, values):
 
 
 def _tone(robot, values):
-    robot.play_tone(*values.tolist())  # clipped to the platform's range, as the MDK does
+    frequency, volume, ticks = values.tolist()
+    robot.play_tone(frequency, volume, ticks)  # the frequency clipped as the MDK clips it
+    # A volume past 255 was made 255 without a word.
+    return f'volume {volume} clamped to {TONE_VOLUME_MAX}' if volume > TONE_VOLUME_MAX \
+        else None
 
 
 def _stream(robot, values):
