@@ -7,6 +7,7 @@ every entity's state is finite.
 import math
 import os
 import threading
+import time
 from types import SimpleNamespace
 
 import pytest
@@ -196,6 +197,23 @@ def test_a_reset_rewinds_the_world_unless_a_body_came_or_went(paused_sim):
     assert node.sim.generation > built  # built anew: the crate is gone
     assert states() == fresh
     still_works(node)
+
+
+def test_the_progress_lines_real_time_factor_counts_the_steps_taken_across_a_reset(
+        paused_sim, monkeypatch):
+    """It was the clock's change over the wall time: a reset between two lines made it
+    negative ('real-time factor -2.64')."""
+    node = paused_sim
+    node._progress = (time.monotonic(), node.steps_taken)
+    ok(serve(node, srv.StepSimulation, steps=500))
+    ok(serve(node, srv.ResetSimulation))
+    ok(serve(node, srv.StepSimulation, steps=100))
+    said = []
+    monkeypatch.setattr(node, 'get_logger', lambda: SimpleNamespace(info=said.append))
+    node._progress = (node._progress[0] - 10.0, node._progress[1])  # the line is due
+    node._report_progress()
+    factor = float(said[0].split('real-time factor ')[1].split(',')[0])
+    assert said[0].startswith('sim time 0.2 s,') and 0.1 <= factor <= 0.12, said
 
 
 def test_a_falling_balls_acceleration_is_gravity(paused_sim):

@@ -162,7 +162,10 @@ class SimNode(Node):
             [PLATFORM, CAMERA, *(kind for i in self.robots.values() for kind in i.streams)],
             Timing(self.sim.dt, self.sim.ticks_per_platform_tick, p.camera_rate))
         self._restart_schedule()
-        self._progress = (time.monotonic(), 0.0)
+        # The progress line's real-time factor counts the steps taken, not the clock's
+        # change: a reset between two lines made it negative.
+        self.steps_taken = 0
+        self._progress = (time.monotonic(), 0)
         self.timer = self._make_timer()
         # A Twist on control/cmd_vel (the MDK's is TwistStamped) is not heard at all: say so.
         self._wrong_types_said = set()
@@ -394,14 +397,14 @@ class SimNode(Node):
         self._report_progress()
 
     def _report_progress(self):
-        wall, sim_time = self._progress
+        wall, steps = self._progress
         now = time.monotonic()
         if now - wall >= 10.0:
             self.get_logger().info(
                 f'sim time {self.sim.time:.1f} s, real-time factor '
-                f'{(self.sim.time - sim_time) / (now - wall):.2f}, '
+                f'{(self.steps_taken - steps) * self.sim.dt / (now - wall):.2f}, '
                 f'{self.frames_published} camera frames')
-            self._progress = (now, self.sim.time)
+            self._progress = (now, self.steps_taken)
 
     def advance(self, steps):
         """Step physics, publishing /clock, sensors and ground truth each platform tick and
@@ -422,6 +425,7 @@ class SimNode(Node):
         for _ in range(steps):
             started = clock()
             sim.step(listening=listening)
+            self.steps_taken += 1
             spent['physics'] += clock() - started
             if self.sim_interface is not None:
                 self.sim_interface.look_for_touches()
