@@ -330,8 +330,12 @@ def test_a_nan_in_an_action_is_refused_and_the_next_episodes_are_sound():
     ('wheels', [0.1, -np.inf], 'is not finite'),
     ('tone', [440.0], r'has shape \(1,\)'),
     ('wheel', [0.1, 0.1], r"no action part 'wheel' \(parts: cosmetic, head, illum"),
+    # Taken as 0.1 and 0.2, and as 0.1 with the 5j dropped
+    ('wheels', ['0.1', '0.2'], 'is not numbers; its space is Box'),
+    ('wheels', [0.1 + 5j, 0.1], 'is not numbers; its space is Box'),
+    ('wheels', np.array([0.1, 'x'], dtype=object), 'is not numbers; its space is Box'),
 ], ids=['head-5', 'cosmetic-2', 'cosmetic-20', 'illum-2-rows', 'illum-halves', 'wheels-inf',
-        'tone-short', 'unknown-part'])
+        'tone-short', 'unknown-part', 'wheels-text', 'wheels-complex', 'wheels-objects'])
 def test_an_action_outside_its_space_is_refused_naming_the_part(part, value, problem):
     env = MiroEnv(KickBall(), eyes=None, detectors=())
     env.reset(seed=1)

@@ -123,9 +123,15 @@ def check_part(name, space, value):
     shape, finite, within the bounds (give or take BOUND_SLACK for a float space), whole
     numbers for a whole-number space."""
     try:
-        array = np.asarray(value, dtype=np.float64)
+        array = np.asarray(value)
+        if array.dtype.kind == 'O':  # numbers in an object array: their own dtype
+            array = np.asarray(array.tolist())
     except (TypeError, ValueError, OverflowError):
+        array = None
+    # Only real numbers: float64 made ['0.1', '0.2'] numbers and dropped 0.1+5j's 5j.
+    if array is None or array.dtype.kind not in 'biuf':
         raise ValueError(f'{name} is not numbers; its space is {space}') from None
+    array = array.astype(np.float64)
     if array.shape != space.shape:
         raise ValueError(f'{name} has shape {array.shape}; its space is {space}')
     whole = space.dtype.kind in 'iu'
