@@ -200,6 +200,33 @@ def test_an_option_taken_as_something_else_is_refused_in_one_line_building_nothi
     assert str(refused.value) == says
 
 
+def connected_worlds():
+    """How many PyBullet worlds this process has connected."""
+    from miro_sim_bullet.bullet import pybullet as pb
+    return sum(pb.isConnected(client) for client in range(1024))
+
+
+@pytest.mark.parametrize('options,says', [
+    (dict(detectors=['nope']), "no detector named 'nope' (known: ball, face, motion, tag)"),
+    (dict(lens='x'), "parameter lens must be pinhole or miro, got 'x'"),
+    (dict(eyes=None, renderer='x'), "parameter renderer must be auto or tiny or egl, got 'x'"),
+])
+def test_a_refused_environment_leaves_no_world_connected(options, says, monkeypatch):
+    """These were refused after the world was built, and each try left its PyBullet world
+    connected; so did anything failing after the build (no EGL, ...)."""
+    before = connected_worlds()
+    with pytest.raises(ValueError) as refused:
+        gymnasium.make('miro_ball/KickBall-v0', **options)
+    assert str(refused.value) == says and connected_worlds() == before
+
+    def no_eyes(*_, **__):
+        raise RuntimeError('no EGL')
+    monkeypatch.setattr(rig_module, 'RigEyes', no_eyes)
+    with pytest.raises(RuntimeError, match='no EGL'):
+        gymnasium.make('miro_ball/KickBall-v0')
+    assert connected_worlds() == before
+
+
 def test_a_keyword_no_environment_takes_is_refused_in_one_line_naming_those_there_are():
     """Any keyword the environment does not have goes to the rig (its eyes' options reach
     both faces that way); one the rig does not take either is refused before a build."""

@@ -24,12 +24,17 @@ def register(name, factory):
     DETECTORS[name] = factory
 
 
-def make_detectors(names, detection_params):
-    """{name: detect} for the names a controller asks for; ValueError names unknown ones."""
+def check_names(names):
+    """ValueError naming those of ``names`` that are no detector's."""
     unknown = [name for name in names if name not in DETECTORS]
     if unknown:
         raise ValueError('no detector named %s (known: %s)'
                          % (', '.join(map(repr, unknown)), ', '.join(sorted(DETECTORS))))
+
+
+def make_detectors(names, detection_params):
+    """{name: detect} for the names a controller asks for; ValueError names unknown ones."""
+    check_names(names)
     return {name: DETECTORS[name](detection_params) for name in names}
 
 

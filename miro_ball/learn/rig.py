@@ -14,8 +14,10 @@ import logging
 
 import numpy as np
 
+from miro_ball.common.ros_params import values_of
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.contract import Eye, Percepts
+from miro_ball.controller.detectors import check_names
 from miro_ball.learn.action_parts import parts
 from miro_ball.learn.eyes import check_options, RigEyes
 from miro_ball.miro.camera_model import CameraModel, PINHOLE
@@ -24,6 +26,7 @@ from miro_ball.miro.hearing import locate
 from miro_sim_bullet.physics.commands import take
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
+from miro_sim_bullet.ros.params import SimParams
 
 
 class WorldRig:
@@ -45,15 +48,26 @@ class WorldRig:
         if eyes is None and (camera_rate, jpeg_quality, latency_s) != (None, None, 0):
             raise ValueError('camera_rate, jpeg_quality and latency_s are options of the '
                              'eyes: give eyes=(w, h)')
-        check_options(camera_rate, jpeg_quality, latency_s, detection)  # before a build
-        self.sim = world if isinstance(world, SimWorld) else SimWorld(world)
-        self.camera = None if eyes is None else CameraModel(*eyes, lens, CAM_HFOV_DEG_SIM)
-        self.renderer = renderer
-        self.cameras = None
-        self.eyes = None
-        if eyes is not None:
-            self.eyes = RigEyes(self.sim, self._cameras(), self.camera, detectors, camera_rate,
-                                jpeg_quality, latency_s, detection)
+        # Checked before a build (the lens and the renderer in the simulator's words): a
+        # refusal after one left its PyBullet world connected, one more each try.
+        check_options(camera_rate, jpeg_quality, latency_s, detection)
+        values_of(SimParams, {'lens': lens, 'renderer': renderer})
+        detectors = tuple(detectors)
+        check_names(detectors)
+        built = not isinstance(world, SimWorld)
+        self.sim = SimWorld(world) if built else world
+        try:
+            self.camera = None if eyes is None else CameraModel(*eyes, lens, CAM_HFOV_DEG_SIM)
+            self.renderer = renderer
+            self.cameras = None
+            self.eyes = None
+            if eyes is not None:
+                self.eyes = RigEyes(self.sim, self._cameras(), self.camera, detectors,
+                                    camera_rate, jpeg_quality, latency_s, detection)
+        except BaseException:  # whatever else fails (no EGL...): the world is not left open
+            if built:
+                self.sim.close()
+            raise
         self.hears = hears
         self.heard = {}  # robot -> the latest MicBlock
         self._warn = Throttled(logging.getLogger(__name__).warning)
