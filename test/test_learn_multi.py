@@ -51,6 +51,23 @@ def test_football_as_an_aec_environment_passes_pettingzoos_api_test():
     env.close()
 
 
+def test_the_aec_football_refuses_an_action_at_its_agents_turn_and_plays_on():
+    """Checked only once every agent had acted, a bad action of miro01 was refused at
+    miro02's turn, stayed stored, and every later step was refused until a reset."""
+    env = football.env(robots=2, eyes=None)
+    env.reset(seed=1)
+    for bad in (None, {'wheels': [math.nan, 0.0]}, np.zeros(2)):
+        with pytest.raises(ValueError, match='^miro01: '):
+            env.step(bad)
+        assert env.agent_selection == 'miro01'  # still its turn
+    start = env.unwrapped.rig.sim.time
+    for agent in ('miro01', 'miro02'):
+        assert env.agent_selection == agent
+        env.step({'wheels': np.full(2, 0.2)})
+    assert env.unwrapped.rig.sim.time > start  # the world stepped
+    env.close()
+
+
 def play(env, seed, steps=30):
     observations, _ = env.reset(seed=seed)
     for index, agent in enumerate(env.possible_agents):

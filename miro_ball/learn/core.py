@@ -154,16 +154,7 @@ class EpisodeCore:
         if not hasattr(actions, 'items'):  # None was "'NoneType' object has no attribute"
             raise ValueError(f'actions is a dict {{agent: action}} (agents: '
                              f'{", ".join(self.agents)}), got {type(actions).__name__}')
-        checked = {}
-        for agent, action in actions.items():
-            if agent not in self.action_spaces:
-                raise ValueError(f'no agent {agent!r} (agents: {", ".join(self.agents)})')
-            try:
-                checked[agent] = spaces.contract_action(action, self.action_spaces[agent],
-                                                        self.frame_skip)
-            except ValueError as err:
-                raise ValueError(f'{agent}: {err}' if len(self.agents) > 1 else str(err)) \
-                    from None
+        checked = {agent: self.check(agent, action) for agent, action in actions.items()}
         for agent, action in checked.items():
             rig.act(agent, action)
         terminated = False
@@ -185,6 +176,18 @@ class EpisodeCore:
             rewards[agent] = float(sum(own.values()))
             infos[agent] = {**info, **{f'reward_{term}': value for term, value in own.items()}}
         return Step(rewards, terminated, truncated, infos)
+
+    def check(self, agent, action):
+        """The contract Action ``agent``'s ``action`` is; ValueError (one line, naming the
+        agent when there are several) for an agent that is none or an action its space
+        refuses."""
+        if agent not in self.action_spaces:
+            raise ValueError(f'no agent {agent!r} (agents: {", ".join(self.agents)})')
+        try:
+            return spaces.contract_action(action, self.action_spaces[agent], self.frame_skip)
+        except ValueError as err:
+            raise ValueError(f'{agent}: {err}' if len(self.agents) > 1 else str(err)) \
+                from None
 
     # -- what the faces show ------------------------------------------------------------------
     def percepts(self, agent):

@@ -16,7 +16,8 @@ The agents are the robots' names (miro01, miro02, ...), each with the observatio
 of learn.spaces (the contract's Percepts and Action as Dicts; with eyes, the ball detector's
 readings in each robot's observation). Every robot's eyes are drawn in one pass a step.
 """
-from pettingzoo.utils.conversions import parallel_to_aec
+from pettingzoo.utils.conversions import parallel_to_aec_wrapper
+from pettingzoo.utils.wrappers import OrderEnforcingWrapper
 
 from miro_ball.learn.parallel_env import MiroParallelEnv
 from miro_ball.learn.tasks.football import Football
@@ -30,10 +31,22 @@ def parallel_env(robots=3, limit_s=20.0, **options):
     return MiroParallelEnv(Football(robots=robots, limit_s=limit_s), **options)
 
 
+class TurnChecked(parallel_to_aec_wrapper):
+    """PettingZoo's AEC face of a MiroParallelEnv, each action checked at its agent's turn.
+    Checked only once the last agent had acted, a refused action named an agent whose turn
+    was over, stayed stored, and had every later step refused until a reset."""
+
+    def step(self, action):
+        agent = self.agent_selection
+        if not (self.terminations[agent] or self.truncations[agent]):  # dead: None, as ever
+            self.env.core.check(agent, action)
+        super().step(action)
+
+
 def env(**kwargs):
     """Football as a PettingZoo AEC environment: the agents act in turn, the world steps
-    once they all have."""
-    return parallel_to_aec(parallel_env(**kwargs))
+    once they all have; an action is refused (ValueError, one line) at its agent's turn."""
+    return OrderEnforcingWrapper(TurnChecked(parallel_env(**kwargs)))
 
 
 raw_env = env
