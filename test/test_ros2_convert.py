@@ -68,6 +68,17 @@ def test_integer_ranges_array_sizes_and_list_items_are_checked(cls, values, says
     assert list(fill(ByteMultiArray(), {'data': [0, 255]}).data) == [b'\x00', b'\xff']
 
 
+def test_a_type_name_of_any_length_is_refused_in_a_short_line():
+    """interface show of a 100,000-letter name printed all of it back."""
+    from miro_ball.ros2.graph import CliError
+    from miro_ball.ros2.verbs import interface_class
+
+    for name in ('a' * 100_000, 'a' * 100_000 + '/msg/X', 'std_msgs/msg/' + 'X' * 100_000):
+        with pytest.raises((ValueError, CliError)) as refused:
+            interface_class(name)
+        assert len(str(refused.value)) < 300 and '\n' not in str(refused.value)
+
+
 def test_interface_text_expands_nested_types_a_tab_in():
     lines = shown('geometry_msgs/msg/TwistStamped')
     assert 'std_msgs/Header header' in lines and '\t\tint32 sec' in lines

@@ -28,8 +28,8 @@ def split_type(type_name):
         parts.insert(1, 'msg')
     if len(parts) != 3 or not all(p.isidentifier() for p in parts) \
             or parts[1] not in ('msg', 'srv', 'action'):
-        raise ValueError(f'{type_name!r} is not a type name (package/msg/Name, as '
-                         'geometry_msgs/msg/Twist)')
+        raise ValueError(f'{str(type_name)[:100]!r} is not a type name (package/msg/Name, '
+                         'as geometry_msgs/msg/Twist)')
     return tuple(parts)
 
 

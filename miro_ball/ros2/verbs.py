@@ -35,8 +35,8 @@ def interface_class(type_name):
     try:
         return getattr(importlib.import_module(f'{package}.{kind}'), name)
     except (ImportError, AttributeError):
-        raise CliError(f'no interface {package}/{kind}/{name} is installed (is it built? '
-                       'python -m miro_ball.build_interfaces)') from None
+        raise CliError(f'no interface {f"{package}/{kind}/{name}"[:200]} is installed (is it '
+                       'built? python -m miro_ball.build_interfaces)') from None
 
 
 def absolute(name):
