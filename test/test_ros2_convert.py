@@ -69,14 +69,19 @@ def test_integer_ranges_array_sizes_and_list_items_are_checked(cls, values, says
 
 
 def test_a_type_name_of_any_length_is_refused_in_a_short_line():
-    """interface show of a 100,000-letter name printed all of it back."""
+    """interface show of a 100,000-letter name printed all of it back, and one of a name
+    past 255 letters was a traceback ('File name too long')."""
+    from miro_ball.common.definitions import package_messages
     from miro_ball.ros2.graph import CliError
     from miro_ball.ros2.verbs import interface_class
 
-    for name in ('a' * 100_000, 'a' * 100_000 + '/msg/X', 'std_msgs/msg/' + 'X' * 100_000):
-        with pytest.raises((ValueError, CliError)) as refused:
-            interface_class(name)
-        assert len(str(refused.value)) < 300 and '\n' not in str(refused.value)
+    for name in ('a' * 100_000, 'a' * 100_000 + '/msg/X', 'std_msgs/msg/' + 'X' * 100_000,
+                 'std_msgs/msg/' + 'X' * 300):
+        for look_up in (interface_class, shown):
+            with pytest.raises((ValueError, CliError)) as refused:
+                look_up(name)
+            assert len(str(refused.value)) < 300 and '\n' not in str(refused.value)
+    assert package_messages('x' * 300) == {}
 
 
 def test_interface_text_expands_nested_types_a_tab_in():

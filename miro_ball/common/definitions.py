@@ -33,14 +33,23 @@ def split_type(type_name):
     return tuple(parts)
 
 
+def _is(path, kind):
+    """path.is_file() or is_dir() (``kind``), False for a name the system can not look up:
+    pathlib's raise OSError for one past 255 bytes ('File name too long')."""
+    try:
+        return getattr(path, kind)()
+    except OSError:
+        return False
+
+
 def definition_file(type_name):
     """The installed .msg/.srv file of a type; ValueError if none is installed."""
     package, kind, name = split_type(type_name)
     for prefix in prefixes():
         path = prefix / 'share' / package / kind / f'{name}.{kind}'
-        if path.is_file():
+        if _is(path, 'is_file'):
             return path
-    raise ValueError(f'no interface {package}/{kind}/{name} is installed')
+    raise ValueError(f'no interface {f"{package}/{kind}/{name}"[:200]} is installed')
 
 
 def package_messages(package):
@@ -48,7 +57,7 @@ def package_messages(package):
     ({} if it is not installed)."""
     for prefix in prefixes():
         folder = prefix / 'share' / package / 'msg'
-        if folder.is_dir():
+        if _is(folder, 'is_dir'):
             return {f'{package}/msg/{path.stem}': path.read_text()
                     for path in sorted(folder.glob('*.msg'))}
     return {}
