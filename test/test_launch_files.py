@@ -325,6 +325,8 @@ def test_arguments_the_files_do_not_take_are_refused(sample, tmp_path):
 def test_an_unknown_package_or_executable_is_refused_in_one_line():
     with pytest.raises(LaunchError, match="package 'no_such_package' is not installed"):
         console_scripts('no_such_package')
+    with pytest.raises(LaunchError, match="^package 'p{100}' not found"):  # was an OSError
+        share_folder('p' * 300)  # $(find-pkg-share ...) of a name past 255 bytes
     with pytest.raises(LaunchError, match="package miro_ball has no executable 'miro_simm'"):
         command(Process('x', Path('f'), pkg='miro_ball', exec='miro_simm'))
 
@@ -382,6 +384,8 @@ def test_help_lists_the_bundled_files_and_their_arguments_and_print_runs_nothing
     (['record'], 'record.launch.yaml needs bag:=...'),
     (['lab', 'gui=false'], "'gui=false' is not name:=value"),
     (['lab', 'gui:=maybe'], "got 'maybe'"),
+    # A name past 255 bytes was a traceback ('File name too long')
+    (['x' * 300], "no launch file '" + 'x' * 200 + "' (a path, or one of"),
 ])
 def test_a_bad_command_line_gets_one_line(args, words):
     refused = run_cli(*args, '--print')

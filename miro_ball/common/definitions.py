@@ -10,6 +10,8 @@ import os
 import sys
 from pathlib import Path
 
+from miro_ball.common.files import is_dir, is_file
+
 # The packages this project builds itself (python -m miro_ball.build_interfaces).
 OWN_PACKAGES = ('miro2_msg',)
 
@@ -33,21 +35,12 @@ def split_type(type_name):
     return tuple(parts)
 
 
-def _is(path, kind):
-    """path.is_file() or is_dir() (``kind``), False for a name the system can not look up:
-    pathlib's raise OSError for one past 255 bytes ('File name too long')."""
-    try:
-        return getattr(path, kind)()
-    except OSError:
-        return False
-
-
 def definition_file(type_name):
     """The installed .msg/.srv file of a type; ValueError if none is installed."""
     package, kind, name = split_type(type_name)
     for prefix in prefixes():
         path = prefix / 'share' / package / kind / f'{name}.{kind}'
-        if _is(path, 'is_file'):
+        if is_file(path):
             return path
     raise ValueError(f'no interface {f"{package}/{kind}/{name}"[:200]} is installed')
 
@@ -57,7 +50,7 @@ def package_messages(package):
     ({} if it is not installed)."""
     for prefix in prefixes():
         folder = prefix / 'share' / package / 'msg'
-        if _is(folder, 'is_dir'):
+        if is_dir(folder):
             return {f'{package}/msg/{path.stem}': path.read_text()
                     for path in sorted(folder.glob('*.msg'))}
     return {}

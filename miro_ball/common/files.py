@@ -25,6 +25,23 @@ class FileRefused(OSError):
     """A file that is not read; str() is one line."""
 
 
+def is_file(path):
+    """Path(path).is_file(), but False for a name the system can not look up: pathlib's
+    raises OSError for one past 255 bytes ('File name too long')."""
+    try:
+        return Path(path).is_file()
+    except OSError:
+        return False
+
+
+def is_dir(path):
+    """Path(path).is_dir(), False for a name the system can not look up (as is_file)."""
+    try:
+        return Path(path).is_dir()
+    except OSError:
+        return False
+
+
 def open_regular(path):
     """A binary file object of ``path`` if it is a regular file; OSError else. Each folder on
     the way is opened in turn, none through a link: give a resolved path (one with links in

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from miro_ball.common.definitions import prefixes
+from miro_ball.common.files import is_file
 from miro_ball.launch import LaunchError
 
 PACKAGE = 'miro_ball'
@@ -18,10 +19,10 @@ def share_folder(pkg):
     folders = ([CHECKOUT] if pkg == PACKAGE and (CHECKOUT / 'launch').is_dir() else []) \
         + [prefix / 'share' / pkg for prefix in prefixes()]
     for folder in folders:
-        if (folder / 'package.xml').is_file():
+        if is_file(folder / 'package.xml'):
             return folder
-    raise LaunchError(f'package {pkg!r} not found (no share/{pkg}/package.xml under '
-                      f'$AMENT_PREFIX_PATH or {sys.prefix})')
+    raise LaunchError(f'package {pkg[:100]!r} not found (no share/{pkg[:100]}/package.xml '
+                      f'under $AMENT_PREFIX_PATH or {sys.prefix})')
 
 
 def bundled():
@@ -34,12 +35,12 @@ def find(file_or_name):
     """The launch file a user means: a path, or a bundled file by name ('football' or
     'football.launch.yaml'); LaunchError if there is none."""
     path = Path(file_or_name)
-    if path.is_file():
+    if is_file(path):  # a name past 255 bytes was a traceback ('File name too long')
         return path
     if path.name == file_or_name:
         for found in bundled():
             if file_or_name in (found.name, found.name.split('.launch.')[0]):
                 return found
     names = ', '.join(path.name.split('.launch.')[0] for path in bundled())
-    raise LaunchError(f'no launch file {file_or_name!r} (a path, or one of miro_ball\'s: '
-                      f'{names})')
+    raise LaunchError(f'no launch file {file_or_name[:200]!r} (a path, or one of '
+                      f'miro_ball\'s: {names})')
