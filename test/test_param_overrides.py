@@ -1,10 +1,13 @@
 """A parameter set on the command line that no node declares, or set to a value of the wrong
 type, is refused before anything starts: the pure part (common.ros_params)."""
+import os
+import subprocess
+import sys
 from dataclasses import dataclass, field
 
 import pytest
 
-from miro_ball.common.ros_params import check_overrides, ros_overrides
+from miro_ball.common.ros_params import check_overrides, PARAMS_FILE_MAX_BYTES, ros_overrides
 
 
 @dataclass(frozen=True)
@@ -36,6 +39,30 @@ def test_what_can_not_be_read_is_a_one_line_error(argv):
     with pytest.raises(ValueError) as err:
         ros_overrides(argv, 'sim')
     assert '\n' not in str(err.value)
+
+
+def test_a_params_file_that_is_no_regular_file_or_too_big_is_refused_without_waiting(
+        tmp_path):
+    """A FIFO held a program for ever, at our read and at rcl's (which comes after ours:
+    common.cli.user_args); a device was read as YAML, and YAML's error took three lines."""
+    fifo = tmp_path / 'fifo'
+    os.mkfifo(fifo)
+    big = tmp_path / 'big.yaml'
+    big.write_text('#' * (PARAMS_FILE_MAX_BYTES + 1))
+    broken = tmp_path / 'broken.yaml'
+    broken.write_text('a: [\n')
+    ended = subprocess.run(
+        [sys.executable, '-c', 'import sys; from miro_ball.common.cli import user_args; '
+                               'user_args(sys.argv, "prog")', '--ros-args', '--params-file',
+         str(fifo)], capture_output=True, text=True, timeout=60)  # a hang guard only
+    assert ended.returncode == 2 and ended.stderr == (
+        f"prog: error: --params-file '{fifo}': 'fifo' is not a regular file\n")
+    for path, says in ((fifo, "'fifo' is not a regular file"), ('/dev/zero', 'not a regular'),
+                       (tmp_path, 'is not a regular file'), (big, 'more than 1 MB'),
+                       (broken, 'while parsing')):
+        with pytest.raises(ValueError) as err:
+            ros_overrides(['p', '--ros-args', '--params-file', str(path)], 'sim')
+        assert says in str(err.value) and '\n' not in str(err.value), err.value
 
 
 @pytest.mark.parametrize('overrides, message', [

@@ -22,12 +22,19 @@ def user_args(argv, prog, params=(), node=None):
     from miro_ball.common.ros_params import check_overrides, ros_overrides
 
     try:
+        # Ours first: it refuses a --params-file that is no regular file, which rcl's read
+        # (in remove_ros_args) would wait on for ever (a FIFO).
+        overrides = ros_overrides(argv, node or prog)
+    except ValueError as err:
+        print(f'{prog}: error: {err}', file=sys.stderr)
+        sys.exit(2)
+    try:
         own = remove_ros_args(argv)[1:]
     except Exception as err:  # rclpy's malformed --ros-args error has no public class
         print(f'{prog}: error: {err}', file=sys.stderr)
         sys.exit(2)
     try:
-        check_overrides(ros_overrides(argv, node or prog), *params)
+        check_overrides(overrides, *params)
     except ValueError as err:
         print(f'{prog}: error: {err}', file=sys.stderr)
         sys.exit(2)

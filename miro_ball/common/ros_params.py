@@ -13,6 +13,7 @@ AffectParams)`` declares ``affect.gain``, ... (a YAML params file nests them und
 """
 import math
 from dataclasses import fields, MISSING, replace
+from pathlib import Path
 from typing import NamedTuple
 
 from miro_ball.common.throttle import Throttled
@@ -20,6 +21,9 @@ from miro_ball.common.throttle import Throttled
 # Parameters every rclpy node has; a user may set them on any of ours.
 ROS_OWN_PARAMS = {'use_sim_time': False, 'start_type_description_service': True}
 ROS_OWN_PREFIXES = ('qos_overrides.',)
+# A --params-file is read only if it is a regular file of at most this size (a FIFO held
+# the program for ever, here and in rcl's own read; /dev/urandom was read as YAML).
+PARAMS_FILE_MAX_BYTES = 1 << 20
 
 
 class Group(NamedTuple):
@@ -186,11 +190,16 @@ def _ros_rules(argv):
 def _params_file(path, node_name):
     import yaml
 
+    from miro_ball.common.files import read_regular
+
+    shown = f'--params-file {path[:200]!r}'
     try:
-        with open(path) as f:
-            content = yaml.safe_load(f) or {}
-    except (OSError, yaml.YAMLError) as err:
-        raise ValueError(f'--params-file {path!r}: {err}') from None
+        text = read_regular(Path(path).resolve(), PARAMS_FILE_MAX_BYTES)
+        if len(text) > PARAMS_FILE_MAX_BYTES:
+            raise ValueError(f'{shown}: more than {PARAMS_FILE_MAX_BYTES >> 20} MB')
+        content = yaml.safe_load(text) or {}
+    except (OSError, RuntimeError, yaml.YAMLError) as err:  # RuntimeError: a link loop
+        raise ValueError(f'{shown}: ' + ' '.join(str(err).split())[:300]) from None
     found = {}
     for node, section in (content.items() if isinstance(content, dict) else ()):
         key = str(node)
