@@ -18,6 +18,7 @@ of held-out people whose liked expression it found (and kept) by the last trial.
 """
 import json
 import math
+import numbers
 import os
 import statistics
 import time
@@ -196,9 +197,9 @@ class KBandit(Task):
 
     def __init__(self, trials=30, mistakes=0.1):
         # trials=2.5 ran 3; mistakes=2 made the person always wrong, NaN never.
-        if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
+        if isinstance(trials, bool) or not isinstance(trials, numbers.Integral) or trials < 1:
             raise ValueError(f'trials must be a whole number >= 1, got {trials!r}')
-        if isinstance(mistakes, bool) or not isinstance(mistakes, (int, float)) or \
+        if isinstance(mistakes, bool) or not isinstance(mistakes, numbers.Real) or \
                 not 0.0 <= mistakes <= 1.0:
             raise ValueError(f'mistakes must be a probability 0 to 1, got {mistakes!r}')
         self.limit_s = trials * SHOW_TICKS * 0.02
