@@ -38,6 +38,8 @@ def drive(controller, pose, seconds):
 # Straight behind, farther than it backs: with odometry a tick late, the bearing's sign
 # (+-pi) flipped with each turn's overshoot, and it shook on the spot for ever.
 @example(start=(0.0, -0.0, 0.0), goal=(-1.0, -0.0, 0.0), tolerance=(0.0625, 0.125))
+# At the goal point, its heading half a turn away: the same flip, turning on the spot.
+@example(start=(0.0, 0.0, 0.125), goal=(0.0078125, 0.0, 3.140625), tolerance=(0.005, 0.125))
 def test_it_arrives_from_anywhere_within_its_tolerances(start, goal, tolerance):
     controller = PoseController(goal, *tolerance)
     distance = math.dist(start[:2], goal[:2])

@@ -22,9 +22,9 @@ from miro_ball.miro.kinematics import wrap
 
 # The fastest turn on the spot: both wheels at full speed, opposite ways (4.9 rad/s).
 MAX_TURN_RAD_S = 2.0 * WHEEL_MAX_SPEED_M_PER_S / WHEEL_TRACK_M
-# A goal point within this of straight behind is turned towards the way MiRo already turns:
-# there the bearing's sign flips with the slightest wobble (and with odometry a tick late,
-# a turn's own overshoot flipped it back and forth for ever).
+# A goal point, or a goal heading, within this of straight behind is turned towards the way
+# MiRo already turns: there the angle's sign flips with the slightest wobble (and with
+# odometry a tick late, a turn's own overshoot flipped it back and forth for ever).
 BEHIND_RAD = 0.3
 
 
@@ -87,6 +87,7 @@ class PoseController:
         if self.arrived:
             return 0.0, 0.0
         if self._turning_on_the_spot:
+            heading_error = self._keep_turning(heading_error)
             turn = max(self.min_turn, self.turn_gain * abs(heading_error))
             return self._limited(0.0, math.copysign(turn, heading_error))
         x, y, theta = pose
@@ -94,12 +95,21 @@ class PoseController:
         direction = 1.0
         if abs(bearing) > math.pi / 2 and distance < self.reverse_within:
             direction, bearing = -1.0, wrap(bearing - math.pi)  # the tail leads
-        elif abs(bearing) > math.pi - BEHIND_RAD and self._turn_sign:
-            bearing = math.copysign(abs(bearing), self._turn_sign)
-        self._turn_sign = math.copysign(1.0, bearing) if bearing else 0.0
+        else:
+            bearing = self._keep_turning(bearing)
         speed = min(self.max_forward, max(self.min_forward, self.forward_gain * distance))
         return self._limited(direction * speed * max(0.0, math.cos(bearing)),
                              self.turn_gain * bearing)
+
+    def _keep_turning(self, angle):
+        """``angle`` to turn through, turned the way MiRo already turns when it is within
+        BEHIND_RAD of half a turn (either way is as short: with odometry a tick late, a turn's
+        own overshoot flipped the sign back and forth for ever, to a point behind or to a
+        heading behind alike)."""
+        if abs(angle) > math.pi - BEHIND_RAD and self._turn_sign:
+            angle = math.copysign(abs(angle), self._turn_sign)
+        self._turn_sign = math.copysign(1.0, angle) if angle else 0.0
+        return angle
 
     def _limited(self, forward, turn):
         """Within max_turn and max_forward, and each wheel within MiRo's top speed: the
