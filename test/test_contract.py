@@ -64,6 +64,8 @@ def test_an_answer_handed_back_again_is_said_to_be_from_the_frame_it_was_found_i
         before = (found, stamp, carried)
     assert said == [(1.0, 1.0), (1.0, 1.1), (1.2, 1.2), (1.2, 1.3)]
     assert Eye(DEFAULT_CAMERA).found_at('face') is None
+    # Nothing found is of its own frame: () is one object, whichever frame found nothing.
+    assert found_in({'face': ()}, ({'face': ()}, 1.0, {})) == {}
 
 
 def test_the_ball_detector_is_one_by_name_among_others():

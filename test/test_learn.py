@@ -632,6 +632,33 @@ def test_the_rig_eyes_refuse_an_option_they_can_not_have_in_one_line_building_no
     assert str(refused.value).startswith(said) and '\n' not in str(refused.value)
 
 
+def test_the_rig_eyes_say_which_frame_a_handed_back_answer_was_found_in(monkeypatch):
+    """A detector that looks at one frame in two (as faces: face_every) hands back its last
+    answer in between; the rig's eyes say it was found in the frame it looked at, as the
+    controller host says it, so that demo mode places it from where the head was then."""
+    def every_other(_params):
+        looks, last = iter(range(1000)), {}
+
+        def detect(image, camera):
+            look = next(looks)
+            if look % 2 == 0:
+                last['answer'] = ('a sight', look)  # a new answer: a new object
+            return last['answer']
+        return detect
+
+    monkeypatch.setitem(DETECTORS, 'every_other', every_other)
+    rig = WorldRig(eyes=(64, 48), detectors=('every_other',))
+    rig.restore()
+    said = []
+    for _ in range(4):
+        rig.tick()
+        rig.look()
+        eye = rig.percepts(rig.sim.robot.name).eyes[0]
+        said.append((round(eye.stamp, 6), round(eye.found_at('every_other'), 6)))
+    rig.close()
+    assert said == [(0.02, 0.02), (0.04, 0.02), (0.06, 0.06), (0.08, 0.06)]
+
+
 def test_the_rig_eyes_detect_with_the_parameters_a_controller_host_is_given():
     """The detectors ran with DetectionParams() whatever the controller host was told: now
     controller.params.detection_params reads the host's command line into what the rig's

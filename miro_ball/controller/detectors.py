@@ -68,5 +68,6 @@ def found_in(found, before):
     if before is None:
         return {}
     results, stamp, carried = before
+    # Not an empty answer: () is one object in CPython, whatever frame found nothing.
     return {name: carried.get(name, stamp) for name, result in found.items()
-            if result is not None and result is results.get(name)}
+            if result and result is results.get(name)}

@@ -30,7 +30,7 @@ from miro_ball.common.jpeg import decode_jpeg
 from miro_ball.common.ros_params import values_of
 from miro_ball.controller.contract import Eye
 from miro_ball.controller.detection import DetectionParams
-from miro_ball.controller.detectors import make_detectors
+from miro_ball.controller.detectors import found_in, make_detectors
 from miro_ball.miro.stream_kinds import CAMERA, Schedule, Timing
 from miro_sim_bullet.render.eye_images import draw_and_encode, EyeWants, to_bgr
 from miro_sim_bullet.ros.params import SimParams
@@ -91,6 +91,7 @@ class RigEyes:
         world was restored)."""
         self.images = {}  # robot -> (left, right) BGR images of the latest frame in
         self.found = {}  # robot -> (left, right) {detector: result} in those images
+        self.carried = {}  # robot -> (left, right) {detector: stamp of the frame it was found in}
         self.stamps = {}  # robot -> the simulated time those images are of
         self._on_the_way.clear()
         if self.schedule is not None:
@@ -118,8 +119,9 @@ class RigEyes:
         """Robot ``name``'s (left, right) Eye: its latest frame in, and what was found in it."""
         images = self.images.get(name, (None, None))
         found = self.found.get(name, ({}, {}))
-        return tuple(Eye(self.camera, image, seen, self.stamps.get(name))
-                     for image, seen in zip(images, found))
+        carried = self.carried.get(name, ({}, {}))
+        return tuple(Eye(self.camera, image, seen, self.stamps.get(name), older)
+                     for image, seen, older in zip(images, found, carried))
 
     def _draw(self):
         """{robot: (left, right) BGR images} of this instant, drawn in one pass for all, as
@@ -138,10 +140,16 @@ class RigEyes:
         return {name: tuple(images[2 * i:2 * i + 2]) for i, name in enumerate(names)}
 
     def _take(self, instant, drawn):
-        """Images of ``instant`` in: each through its eye's detectors, once."""
+        """Images of ``instant`` in: each through its eye's detectors, once; an answer a
+        detector handed back from an older frame is said to be of that frame, as the
+        controller host says it (detectors.found_in)."""
         for name, images in drawn.items():
-            self.images[name] = images
-            self.stamps[name] = instant
-            self.found[name] = tuple(
-                {key: detect(image, self.camera) for key, detect in detectors.items()}
-                for image, detectors in zip(images, self._detectors[name]))
+            found = tuple({key: detect(image, self.camera) for key, detect in detectors.items()}
+                          for image, detectors in zip(images, self._detectors[name]))
+            if name in self.found:
+                self.carried[name] = tuple(
+                    found_in(now, (before, self.stamps[name], older))
+                    for now, before, older in zip(found, self.found[name], self.carried[name]))
+            else:
+                self.carried[name] = ({}, {})
+            self.images[name], self.stamps[name], self.found[name] = images, instant, found
