@@ -7,7 +7,8 @@ from dataclasses import dataclass, field
 
 import pytest
 
-from miro_ball.common.ros_params import check_overrides, PARAMS_FILE_MAX_BYTES, ros_overrides
+from miro_ball.common.ros_params import (check_overrides, node_matches, PARAMS_FILE_MAX_BYTES,
+                                         ros_overrides)
 
 
 @dataclass(frozen=True)
@@ -88,3 +89,23 @@ def test_a_node_without_parameters_of_its_own_says_so_and_names_rosss():
 def test_good_overrides_and_ross_own_parameters_pass():
     check_overrides({'real_time_factor': 2, 'paused': True, 'world': 'cube',
                      'use_sim_time': True, 'qos_overrides./clock.depth': 5}, Speeds)
+
+
+@pytest.mark.parametrize('key, fqn, applies', [
+    ('/**', '/miro02/kick_blue_ball', True),
+    ('kick_blue_ball', '/kick_blue_ball', True),
+    ('kick_blue_ball', '/miro02/kick_blue_ball', False),  # a key is taken from the root
+    ('/*/kick_blue_ball', '/miro02/kick_blue_ball', True),
+    ('/*/kick_blue_ball', '/kick_blue_ball', False),
+    ('/**/kick_blue_ball', '/kick_blue_ball', True),
+    ('/**/**/kick_blue_ball', '/a/b/kick_blue_ball', True),
+    ('/**/*/**/kick_blue_ball', '/kick_blue_ball', False),
+    ('/' + '**/' * 100_000 + 'x', '/' + '/'.join('abcdefghijklmnop'), False),
+    ('/' + '*/' * 100_000 + 'x', '/a', False),
+], ids=['all', 'root', 'root-only', 'one', 'one-missing', 'any-none', 'any-twice',
+        'one-needed', 'many-any', 'many-one'])
+def test_a_params_file_key_applies_to_a_node_as_rcl_decides_in_a_moment_whatever_it_is(
+        key, fqn, applies):
+    """A key of thousands of '**' took time exponential in their number (a params file can
+    be anything); and one of 100,000 parts was a RecursionError."""
+    assert node_matches(key, fqn) is applies

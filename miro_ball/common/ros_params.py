@@ -11,6 +11,7 @@ A node with many groups names them the ROS 2 way, with dotted names: ``Group('af
 AffectParams)`` declares ``affect.gain``, ... (a YAML params file nests them under
 ``affect:``). A plain dataclass is a group without a prefix.
 """
+import functools
 import math
 from dataclasses import fields, MISSING, replace
 from pathlib import Path
@@ -212,16 +213,26 @@ def _params_file(path, node_name):
 def node_matches(key, fqn):
     """Whether the part ``key`` of a --params-file applies to the node of fully qualified
     name ``fqn``, as rcl decides: a key is taken from the root ('kick_blue_ball' is
-    '/kick_blue_ball', not '/miro/kick_blue_ball'), '*' stands for one part of the name and
-    '**' for any number of parts."""
-    def match(pattern, name):
-        if not pattern:
-            return not name
-        if pattern[0] == '**':
-            return any(match(pattern[1:], name[i:]) for i in range(len(name) + 1))
-        return bool(name) and pattern[0] in ('*', name[0]) and match(pattern[1:], name[1:])
+    '/kick_blue_ball', not '/<robot>/kick_blue_ball'), '*' stands for one part of the name
+    and '**' for any number of parts."""
+    name = fqn.strip('/').split('/')
+    parts = key.strip('/').split('/')
+    pattern = [part for k, part in enumerate(parts)
+               if part != '**' or k == 0 or parts[k - 1] != '**']  # '**/**' is '**'
+    if sum(part != '**' for part in pattern) > len(name):
+        return False  # (and the recursion below stays as deep as the node's name is long)
 
-    return match(key.strip('/').split('/'), fqn.strip('/').split('/'))
+    # Each (pattern part, name part) pair decided once: a key of many '**' (a params file
+    # can be anything) took time exponential in their number.
+    @functools.cache
+    def match(p, n):
+        if p == len(pattern):
+            return n == len(name)
+        if pattern[p] == '**':
+            return any(match(p + 1, i) for i in range(n, len(name) + 1))
+        return n < len(name) and pattern[p] in ('*', name[n]) and match(p + 1, n + 1)
+
+    return match(0, 0)
 
 
 def remapped_namespace(argv):
