@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from miro_sim_bullet.render.visuals import client_visuals
+from miro_sim_bullet.render.visuals import client_visuals, VisualsGroup
 from miro_sim_bullet.scene.world_model import PICTURE_UV
 
 SUN_DIRECTION = (-0.5, 0.5, -1.0)  # where the sun's light travels (MDK worlds)
@@ -167,7 +167,8 @@ def _cylinder_mesh(slices=CYLINDER_SLICES):
 
 
 def _instances(visuals):
-    """(n, 18) float32 rows in _INSTANCE_FORMAT of one body's shapes as they are now."""
+    """(n, 18) float32 rows in _INSTANCE_FORMAT of the shapes of ``visuals`` (a
+    render.visuals.VisualsGroup) as they are now."""
     rot, offset = visuals.world_poses()
     rows = np.empty((len(visuals.mesh), 18), 'f4')
     rows[:, 0:9] = rot.transpose(0, 2, 1).reshape(-1, 9)  # columns of each rotation
@@ -267,19 +268,14 @@ class ClientScene:
     def __init__(self, client_id, pictures=()):
         bodies = client_visuals(client_id)
         static = [b for b in bodies if b.static]
-        self.moving = [b for b in bodies if not b.static]
+        self.moving = VisualsGroup(b for b in bodies if not b.static)
         self.layout = SceneLayout(
-            meshes=np.concatenate([b.mesh for b in static + self.moving] or [np.empty(0, int)]),
-            static_rows=_rows(static), pictures=tuple(pictures))
+            meshes=np.concatenate([VisualsGroup(static).mesh, self.moving.mesh]),
+            static_rows=_instances(VisualsGroup(static)), pictures=tuple(pictures))
 
     def moving_rows(self):
         """(n, 18) float32 rows of the moving instances as they are now."""
-        return _rows(self.moving)
-
-
-def _rows(bodies):
-    """The _instances rows of these bodies' shapes, one after the other."""
-    return np.concatenate([_instances(b) for b in bodies] or [np.empty((0, 18), 'f4')])
+        return _instances(self.moving)
 
 
 class GlBackend:
