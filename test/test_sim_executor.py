@@ -12,6 +12,7 @@ from sensor_msgs.msg import CompressedImage, JointState
 from std_srvs.srv import SetBool, Trigger
 
 from miro_ball.miro.interface import EYES, RobotTopics, SimTopics, default_robot_name
+from miro_sim_bullet.render.eye_pipeline import IN_FLIGHT
 from miro_sim_bullet.ros.node import make_executor, SimNode
 from rostools import Probe, spin_until
 
@@ -105,7 +106,7 @@ def test_a_paused_free_running_simulator_leaves_the_cpu_to_others(running):
     assert spin_until(executor, lambda: node.sim.time > resumed_at + 0.1, 60)
 
 
-def test_eyes_drawn_beside_physics_come_at_most_one_camera_period_late(running):
+def test_eyes_drawn_beside_physics_come_at_most_two_camera_periods_late(running):
     node, executor, probe = running
     eyes = {eye: probe.watch(CompressedImage, T.eye_compressed(eye)) for eye in EYES}
     late = []  # simulated seconds between an image's instant and its publication
@@ -117,13 +118,13 @@ def test_eyes_drawn_beside_physics_come_at_most_one_camera_period_late(running):
     assert spin_until(executor, lambda: node.sim.time >= 2.0
                       and all(len(f) >= 10 for f in eyes.values()), 120)
     assert node.eyes.drawing_in_workers  # the helper process took the eyes
-    # None came before its instant, some after it (drawn while physics stepped on: one the
-    # helper had done before the next step comes at its own instant), none more than one
-    # camera period after it: the gap to the next instant, on a physics step (34 steps of
-    # 2 ms at 15 Hz, 0.068 s, seen in CI under load).
+    # None came before its instant, some after it (drawn while physics stepped on), none
+    # more than IN_FLIGHT camera periods after it: the helper may have two instants at once,
+    # and instant t is out before t + 2 is asked for (a period is the gap to the next
+    # instant, on a physics step: 34 steps of 2 ms at 15 Hz, 0.068 s).
     assert min(late) >= -1e-9 and max(late) > 0
     period = math.ceil(1 / node.params.camera_rate / node.sim.dt - 1e-9) * node.sim.dt
-    assert max(late) <= period + 1e-9
+    assert max(late) <= IN_FLIGHT * period + 1e-9
     # Paused, nothing is held back: every image drawn is out.
     assert probe.call(executor, SetBool, SIM.pause, SetBool.Request(data=True)).success
     assert node.eyes.pending == 0

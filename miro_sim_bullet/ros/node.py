@@ -42,7 +42,7 @@ from miro_ball.miro.stream_kinds import BLOCK, CAMERA, Schedule, Timing
 from miro_sim_bullet.control.codes import SimulationState
 from miro_sim_bullet.physics.world import SimWorld
 from miro_sim_bullet.render.cameras import Cameras
-from miro_sim_bullet.render.eye_pipeline import EyePipeline
+from miro_sim_bullet.render.eye_pipeline import EyePipeline, IN_FLIGHT
 from miro_sim_bullet.render.renderer import RendererUnavailable
 from miro_sim_bullet.ros import convert
 from miro_sim_bullet.ros.domain_guard import refuse_shared_domain, SharedDomain
@@ -436,7 +436,8 @@ class SimNode(Node):
             # on sim time has them when its timer fires for that instant.
             if CAMERA in due:
                 due.remove(CAMERA)
-                self._publish_eyes(wait=True)  # the previous instant, before the next
+                # The instants before the previous one are out before the next is asked for.
+                self._publish_eyes(wait=True, leave=IN_FLIGHT - 1)
                 self._submit_eyes(overlap)
             if due:
                 self._publish_eyes(wait=False)
@@ -495,10 +496,10 @@ class SimNode(Node):
             self.stage_seconds['eyes: submit'] += time.perf_counter() - started
             self._publish_eyes(wait=False)  # drawn here: out before this instant's /clock
 
-    def _publish_eyes(self, wait):
-        """Publish the instants whose eyes are done (``wait``: all of them)."""
+    def _publish_eyes(self, wait, leave=0):
+        """Publish the instants whose eyes are done (``wait``: all but ``leave``)."""
         started = time.perf_counter()
-        for (when, eyes), frames, seconds in self.eyes.finished(wait):
+        for (when, eyes), frames, seconds in self.eyes.finished(wait, leave):
             for (interface, eye), frame in zip(eyes, frames):
                 interface.publish_eye(eye, frame, when, self.camera)
             self.frames_published += len(eyes)
