@@ -5,6 +5,7 @@
 #   ./dev.sh test [args]   the test suite (pytest); no args: every tier once, three test files
 #                          at a time, as robot miro02; -m unit: the quick tier
 #   ./dev.sh bench         simulator, detection and scenario benchmarks
+#   ./dev.sh speed [args]  the simulator side by side with the previous landing (.ci/landed)
 #   ./dev.sh soak [args]   long free run: memory, open files, speed per minute (--minutes N)
 #   ./dev.sh setup         only the set-up
 set -euo pipefail
@@ -81,6 +82,8 @@ case "$cmd" in
     MIRO_ROBOT_NAME=miro02 exec "$PY" -m pytest -n "${TEST_JOBS:-3}" --dist loadfile \
       --durations=15 ;;
   bench) setup; exec "$PY" -m miro_ball.bench.sim_bench "$@" ;;
+  speed) setup; exec "$PY" -m miro_ball.bench.sim_bench --against landed --cases egl \
+      --runs 5 --seconds 20 --batches 0 "$@" ;;
   soak) setup; exec "$PY" -m miro_ball.bench.soak "$@" ;;
-  *) sed -n '2,9p' "$0"; exit 2 ;;
+  *) sed -n '2,10p' "$0"; exit 2 ;;
 esac

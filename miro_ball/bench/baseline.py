@@ -4,6 +4,9 @@ The simulator benchmark runs each case with this tree and with the commit in tur
 that both see the same load on a shared machine. The commit gets a git worktree of its
 own (kept under the system's temporary directory for the next run) and runs on this
 tree's virtual environment with its own packages and worlds first on the path.
+
+``landed`` names the previous landing: the commit in .ci/landed, which the first commit of
+each round of work sets to the main it started from.
 """
 import os
 import subprocess
@@ -13,14 +16,29 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 # Where the simulator benchmark lived: it moved from lab/ to bench/.
 BENCH_MODULES = ('miro_ball/bench/sim_bench.py', 'miro_ball/lab/sim_bench.py')
+LANDED = ROOT / '.ci' / 'landed'  # its first word: the previous landing's commit
 
 
 class BaselineError(RuntimeError):
     """The commit can not be checked out or has no simulator benchmark; one line."""
 
 
+def landed():
+    """The previous landing's commit, as .ci/landed says."""
+    try:
+        words = LANDED.read_text().split()
+    except OSError as exc:
+        raise BaselineError(f'{LANDED} can not be read ({exc.strerror})') from None
+    if not words:
+        raise BaselineError(f'{LANDED} names no commit')
+    return words[0]
+
+
 def checkout(ref):
-    """(worktree path, the commit's sim_bench module name) for git ``ref``."""
+    """(worktree path, the commit's sim_bench module name) for git ``ref`` ('landed': the
+    previous landing)."""
+    if ref == 'landed':
+        ref = landed()
     try:
         commit = subprocess.run(['git', '-C', str(ROOT), 'rev-parse', '--verify',
                                  f'{ref}^{{commit}}'], capture_output=True, text=True,

@@ -18,6 +18,11 @@ def machine():
             f'Python {platform.python_version()}')
 
 
+def load_average():
+    """The machine's load average over 1, 5 and 15 minutes, as one line."""
+    return ', '.join(f'{v:.2f}' for v in os.getloadavg())
+
+
 def markers(name):
     return (f'<!-- {name}: written by python -m miro_ball.bench.{name} -->',
             f'<!-- end of {name} -->')

@@ -15,7 +15,10 @@ where the eyes are drawn in helper processes, the share of a core they spent pos
 world copy, drawing (uploading the scene, draw calls, reading back) and encoding.
 
 ``--against REF`` runs every case also with git commit REF (checked out beside this tree),
-the two taking turns, and adds the ratio of real-time factors. ``--robots 1,2,4,8`` adds
+the two taking turns, and adds the ratio of real-time factors: the median of each round's
+ratio (this tree's run over the commit's run just beside it), with the lowest and highest.
+``--against landed`` is the previous landing (.ci/landed): ``./dev.sh speed`` runs that
+comparison, and CI prints it after the tests, so that no round loses speed unseen. ``--robots 1,2,4,8`` adds
 the curve of real-time factor against the number of robots, every eye watched, on the
 football pitch.
 
@@ -41,7 +44,7 @@ import cv2
 from miro_ball.common.isolation import isolated_env, private_domain
 from miro_ball.bench import baseline, render_bench
 from miro_ball.bench.memory import tree_memory_mb
-from miro_ball.bench.report import machine, write_section
+from miro_ball.bench.report import load_average, machine, write_section
 from miro_ball.miro.interface import EYES, RobotTopics
 from miro_sim_bullet.render.renderer import probe_egl
 from miro_sim_bullet.ros.params import SimParams
@@ -52,6 +55,7 @@ CASES = (('default world, 2 eyes', 'miro', 1, ('egl', 'tiny')),
          ('football_pitch, 6 eyes', 'football_pitch', 3, ('egl',)),
          ('football_pitch, 2 of 6 eyes', 'football_pitch', 1, ('egl',)))
 COMPARED = (('miro', 1), ('football_pitch', 3))
+RUN_TIMEOUT_S = 600.0  # a run takes ~10 s here; one still going after this is hung
 
 
 def measure(renderer, world, watched, sim_seconds, width, height, rate):
@@ -143,6 +147,7 @@ def run_once(args, env, renderer, world, watched, tree=None):
     """Figures of one child process (with the peak memory of it and its helpers), or None
     (and a line) if it failed. tree: (worktree, module) of an earlier commit to run."""
     module = 'miro_ball.bench.sim_bench' if tree is None else tree[1]
+    started = time.monotonic()
     child = subprocess.Popen(
         [sys.executable, '-m', module, '--one', renderer,
          '--world', world, '--watched', str(watched), '--seconds', str(args.seconds),
@@ -155,6 +160,11 @@ def run_once(args, env, renderer, world, watched, tree=None):
             out, err = child.communicate(timeout=0.25)
             break
         except subprocess.TimeoutExpired:
+            if time.monotonic() - started > RUN_TIMEOUT_S:  # a hung run ends the case, not CI
+                child.kill()
+                child.communicate()
+                print(f'{renderer} {world}: run killed after {RUN_TIMEOUT_S:g} s')
+                return None
             now = tree_memory_mb(child.pid)
             peak = (max(peak[0], now[0]), max(peak[1], now[1]))
     lines = [ln for ln in out.splitlines() if ln.startswith('{')]
@@ -178,13 +188,20 @@ def real_time_factors(args, cases, report, against=None):
             for label, tree in trees:
                 figures = run_once(args, env, case[3], case[1], case[2], tree)
                 if figures:
+                    figures['round'] = index
                     runs[case, label].append(figures)
     return runs
 
 
+def paired_ratios(done, base):
+    """This tree's real-time factor over the commit's in each round both ran."""
+    theirs = {r['round']: r['real_time_factor'] for r in base}
+    return [r['real_time_factor'] / theirs[r['round']] for r in done if r['round'] in theirs]
+
+
 def median_figures(done):
     return {k: statistics.median(r[k] for r in done) for k in done[0]
-            if k not in ('renderer', 'profile')}
+            if k not in ('renderer', 'profile', 'round')}
 
 
 def rtf_table(runs, against):
@@ -194,19 +211,21 @@ def rtf_table(runs, against):
         if not done:
             continue
         med = median_figures(done)
+        factors = [r['real_time_factor'] for r in done]
         ratio = ''
         if against:
-            base = runs.get((case, against))
-            if base and label != against:
-                ratio = f' | {med["real_time_factor"] / median_figures(base)["real_time_factor"]:.2f}x'
-            else:
-                ratio = ' | '
+            ratios = paired_ratios(done, runs.get((case, against)) or []) \
+                if label != against else []
+            ratio = (f' | {statistics.median(ratios):.2f}x ({min(ratios):.2f}-{max(ratios):.2f})'
+                     if ratios else ' | ')
         rows.append(f'| {case[0]} | {label} | {done[0]["renderer"]} | '
-                    f'{med["real_time_factor"]:.2f}{ratio} | {med["frames_per_wall_s"]:.1f} | '
+                    f'{med["real_time_factor"]:.2f} ({min(factors):.2f}-{max(factors):.2f})'
+                    f'{ratio} | {med["frames_per_wall_s"]:.1f} | '
                     f'{max(r["frames_lost"] for r in done)} | '
                     f'{med["ms_per_camera_instant"]:.1f} | {med["peak_pss_mb"]:.0f} | '
                     f'{med["peak_rss_mb"]:.0f} |')
-    head = ('| case | code | renderer | real-time factor | ' + ('ratio | ' if against else '')
+    head = ('| case | code | renderer | real-time factor (lowest-highest) | '
+            + ('ratio, median of the rounds (lowest-highest) | ' if against else '')
             + 'frames/s | frames lost (max) | ms drawing + encoding an instant | peak PSS MB | '
             'peak RSS MB |')
     return [head, '|' + '---|' * (head.count('|') - 1)] + rows
@@ -261,8 +280,9 @@ def main(argv=None):
                         help='renderer comparison: turns of 10 instants per renderer '
                              '(0: no comparison)')
     parser.add_argument('--against', metavar='REF',
-                        help='also run every case with this git commit, in turns, and show '
-                             'the ratio of real-time factors')
+                        help='also run every case with this git commit (landed: the previous '
+                             'landing, .ci/landed), in turns, and show the ratio of '
+                             'real-time factors')
     parser.add_argument('--robots', metavar='N,N,...',
                         help='also the football pitch with N robots, every eye watched')
     parser.add_argument('--cases', choices=('all', 'egl', 'tiny'), default='all',
@@ -313,7 +333,10 @@ def main(argv=None):
                  for renderer in kinds if renderer in renderers]
         cases += [(f'football pitch, {n} robots, {2 * n} eyes', robots_world(n, folder), n,
                    renderers[0]) for n in robots]
+        load_before = load_average()
         runs = real_time_factors(args, cases, report, against)
+        load = f'Load average (1, 5, 15 min): at start {load_before}; at end {load_average()}.'
+    report(load)
     rtf = rtf_table(runs, args.against if against else None)
     shares = profile_lines(runs)
     report('\n'.join(rtf))
@@ -341,7 +364,7 @@ def main(argv=None):
             *(['', 'Renderers alone, same scene, taking turns: median ms per camera instant '
                '(egl = ours, pybullet-egl = PyBullet\'s eglRenderer plugin as shipped, tiny = '
                'TinyRenderer in-process).', '', *compared] if compared else []),
-            '', f'Machine: {machine()}.']))
+            '', load, '', f'Machine: {machine()}.']))
         report(f'\nwritten to {args.output}')
 
 
