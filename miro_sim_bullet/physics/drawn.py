@@ -45,10 +45,11 @@ class DrawnParts:
         kw = {'physicsClientId': client}
         self.bodies = {}
         for name in DRAWN:
-            # A multibody: PyBullet's saveState and restoreState (SimWorld.rewind) know no
-            # other kind, though a static rigid body would cost the step less (0.05 us
-            # against 0.2).
-            body = pb.createMultiBody(0, -1, visual(desc.LINK[name].visuals), **kw)
+            # A static rigid body (maximal coordinates): Bullet steps a fixed multibody
+            # every physics step, a static rigid body not at all.
+            body = pb.createMultiBody(0, -1, visual(desc.LINK[name].visuals),
+                                      useMaximalCoordinates=True, **kw)
+            pb.setCollisionFilterGroupMask(body, -1, 0, 0, **kw)  # no pairs with anything
             pb.addUserData(body, POSED_KEY, '1', **kw)
             self.bodies[name] = body
         # name -> (parent, joint origin xyz, its turn, joint axis, index in COSMETIC or None)

@@ -97,12 +97,12 @@ class SimWorld:
         self._bits = {}  # robot name -> its collision group's bit number
         for spec in world.robots:
             self._add_robot(spec)
-        self._filter_collisions()
         self.unnamed = self._name_unnamed()
-        self._pictures()  # last, so that the other bodies keep their ids
+        self.picture_bodies = self._pictures()  # last, so that the other bodies keep their ids
+        self._filter_collisions()
         self._new_acoustics()
         self.generation += 1
-        self._built = pb.saveState(**kw)
+        self._built = self._movers_state()
 
     def _name_unnamed(self):
         """{body id: '<table>_<k>'} of the ground and the unnamed static shapes: the k-th of
@@ -165,9 +165,13 @@ class SimWorld:
         movable = set(self.objects.values())
         for name, robot in self.robots.items():
             robot.model.set_collision_filter(robot_group(self._bits[name]), ALL_GROUPS)
-        robots = {robot.body_id for robot in self.robots.values()}
+        # The robots' own filters are set above; the pictures and drawn parts, which have
+        # no collision shape, meet nothing from when they are made.
+        skipped = {*self.picture_bodies, *(body for robot in self.robots.values()
+                                           for body in (robot.body_id,
+                                                        *robot.model.drawn.bodies.values()))}
         for body in (pb.getBodyUniqueId(k, **kw) for k in range(pb.getNumBodies(**kw))):
-            if body in robots:
+            if body in skipped:
                 continue
             if body in movable:
                 pb.setCollisionFilterGroupMask(body, -1, MOVABLE_GROUP, ALL_GROUPS, **kw)
@@ -197,17 +201,23 @@ class SimWorld:
         geom = {'box': pb.GEOM_BOX, 'cylinder': pb.GEOM_CYLINDER, 'sphere': pb.GEOM_SPHERE}
         col = pb.createCollisionShape(geom[shape.kind], **cdims, **kw)
         vis = pb.createVisualShape(geom[shape.kind], rgbaColor=(*shape.colour, 1), **dims, **kw)
+        # What does not move is a static rigid body (maximal coordinates): Bullet steps a
+        # fixed multibody every physics step, a static rigid body not at all (the default
+        # world's step 20 % cheaper with the pictures and drawn parts as such too).
         body = pb.createMultiBody(shape.mass, col, vis, shape.position,
-                                  pb.getQuaternionFromEuler((0, 0, shape.yaw)), **kw)
+                                  pb.getQuaternionFromEuler((0, 0, shape.yaw)),
+                                  useMaximalCoordinates=shape.mass <= 0, **kw)
         pb.changeDynamics(body, -1, lateralFriction=shape.friction,
                           restitution=shape.restitution, **kw)
         return body
 
     def _pictures(self):
         """A visual-only static body per picture, a textured quad, for PyBullet's
-        TinyRenderer. Our GL renderer draws World.pictures itself; it skips these meshes."""
+        TinyRenderer; their ids. Our GL renderer draws World.pictures itself; it skips these
+        meshes."""
         kw = self._kw()
         textures = {}  # one texture per image file
+        bodies = []
         for picture in self.description.pictures:
             if picture.image not in textures:
                 textures[picture.image] = _texture(picture.png, kw)
@@ -223,9 +233,12 @@ class SimWorld:
                 # TinyRenderer's texture v runs up from the image's bottom row (OBJ's way).
                 uvs=[(u, 1.0 - v) for u, v in PICTURE_UV],
                 normals=[[n / length for n in normal]] * 4, **kw)
-            body = pb.createMultiBody(0, -1, visual, (0, 0, 0), **kw)
+            body = pb.createMultiBody(0, -1, visual, (0, 0, 0), useMaximalCoordinates=True, **kw)
+            pb.setCollisionFilterGroupMask(body, -1, 0, 0, **kw)  # no pairs with anything
             pb.changeVisualShape(body, -1, textureUniqueId=textures[picture.image],
                                  rgbaColor=(1, 1, 1, 1), **kw)
+            bodies.append(body)
+        return bodies
 
     def reset(self):
         """Back to the world as loaded, time zero: what was spawned since is gone, what was
@@ -420,15 +433,20 @@ class SimWorld:
         """Back to the state right after the build without building anew (a learning
         environment's reset, and reset()'s when it can: 1 ms where rebuild() took 100 ms for
         the default world, 6 ms against 140 ms for the football pitch, medians of 15 here):
-        PyBullet's snapshot of the built bodies restored, time from zero, each robot's
-        platform and the world's sound started again. Body ids stay, so renderers keep what they read. A world that
-        holds a non-finite value is built anew instead: a NaN that reached the physics
-        spoils more than the state a snapshot restores (MiRo sank into the floor at every
-        rewind after one NaN head target)."""
+        what moves put back where it was built (_movers_state), time from zero, each
+        robot's platform and the world's sound started again. Body ids stay, so renderers
+        keep what they read. A world that holds a non-finite value is built anew instead: a
+        NaN that reached the physics spoils more than the state a rewind puts back (MiRo sank
+        into the floor at every rewind after one NaN head target)."""
         if self._built is None or not self.finite():  # None: bodies were added or removed
             self._build()
             return
-        pb.restoreState(self._built, **self._kw())
+        kw = self._kw()
+        for body, (pose, velocity, joints) in self._built.items():
+            pb.resetBasePositionAndOrientation(body, *pose, **kw)
+            pb.resetBaseVelocity(body, *velocity, **kw)
+            for joint, (position, speed) in enumerate(joints):
+                pb.resetJointState(body, joint, position, speed, **kw)
         # Without this the contacts cached before the rewind warm-start the solver after
         # it, and the same seed no longer gives the same trajectory.
         self._filter_collisions()
@@ -436,6 +454,20 @@ class SimWorld:
         for robot in self.robots.values():
             robot.start()
         self._new_acoustics()
+
+    def _movers_state(self):
+        """{body: (pose, velocity, joint (position, velocity)s)} of everything that moves:
+        what rewind() puts back. Not PyBullet's saveState: its restoreState refuses a world
+        with static rigid bodies in it, and it copies every body where only these move."""
+        kw = self._kw()
+        state = {}
+        for body in (*self.objects.values(), *(r.body_id for r in self.robots.values())):
+            joints = pb.getNumJoints(body, **kw)
+            state[body] = (pb.getBasePositionAndOrientation(body, **kw),
+                           pb.getBaseVelocity(body, **kw),
+                           [s[:2] for s in pb.getJointStates(body, range(joints), **kw)]
+                           if joints else [])
+        return state
 
     def finite(self):
         """Whether the pose, velocity and joints of everything that moves are finite."""

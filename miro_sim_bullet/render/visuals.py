@@ -39,13 +39,16 @@ class BodyVisuals:
         kw = {'physicsClientId': client}
         self.links = p.getNumJoints(body, **kw)
         info = p.getDynamicsInfo(body, -1, **kw)
+        massless = info[0] == 0 and self.links == 0
         # A body without mass or links stays where it is, but for a drawn-only part of a
         # robot, which the simulator poses (physics.drawn).
-        self.static = (info[0] == 0 and self.links == 0
-                       and p.getUserDataId(body, POSED_KEY, **kw) < 0)
+        self.static = massless and p.getUserDataId(body, POSED_KEY, **kw) < 0
         # PyBullet reports a base by its centre of mass; visuals hang off the link frame.
-        inertial_rot = matrices([info[4]])[0]
-        self.base_to_link = (inertial_rot.T, -inertial_rot.T @ np.asarray(info[3]))
+        # A massless body is a static rigid body (physics.world), whose frames coincide
+        # (PyBullet fills in no inertial frame for those: what it reports is left over).
+        inertial_rot = np.eye(3) if massless else matrices([info[4]])[0]
+        inertial_pos = np.zeros(3) if massless else np.asarray(info[3])
+        self.base_to_link = (inertial_rot.T, -inertial_rot.T @ inertial_pos)
         mesh, link, entry, rot, offset, scale = [], [], [], [], [], []
         shapes = p.getVisualShapeData(body, **kw)
         self.shapes = len(shapes)  # entries in getVisualShapeData, drawn or not
