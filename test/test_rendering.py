@@ -300,6 +300,39 @@ def test_all_eyes_in_one_pass_equal_eyes_one_by_one(sims):
     assert len({image.tobytes() for image in together}) == 6
 
 
+
+@requires_egl
+def test_shapes_out_of_an_eyes_view_are_left_out_and_the_images_are_the_same(sims,
+                                                                            monkeypatch):
+    """Each view draws only the shapes and pictures that may show in it (most of a world is
+    out of an eye's view, and llvmpipe shades every vertex drawn on the CPU): the images
+    are those of every shape drawn, pixel for pixel, as the robots turn and look about."""
+    sim, cameras = sims('football_pitch', 'egl')
+    camera = CameraModel(64, 48)
+    requests = [(robot, side) for robot in sim.robots.values() for side in (1, -1)]
+    visible = gl_renderer._visible
+    kept = []
+
+    def counted(matrices, centres, radii):
+        shown = visible(matrices, centres, radii)
+        kept.append(shown.mean())
+        return shown
+
+    for step in range(8):
+        for k, robot in enumerate(sim.robots.values()):
+            robot.set_cmd_vel(0.2, 1.5 * math.sin(step + k))
+            robot.set_kinematic_targets([0.0, 0.3 + 0.1 * k, math.sin(step / 2 + k),
+                                         0.2 * math.cos(step)])
+        sim.run(0.1)
+        monkeypatch.setattr(gl_renderer, '_visible', counted)
+        culled = cameras.render_eyes(requests, camera)
+        monkeypatch.setattr(gl_renderer, '_visible',
+                            lambda matrices, centres, _: np.ones((len(centres),
+                                                                  len(matrices)), bool))
+        every = cameras.render_eyes(requests, camera)
+        for a, b in zip(culled, every):
+            assert np.array_equal(a, b)
+    assert np.mean(kept) < 0.5  # most shapes were left out of each view
 @pytest.mark.parametrize('kind', KINDS)
 def test_renderer_survives_a_world_reset(sims, kind):
     sim, cameras = sims('miro', kind)

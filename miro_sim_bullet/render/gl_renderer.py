@@ -6,7 +6,9 @@ PyBullet reports, with instanced primitive meshes (box, sphere, cylinder; a caps
 cylinder and two spheres) and per-vertex lighting like the MDK worlds' (a sun from
 SUN_DIRECTION, ambient 0.4), then the world's pictures (World.pictures) as textured quads lit
 the same way, one texture per image file. Several views (both eyes of every robot) go into one
-framebuffer, stacked vertically, and come back in one read-back.
+framebuffer, stacked vertically, and come back in one read-back. Each view draws only the
+shapes whose bounding spheres reach into it (_visible): the same pixels, a quarter of the
+vertices to shade.
 
 Images follow the pinhole model of :func:`renderer.opengl_projection`. The projection is
 flipped vertically so that the first row read back is the top row of the image: no copy.
@@ -178,6 +180,33 @@ def _instances(visuals):
     return rows
 
 
+# Per mesh of visuals.MESHES, what a row's scale is multiplied by for a radius about its
+# offset that holds the whole shape: the unit cube's corners (0.5 each way), the unit sphere,
+# the unit cylinder (radius 1, half a length each way).
+_BOUNDS = np.array([(0.5, 0.5, 0.5), (1.0, 1.0, 1.0), (1.0, 1.0, 0.5)])
+# How much further than its bound a shape must be from a side of the view to be left out: a
+# shape drawn in float32 strays far less, and a shape kept that draws nothing costs only its
+# vertices.
+_CULL_MARGIN = 1e-3
+
+
+def _visible(matrices, centres, radii):
+    """(n, views): whether each sphere (centres (n, 3), radii (n,)) may show in each view of
+    ``matrices`` (view_projection()'s bytes): False only for one wholly outside a side of
+    the view, whose every triangle clipping would discard (the same pixels, without shading
+    its vertices)."""
+    rows = np.frombuffer(b''.join(matrices), 'f4').astype(float).reshape(-1, 4, 4)
+    rows = rows.transpose(0, 2, 1)  # the matrices' rows: they are column-major
+    # The six sides (a, b, c, d) of each view: (x, y, z) is inside when a x + b y + c z + d
+    # >= 0 for all six (left, bottom, near, right, top, far).
+    planes = np.concatenate([rows[:, 3:] + rows[:, :3], rows[:, 3:] - rows[:, :3]],
+                            axis=1).reshape(-1, 4)
+    norms = np.sqrt(np.einsum('ij,ij->i', planes[:, :3], planes[:, :3]))
+    reach = centres @ planes[:, :3].T + planes[:, 3]  # (n, 6 * views)
+    inside = reach >= -(radii[:, None] * (1 + _CULL_MARGIN) + _CULL_MARGIN) * norms
+    return inside.reshape(len(centres), -1, 6).all(axis=2)
+
+
 def _picture_vertices(pictures, to_sun):
     """(n * 6, 6) float32 corners (xyz, uv, light) of the pictures' quads, lit by their
     normals as the shapes are."""
@@ -315,20 +344,29 @@ class GlBackend:
         self.layout = layout
         meshes = layout.meshes
         self._release_vaos()
-        # The instance counts are fixed until the next rebuild: one buffer and vertex
-        # array per mesh, rewritten every frame.
-        self.by_mesh = []
-        for index, (vertices, indices) in enumerate(self.meshes):
-            chosen = np.flatnonzero(meshes == index)
-            if not len(chosen):
-                continue
-            buffer = self.ctx.buffer(reserve=len(chosen) * 18 * 4)
+        # Each view draws the instances of each mesh that may show in it (_visible): llvmpipe
+        # shades every vertex drawn on the CPU, and most of a world is out of an eye's view.
+        # The instance counts are fixed until the next rebuild: a buffer and vertex array
+        # per mesh and view of a pass, made at its first use and rewritten every frame.
+        self.by_mesh = [(index, np.flatnonzero(meshes == index))
+                        for index in range(len(self.meshes))]
+        self.by_mesh = [(index, chosen) for index, chosen in self.by_mesh if len(chosen)]
+        self._bounds = _BOUNDS[meshes]
+        self._slots = {}  # (mesh, view in the pass) -> (buffer, vertex array)
+        self._read_pictures(layout.pictures)
+
+    def _slot(self, mesh, view):
+        """The instance buffer and vertex array of ``mesh`` for the pass's view ``view``."""
+        if (mesh, view) not in self._slots:
+            vertices, indices = self.meshes[mesh]
+            count = np.count_nonzero(self.layout.meshes == mesh)
+            buffer = self.ctx.buffer(reserve=count * 18 * 4)
             vao = self.ctx.vertex_array(
                 self.program, [(vertices, '3f 3f', 'in_position', 'in_normal'),
                                (buffer, _INSTANCE_FORMAT, *_INSTANCE_ATTRIBUTES)],
                 index_buffer=indices)
-            self.by_mesh.append((chosen, buffer, vao))
-        self._read_pictures(layout.pictures)
+            self._slots[mesh, view] = buffer, vao
+        return self._slots[mesh, view]
 
     def _read_pictures(self, pictures):
         """A texture per image file and a vertex array of every quad that shows it."""
@@ -336,7 +374,8 @@ class GlBackend:
         by_image = {}
         for picture in pictures:
             by_image.setdefault(picture.image, []).append(picture)
-        self.by_texture = []
+        self.by_texture = []  # (texture, buffer, vertex array, its quads' bounds)
+        picture_centres, picture_radii = [], []
         for pictures in by_image.values():
             rgb = _load_rgb(pictures[0].png)
             if rgb is None:
@@ -350,24 +389,45 @@ class GlBackend:
             vao = self.ctx.vertex_array(self.picture_program,
                                         [(buffer, '3f 2f 1f', 'in_position', 'in_uv',
                                           'in_light')])
-            self.by_texture.append((texture, buffer, vao))
+            self.by_texture.append((texture, buffer, vao,
+                                    len(picture_centres) + np.arange(len(pictures))))
+            corners = np.array([picture.corners for picture in pictures], float)
+            picture_centres += list(corners.mean(axis=1))
+            picture_radii += list(np.linalg.norm(corners - corners.mean(axis=1)[:, None],
+                                                 axis=2).max(axis=1))
+        # Each quad's bounding sphere, after the instances' in _visible's arguments.
+        self._picture_bounds = (np.array(picture_centres).reshape(-1, 3),
+                                np.array(picture_radii))
 
     def _release_vaos(self):
-        for _, buffer, vao in getattr(self, 'by_mesh', ()):
+        for buffer, vao in getattr(self, '_slots', {}).values():
             vao.release()
             buffer.release()
-        self.by_mesh = []
-        for texture, buffer, vao in getattr(self, 'by_texture', ()):
+        self._slots = {}
+        for texture, buffer, vao, *_ in getattr(self, 'by_texture', ()):
             vao.release()
             buffer.release()
             texture.release()
         self.by_texture = []
 
-    def _upload_instances(self, moving_rows):
-        """Write this instant's poses and colours into the instance buffers."""
-        rows = np.concatenate([self.layout.static_rows, moving_rows])
-        for chosen, buffer, _ in self.by_mesh:
-            buffer.write(rows[chosen].tobytes())
+    def _draw_view(self, view, matrix, rows, shown):
+        """Draw, in the viewport set, what may show (``shown``: _visible's column of this
+        view) of ``rows`` (all instances of this instant) and of the pictures from
+        view-projection ``matrix``, as view ``view`` of the pass."""
+        self.program['view_projection'].write(matrix)
+        for mesh, chosen in self.by_mesh:
+            chosen = chosen[shown[chosen]]
+            if len(chosen):
+                buffer, vao = self._slot(mesh, view)
+                buffer.write(rows[chosen].tobytes())
+                vao.render(instances=len(chosen))
+        pictures = [(texture, vao) for texture, _, vao, quads in self.by_texture
+                    if shown[len(rows) + quads].any()]
+        if pictures:
+            self.picture_program['view_projection'].write(matrix)
+            for texture, vao in pictures:
+                texture.use(0)
+                vao.render()
 
     def _framebuffer(self, width, height):
         key = (width, height)
@@ -394,7 +454,12 @@ class GlBackend:
         import moderngl
         clock = time.perf_counter
         started = clock()
-        self._upload_instances(moving_rows)
+        rows = np.concatenate([self.layout.static_rows, moving_rows])
+        reach = rows[:, 12:15] * self._bounds
+        shown = _visible(view_projections,
+                         np.concatenate([rows[:, 9:12], self._picture_bounds[0]]),
+                         np.concatenate([np.sqrt(np.einsum('ij,ij->i', reach, reach)),
+                                         self._picture_bounds[1]]))
         mark = clock()
         self.seconds['upload'] += mark - started
         per_pass = max(1, self.max_height // height)
@@ -409,14 +474,7 @@ class GlBackend:
             ctx.clear(*SKY, 1.0, depth=1.0)
             for k, matrix in enumerate(batch):
                 ctx.viewport = (0, k * height, width, height)
-                self.program['view_projection'].write(matrix)
-                for chosen, _, vao in self.by_mesh:
-                    vao.render(instances=len(chosen))
-                if self.by_texture:
-                    self.picture_program['view_projection'].write(matrix)
-                    for texture, _, vao in self.by_texture:
-                        texture.use(0)
-                        vao.render()
+                self._draw_view(k, matrix, rows, shown[:, first + k])
             # RGBA is the framebuffer's own format: llvmpipe reads it back without a
             # conversion (a 640x360 stereo pair 2.4 ms instead of 3.1, rasterising included).
             pixels = np.empty((len(batch) * height, width, components), np.uint8)
