@@ -1,54 +1,67 @@
 """Learning environments' speed: environment steps a second (one step = one 20 ms platform
-tick, frame_skip=1) of ``miro_ball/KickBall-v0``.
+tick, frame_skip=1) of ``miro_ball/KickBall-v0``, side by side with gym-pybullet-drones.
 
 ``python -m miro_ball.bench.learn_bench [--seconds 5] [--repeats 5] [--output BENCHMARKS.md]``
 
 Cases: state only (``eyes=None``: no image drawn), both eyes at 64x48 and both at 160x90,
-drawn every step (no detector: the environment's own cost). Each in one process; in one
-process per core side by side, each stepping an environment of its own (as training's
-workers do: their steps a second added up); and as
-``gymnasium.make_vec(..., vectorization_mode='async')`` with one process per core. The
-ratios to one process say whether every core is used, and so does the CPU each took
-(cores busy = CPU seconds of the measuring process and its workers / wall seconds).
-On a shared machine the cores are not all ours: steps per CPU second hardly depend on the
-others' load, and processes x their ratio bounds the ratio a core each would give.
-The action is a fixed wheels action (``PickActions(env, 'wheels')``): nothing else changes,
-so an LED or a joint never costs a step more than it would. An episode that ends is reset
-(a snapshot restored) and the steps go on. Then the physics step alone: ``SimWorld.step`` in
-the default world with the robot driving, in ms and platform ticks a second. Then, when
-Ray is installed (``--ray-repeats 0``: not), KickBall training's rollouts
-(``learn.ray_rollouts``, as ``learn.train --ray`` runs them) on a Ray cluster of two nodes
-of one CPU each made on this machine against one node (Ray's own test helper; the nodes
-share this machine's cores).
+drawn every step (no detector: the environment's own cost). Each in one process; as our
+vector env (``learn.vector``: the caller steps its share, workers write observations into
+shared memory) and as ``gymnasium.make_vec(..., vectorization_mode='async')``, each with a
+process a core; and in one process per core side by side, each stepping an environment of
+its own (as training's workers do: their steps a second added up). The ratios to one
+process say whether every core is used, and so does the CPU each took (cores busy = CPU
+seconds of the measuring process and its workers / wall seconds). On a shared machine the
+cores are not all ours: steps per CPU second hardly depend on the others' load, and
+processes x their ratio bounds the ratio a core each would give. Each step's action is
+sampled from the (wheels-only: ``PickActions(env, 'wheels')``) action space, seeded, as the
+anchor samples its own; an episode that ends is reset and the steps go on.
+
+The anchor, gym-pybullet-drones 2.1.0 (HoverAviary, one process: state-only KIN against our
+state only, its 64x48 RGB camera against our two 64x48 eyes), is run by its own script
+(``--anchor``, default ``../shared/anchors/gpd_bench.sh`` beside this checkout; it makes its
+own venv on first use, done before the clock starts) in turns with ours: each repeat runs
+ours, then the anchor, then ours... Every ratio to it is of figures of the same run: the
+median of each repeat's ratio, and their range. Without the anchor, one line says so and
+there is no ratio.
+
+Then the physics step alone: ``SimWorld.step`` in the default world with the robot driving,
+in ms and platform ticks a second. Then, when Ray is installed (``--ray-repeats 0``: not),
+KickBall training's rollouts (``learn.ray_rollouts``, as ``learn.train --ray`` runs them) on
+a Ray cluster of two nodes of one CPU each made on this machine against one node (Ray's own
+test helper; the nodes share this machine's cores).
 
 Every measurement runs in a process of its own; the cases take turns, repeat after repeat,
 so a busy moment of a shared machine falls on all of them; figures are medians. The load
-average is printed with the figures. Reference: gym-pybullet-drones 2.1.0 (HoverAviary, one
-process) measured on this machine: 1,044 steps/s state only, 187 with its one 64x48 camera.
+average is printed at the start and at the end.
 """
 import argparse
 import importlib.util
 import json
 import os
+import re
 import statistics
 import subprocess
 import sys
 import time
 from pathlib import Path
 
-from miro_ball.bench.report import machine, write_section
+from miro_ball.bench.report import load_average, machine, write_section
 
 ENV_ID = 'miro_ball/KickBall-v0'
 MAKE_ID = f'miro_ball.learn:{ENV_ID}'  # the module that registers it, imported by make
-WHEELS = (0.25, 0.15)  # m/s, left and right: a wide circle, the same every step
+WHEELS = (0.25, 0.15)  # m/s, left and right: the physics bench's robot drives a wide circle
 SEED = 0
 WARMUP_STEPS = 100  # per process, before the clock starts (first frames, caches)
 CASES = (('state only', None), ('both eyes 64x48', (64, 48)),
          ('both eyes 160x90', (160, 90)))
-# gym-pybullet-drones 2.1.0, HoverAviary, one process, measured on this machine (issue 40)
-REFERENCE = {'state only': 1044, 'both eyes 64x48': 187}
-GOALS = {'state only': 2000, 'both eyes 64x48': 500}  # steps/s, one process
-SCALING_GOAL = 1.8  # one process per core (two here) against one
+# The anchor's case for ours (its script's argument) and the ratio to it we aim at.
+ANCHOR_CASES = {'state only': 'kin', 'both eyes 64x48': 'rgb'}
+ANCHOR_GOALS = {'state only': 2.0, 'both eyes 64x48': 2.5}
+ANCHOR = Path(__file__).resolve().parents[2].parent / 'shared' / 'anchors' / 'gpd_bench.sh'
+ANCHOR_SETUP_S = 900  # its first use makes its venv (about a minute; pip may be slow)
+VECTOR_GOAL = 1.6  # our vector env of a process a core (two here) against one process
+SCALING_GOAL = 1.8  # Ray: 2 nodes against one
+VECTORS = {'shared': 'our vector env (learn.vector)', 'async': "Gymnasium's async vector env"}
 PHYSICS_STEPS = 5000  # physics steps timed, a repeat
 # Ray: a population of 16 policies on 2 seeds each, 4 simulated s an episode at most.
 RAY_POPULATION, RAY_SEEDS, RAY_EPISODE_S = 16, 2, 4.0
@@ -59,16 +72,21 @@ def cores():
     return len(os.sched_getaffinity(0))
 
 
-def make_env(eyes, processes):
-    """The environment (one process) or its async vector env (``processes`` workers)."""
+def make_env(eyes, processes, vector):
+    """The environment (one process) or a vector env of ``processes`` (``vector``: 'shared',
+    ours; 'async', Gymnasium's), wheels only."""
     import gymnasium as gym
+    from miro_ball.learn.vector import make_vec
     from miro_ball.learn.wrappers import PickActions
 
     kwargs = dict(eyes=eyes, detectors=(), frame_skip=1)
+    wheels = [lambda env: PickActions(env, 'wheels')]
     if processes == 1:
-        return PickActions(gym.make(MAKE_ID, **kwargs), 'wheels')
+        return wheels[0](gym.make(MAKE_ID, **kwargs))
+    if vector == 'shared':
+        return make_vec(MAKE_ID, processes, wrappers=wheels, **kwargs)
     return gym.make_vec(MAKE_ID, num_envs=processes, vectorization_mode='async',
-                        wrappers=[lambda env: PickActions(env, 'wheels')], **kwargs)
+                        wrappers=wheels, **kwargs)
 
 
 def cpu_seconds(process):
@@ -82,26 +100,25 @@ def cpu_seconds(process):
     return total
 
 
-def measure_env(eyes, processes, seconds):
+def measure_env(eyes, processes, seconds, vector):
     """In the child: {'steps_per_s', 'cores_busy', 'per_cpu_s'} of stepping for ``seconds``
-    of wall."""
-    import numpy as np
+    of wall, each step's action sampled from the action space (seeded)."""
     import psutil
 
-    env = make_env(eyes, processes)
-    vector = processes > 1
-    action = np.tile(np.float32(WHEELS), (processes, 1)) if vector else np.float32(WHEELS)
+    env = make_env(eyes, processes, vector)
+    sample = env.action_space.sample
 
     def run(limit_steps, limit_s):
         steps, start = 0, time.perf_counter()
         while steps < limit_steps and time.perf_counter() - start < limit_s:
-            _, _, terminated, truncated, _ = env.step(action)
+            _, _, terminated, truncated, _ = env.step(sample())
             steps += processes
-            if not vector and (terminated or truncated):
-                env.reset()  # the vector env resets its own at the next step
+            if processes == 1 and (terminated or truncated):
+                env.reset()  # a vector env resets its own at the next step
         return steps, time.perf_counter() - start
 
     env.reset(seed=SEED)
+    env.action_space.seed(SEED)
     run(WARMUP_STEPS * processes, float('inf'))
     me = psutil.Process()
     cpu = cpu_seconds(me)
@@ -194,39 +211,94 @@ def side_by_side(figures):
             'per_cpu_s': statistics.mean(f['per_cpu_s'] for f in figures)}
 
 
-def load():
-    return ', '.join(f'{v:.2f}' for v in os.getloadavg())
+def anchor_steps(anchor, kind, seconds, timeout_s):
+    """Steps a second the anchor's script printed for ``kind`` ('kin' or 'rgb'), run for
+    ``seconds``; or the one line saying why there is no figure."""
+    try:
+        done = subprocess.run([str(anchor), kind, f'{seconds:g}'], capture_output=True,
+                              text=True, timeout=timeout_s)
+    except (OSError, subprocess.TimeoutExpired) as err:
+        return f'anchor {kind}: {err}'
+    found = re.search(r'([\d.]+) steps/s', done.stdout)
+    if done.returncode or not found:
+        last = (done.stderr.strip().splitlines() or ['no output'])[-1]
+        return f'anchor {kind} failed (exit code {done.returncode}): {last}'
+    return float(found.group(1))
 
 
-def median(runs, key):
-    values = [run[key] for run in runs if run]
+def start_anchor(anchor):
+    """The anchor ready to time (its first use makes its venv: done here, before any clock
+    starts), or the one line saying why there is none."""
+    if not anchor.is_file():
+        return f'anchor not found at {anchor}: no ratio to gym-pybullet-drones'
+    print(f'  anchor: {anchor} (its first use makes its venv, about a minute)', flush=True)
+    for kind in sorted(set(ANCHOR_CASES.values())):  # each kind's first frames and caches
+        warm = anchor_steps(anchor, kind, 1, ANCHOR_SETUP_S)
+        if isinstance(warm, str):
+            return f'{warm}: no ratio to gym-pybullet-drones'
+    return None
+
+
+def median(runs, key=None):
+    values = [run if key is None else run[key] for run in runs if run]
     return statistics.median(values) if values else float('nan')
 
 
+def ratios(over, under, key='steps_per_s'):
+    """Each repeat's ratio of ``over`` to ``under`` (figures of the same repeat; a failed
+    one is left out): 'median (lowest-highest)'."""
+    each = [a[key] / b[key] for a, b in zip(over, under) if a and b]
+    if not each:
+        return '-', float('nan')
+    middle = statistics.median(each)
+    return f'{middle:.2f}x ({min(each):.2f}-{max(each):.2f})', middle
+
+
+def goal_text(goal, reached):
+    return f'>= {goal}x ({"met" if reached >= goal else "not met"})'
+
+
+def anchor_rows(results, anchor):
+    """The table of one process against the anchor, each ratio of the same repeat."""
+    rows = ['| case | ours, 1 process: steps/s | gym-pybullet-drones 2.1.0, same run: '
+            'steps/s | ours / theirs, median of the repeats (range) | goal |',
+            '|---|---|---|---|---|']
+    for label, kind in ANCHOR_CASES.items():
+        ours, theirs = results[label, 1], anchor[kind]
+        text, middle = ratios(ours, [{'steps_per_s': value} if value else None
+                                     for value in theirs])
+        rows.append(f'| {label} (theirs: {kind}) | {median(ours, "steps_per_s"):,.0f} | '
+                    f'{median(theirs):,.0f} | {text} | '
+                    f'{goal_text(ANCHOR_GOALS[label], middle)} |')
+    return rows
+
+
 def env_rows(results, processes):
-    """The table of steps a second: one process, one per core, ratios. Steps per CPU
+    """The table of steps a second: one process, each vector env of a process a core, the
+    processes side by side; ratios to one process, each of the same repeat. Steps per CPU
     second (steps/s / cores busy) hardly depend on what else the machine runs: the bound
     on the ratio with a core for each process is processes x their ratio."""
-    head = (f'| case | 1 process: steps/s | cores busy | steps/CPU s | {processes} processes, '
-            'an environment each: steps/s | ratio | async vector env of '
-            f'{processes}: steps/s | cores busy | steps/CPU s | ratio | ratio bound, a core '
-            'each | gym-pybullet-drones 2.1.0 | ours / theirs | goal |')
+    head = '| case | 1 process: steps/s | cores busy | steps/CPU s |'
+    for vector in VECTORS:
+        head += (f' {VECTORS[vector]} of {processes}: steps/s | cores busy | steps/CPU s | '
+                 'ratio, median (range) | ratio bound, a core each |')
+    head += f' {processes} processes, an environment each: steps/s | ratio | goal, ours |'
     rows = [head, '|' + '---|' * (head.count('|') - 1)]
     for label, _ in CASES:
-        one, many = results[label, 1], results[label, processes]
-        single, vector = median(one, 'steps_per_s'), median(many, 'steps_per_s')
-        apart = median(results[label, 'apart'], 'steps_per_s')
-        theirs, goal = REFERENCE.get(label), GOALS.get(label)
-        rows.append(
-            f'| {label} | {single:,.0f} | {median(one, "cores_busy"):.2f} | '
-            f'{median(one, "per_cpu_s"):,.0f} | {apart:,.0f} | {apart / single:.2f}x | '
-            f'{vector:,.0f} | '
-            f'{median(many, "cores_busy"):.2f} | {median(many, "per_cpu_s"):,.0f} | '
-            f'{vector / single:.2f}x | '
-            f'{processes * median(many, "per_cpu_s") / median(one, "per_cpu_s"):.2f}x |'
-            f' {f"{theirs:,}" if theirs else "-"} |'
-            f' {f"{single / theirs:.2f}x" if theirs else "-"} |'
-            f' {f">= {goal:,} ({single / goal:.2f}x)" if goal else "-"} |')
+        one = results[label, 1]
+        row = (f'| {label} | {median(one, "steps_per_s"):,.0f} | '
+               f'{median(one, "cores_busy"):.2f} | {median(one, "per_cpu_s"):,.0f} |')
+        reached = {}
+        for vector in VECTORS:
+            many = results[label, vector]
+            text, reached[vector] = ratios(many, one)
+            bound = processes * median(many, 'per_cpu_s') / median(one, 'per_cpu_s')
+            row += (f' {median(many, "steps_per_s"):,.0f} | {median(many, "cores_busy"):.2f} | '
+                    f'{median(many, "per_cpu_s"):,.0f} | {text} | {bound:.2f}x |')
+        apart = results[label, 'apart']
+        row += (f' {median(apart, "steps_per_s"):,.0f} | {ratios(apart, one)[0]} | '
+                f'{goal_text(VECTOR_GOAL, reached["shared"])} |')
+        rows.append(row)
     return rows
 
 
@@ -245,16 +317,18 @@ def ray_rows(ray):
 
 
 def cpu_notes(results, processes):
-    """Per case, the CPU a step costs alone and in the vector env, and the cores the vector
-    env kept busy (less than all: its processes wait for each other, or others' work)."""
+    """Per case, the CPU a step costs alone and in each vector env, and the cores each kept
+    busy (less than all: its processes wait for each other, or others' work)."""
     notes = []
     for label, _ in CASES:
-        one, many = results[label, 1], results[label, processes]
-        alone, vector = (1000 / median(r, 'per_cpu_s') for r in (one, many))
-        busy = median(many, 'cores_busy')
-        notes.append(f'- {label}: {alone:.3f} ms of CPU a step in one process, {vector:.3f} ms '
-                     f'in the vector env (+{vector - alone:.3f} ms: its pipes and batching); '
-                     f'it kept {busy:.2f} of {processes} cores busy.')
+        alone = 1000 / median(results[label, 1], 'per_cpu_s')
+        for vector, name in VECTORS.items():
+            many = results[label, vector]
+            cost = 1000 / median(many, 'per_cpu_s')
+            notes.append(f'- {label}, {name}: {alone:.3f} ms of CPU a step in one process, '
+                         f'{cost:.3f} ms in the vector env ({cost - alone:+.3f} ms: its '
+                         f'messages and batching); it kept {median(many, "cores_busy"):.2f} '
+                         f'of {processes} cores busy.')
     return notes
 
 
@@ -267,13 +341,16 @@ def main(argv=None):
     parser.add_argument('--repeats', type=int, default=5,
                         help='measurements of each case (median shown; default 5)')
     parser.add_argument('--processes', type=int, default=cores(),
-                        help=f'workers of the vector env (default: one per core, {cores()})')
+                        help=f'processes of the vector envs (default: one per core, {cores()})')
     parser.add_argument('--ray-repeats', type=int, default=3,
                         help='measurements of Ray rollouts on 1 and 2 nodes (default 3; 0: none)')
+    parser.add_argument('--anchor', type=Path, default=ANCHOR,
+                        help=f"gym-pybullet-drones' benchmark script (default {ANCHOR})")
     parser.add_argument('--output', type=Path,
                         help='also write the figures into this file (its learn_bench section)')
     parser.add_argument('--one', choices=[label for label, _ in CASES] + ['physics', 'ray'],
                         help=argparse.SUPPRESS)  # child process: one measurement
+    parser.add_argument('--vector', choices=list(VECTORS), help=argparse.SUPPRESS)
     parser.add_argument('--nodes', type=int, default=1, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if not (0 < args.seconds <= 600 and 1 <= args.repeats <= 100 and 0 <= args.ray_repeats
@@ -286,25 +363,40 @@ def main(argv=None):
     if args.one == 'ray':
         print(json.dumps(measure_ray(args.nodes, RAY_POPULATION, RAY_SEEDS, RAY_EPISODE_S)))
         return
+    if args.one:
+        print(json.dumps(measure_env(dict(CASES)[args.one], args.processes, args.seconds,
+                                     args.vector)))
+        return
     if args.ray_repeats and importlib.util.find_spec('ray') is None:
         print("no Ray here (pip install -e '.[scale]'): no Ray figures")
         args.ray_repeats = 0
-    if args.one:
-        print(json.dumps(measure_env(dict(CASES)[args.one], args.processes, args.seconds)))
-        return
 
-    started = load()
-    print(f'learning environments benchmark: {ENV_ID}, frame_skip 1, fixed wheels, '
+    started = load_average()
+    print(f'learning environments benchmark: {ENV_ID}, frame_skip 1, wheels sampled each step, '
           f'{args.seconds:g} s x {args.repeats} repeats per case; 1 process and '
           f'{args.processes}; load average (1, 5, 15 min) at start {started}', flush=True)
-    results = {(label, n): [] for label, _ in CASES for n in (1, args.processes, 'apart')}
+    no_anchor = start_anchor(args.anchor)
+    if no_anchor:
+        print(no_anchor, flush=True)
+    results = {(label, n): [] for label, _ in CASES
+               for n in (1, *VECTORS, 'apart')}
+    anchor = {kind: [] for kind in ANCHOR_CASES.values()}
     physics = []
+    processes = str(args.processes)
     for index in range(args.repeats):
         print(f'  repeat {index + 1} of {args.repeats}', flush=True)
+        for label, _ in CASES:  # ours, then the anchor's same case: side by side
+            results[label, 1].append(run_child(args, '--one', label, '--processes', '1'))
+            kind = ANCHOR_CASES.get(label)
+            if kind and not no_anchor:
+                figure = anchor_steps(args.anchor, kind, args.seconds, 10 * args.seconds + 60)
+                if isinstance(figure, str):
+                    print(figure)
+                anchor[kind].append(None if isinstance(figure, str) else figure)
         for label, _ in CASES:
-            for n in (1, args.processes):
-                results[label, n].append(run_child(args, '--one', label,
-                                                   '--processes', str(n)))
+            for vector in VECTORS:
+                results[label, vector].append(run_child(
+                    args, '--one', label, '--processes', processes, '--vector', vector))
             results[label, 'apart'].append(side_by_side(run_children(
                 args, args.processes, '--one', label, '--processes', '1')))
         physics.append(run_child(args, '--one', 'physics'))
@@ -313,8 +405,9 @@ def main(argv=None):
         print(f'  Ray, repeat {index + 1} of {args.ray_repeats}', flush=True)
         for nodes in ray:
             ray[nodes].append(run_child(args, '--one', 'ray', '--nodes', str(nodes)))
-    ended = load()
-    rows = env_rows(results, args.processes) + [''] + cpu_notes(results, args.processes)
+    ended = load_average()
+    rows = ([no_anchor] if no_anchor else anchor_rows(results, anchor)) + [
+        '', *env_rows(results, args.processes), '', *cpu_notes(results, args.processes)]
     physics_line = (f'Physics step alone (SimWorld.step, default world, robot driving, '
                     f'{PHYSICS_STEPS} steps): {median(physics, "ms_per_step"):.3f} ms, '
                     f'{median(physics, "ticks_per_s"):,.0f} platform ticks/s.')
@@ -331,13 +424,16 @@ def main(argv=None):
         write_section(args.output, 'learn_bench', '\n'.join([
             '# Learning environments: speed', '',
             f'`python -m miro_ball.bench.learn_bench --seconds {args.seconds:g} --repeats '
-            f'{args.repeats}`: environment steps a second of `{ENV_ID}` (one step = one '
-            '20 ms platform tick, frame_skip 1, a fixed wheels action, no detector), medians; '
-            f'{args.processes} processes, an environment each: side by side, their steps '
-            'a second added up; the async vector env: `gymnasium.make_vec(..., '
-            'vectorization_mode="async")`. Cores busy: CPU seconds of the process and its '
-            'workers a wall second.', '', *rows, '', physics_line, *ray_lines, '', load_line,
-            '',
+            f'{args.repeats} --ray-repeats {args.ray_repeats}`: environment steps a second of '
+            f'`{ENV_ID}` (one step = one 20 ms platform tick, frame_skip 1, the wheels action '
+            'sampled each step, no detector), medians, beside gym-pybullet-drones 2.1.0 '
+            '(HoverAviary, its action sampled each step) run in turns with ours in the same '
+            'run: a ratio is the median of the repeats\' ratios (their range in brackets). '
+            f'Vector envs of {args.processes} processes: ours (`miro_ball.learn.vector`) and '
+            '`gymnasium.make_vec(..., vectorization_mode="async")`; '
+            f'{args.processes} processes, an environment each: side by side, their steps a '
+            'second added up. Cores busy: CPU seconds of the process and its workers a wall '
+            'second.', '', *rows, '', physics_line, *ray_lines, '', load_line, '',
             f'Machine: {machine()}.']))
         print(f'\nwritten to {args.output}')
 
