@@ -1,12 +1,23 @@
-"""Gymnasium's async vector env on the learning environments: each worker process builds
-its own world and steps it exactly as the environment does alone (same seed, same actions,
-the same observations bit for bit). How fast: python -m miro_ball.bench.learn_bench."""
+"""Vector envs on the learning environments, ours (learn.vector) and Gymnasium's async one:
+each worker process builds its own world and steps it exactly as the environment does alone
+(same seed, same actions, the same observations bit for bit). How fast:
+python -m miro_ball.bench.learn_bench."""
 import os
+import re
+import select
+import subprocess
+import sys
+import time
 
 import gymnasium as gym
 import numpy as np
+import psutil
+import pytest
+from gymnasium.vector import AutoresetMode
 
+import miro_ball.learn  # noqa: F401 (registers the ids)
 from miro_ball.learn.spaces import action_space
+from miro_ball.learn.vector import make_vec, SharedVectorEnv
 
 ENV_ID = 'miro_ball.learn:miro_ball/KickBall-v0'  # imports the module that registers it
 SETTINGS = dict(eyes=(32, 24), frame_skip=2)
@@ -39,3 +50,137 @@ def test_an_async_vector_env_steps_each_world_as_the_environment_alone():
             alone, *_ = env.step({part: value[index] for part, value in batch.items()})
         env.close()
         assert all(np.array_equal(alone[key], together[key][index]) for key in alone)
+
+
+# -- our own vector env (learn.vector) ----------------------------------------------------------
+KICK = 'miro_ball/KickBall-v0'
+SHORT = dict(eyes=(32, 24), frame_skip=2, limit_s=0.1)  # an episode of 3 steps
+GUARD_S = 60.0  # hang guard only
+
+
+def gone(pids):
+    """Whether none of ``pids`` runs (a zombie no init has reaped yet runs nothing)."""
+    for pid in pids:
+        try:
+            if psutil.Process(pid).status() != psutil.STATUS_ZOMBIE:
+                return False
+        except psutil.NoSuchProcess:
+            pass
+    return True
+
+
+def wait_gone(pids):
+    deadline = time.monotonic() + GUARD_S
+    while not gone(pids) and time.monotonic() < deadline:
+        time.sleep(0.05)  # a hang guard's poll: nothing waits on it to happen
+    return gone(pids)
+
+
+def same(one, batch, index):
+    """Whether observation ``one`` is entry ``index`` of the batch, bit for bit."""
+    return all(np.array_equal(one[key], batch[key][index]) for key in one)
+
+
+def test_our_vector_env_is_each_environment_alone_bit_for_bit_autoreset_and_all():
+    vector = gym.make_vec(KICK, num_envs=2, **SHORT)  # ours: the ids' vector entry point
+    steps = 6  # an episode of 3 steps, the autoreset, 2 steps of the next
+    try:
+        assert isinstance(vector, SharedVectorEnv)
+        assert vector.metadata['autoreset_mode'] is AutoresetMode.NEXT_STEP
+        workers = [process.pid for process in vector.processes]
+        assert len(workers) == 1 and os.getpid() not in workers  # the caller steps env 0
+        vector.action_space.seed(0)
+        batches = [vector.action_space.sample() for _ in range(steps)]
+        first, _ = vector.reset(seed=7)  # env k: seed 7 + k
+        together = [vector.step(batch) for batch in batches]
+        # An action an environment refuses comes back naming it; the vector env goes on.
+        refused = {**batches[0], 'wheels': np.float32([[0.1, 0.1], [np.nan, 0.1]])}
+        with pytest.raises(ValueError, match='environment 1: .*wheels'):
+            vector.step(refused)
+        vector.step(batches[0])
+    finally:
+        vector.close()
+    assert wait_gone(workers)  # close() leaves no process behind
+    for index in range(2):
+        env = gym.make(KICK, **SHORT)
+        observation, _ = env.reset(seed=7 + index)
+        assert same(observation, first, index)
+        ended = False
+        for batch, (observations, rewards, terminated, truncated, infos) in zip(
+                batches, together):
+            if ended:  # NEXT_STEP: the step after an episode's end resets it, reward 0
+                observation, info = env.reset()
+                reward, over, cut = 0.0, False, False
+            else:
+                observation, reward, over, cut, info = env.step(
+                    {part: value[index] for part, value in batch.items()})
+            ended = over or cut
+            assert same(observation, observations, index)
+            assert (reward, over, cut) == (rewards[index], terminated[index],
+                                           truncated[index])
+            assert all(infos[f'_{key}'][index] and infos[key][index] == value
+                       for key, value in info.items())
+        env.close()
+    assert any(truncated.any() for *_, truncated, _ in together)  # an episode did end
+
+
+def test_same_step_autoreset_hands_back_the_final_observation():
+    settings = dict(eyes=None, frame_skip=2, limit_s=0.1)
+    vector = make_vec(KICK, 2, processes=1, autoreset_mode='SameStep', **settings)
+    env = gym.make(KICK, **settings)
+    try:
+        assert not vector.processes  # one process: the caller steps both
+        vector.reset(seed=1)
+        env.reset(seed=1)
+        batch = actions(2)
+        for _ in range(3):
+            observations, _, _, truncated, infos = vector.step(batch)
+            final, *_ = env.step({part: value[0] for part, value in batch.items()})
+        assert truncated.all() and infos['_final_obs'].all()
+        assert same(final, {key: [infos['final_obs'][0][key]] for key in final}, 0)
+        fresh, _ = env.reset()
+        assert same(fresh, observations, 0)
+    finally:
+        vector.close()
+        env.close()
+
+
+@pytest.mark.parametrize('count', [0, 10**6, 2.5, '2', True, None])
+def test_a_bad_number_of_environments_is_refused_in_one_line(count):
+    with pytest.raises(ValueError, match=r'^num_envs must be a whole number 1 to 128, got'):
+        make_vec(KICK, count, eyes=None)
+
+
+@pytest.mark.parametrize('options, refusal', [
+    (dict(processes=3), 'processes must be a whole number 1 to 2, got 3'),
+    (dict(processes=0), 'processes must be a whole number 1 to 2, got 0'),
+    (dict(autoreset_mode='sometimes'), "'sometimes' is not a valid AutoresetMode"),
+    (dict(context='teleport'), "cannot find context for 'teleport'")])
+def test_bad_vector_options_are_refused_before_any_world_is_built(options, refusal):
+    def never():
+        raise AssertionError('a world was built')
+
+    with pytest.raises(ValueError, match=re.escape(refusal)):
+        SharedVectorEnv([never, never], **options)
+
+
+KILLED_CALLER = """
+import sys
+from miro_ball.learn.vector import make_vec
+envs = make_vec('miro_ball/KickBall-v0', 2, eyes=None)
+print(*[process.pid for process in envs.processes], flush=True)
+sys.stdin.read()
+"""
+
+
+def test_a_caller_that_dies_leaves_no_worker_behind():
+    caller = subprocess.Popen([sys.executable, '-c', KILLED_CALLER], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert select.select([caller.stdout], [], [], GUARD_S)[0], 'no worker started'
+        workers = [int(pid) for pid in caller.stdout.readline().split()]
+        assert len(workers) == 1 and not gone(workers)
+    finally:
+        caller.kill()  # SIGKILL: no close(), no atexit
+        caller.wait()
+    assert wait_gone(workers)

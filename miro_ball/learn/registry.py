@@ -1,6 +1,7 @@
 """The tasks as Gymnasium environments: every task of the catalogue (learn.tasks) that
 declares a ``gym_id`` is registered as miro_ball/<gym_id> (learn/__init__.py does it on
-import), and made by make().
+import), and made by make(); ``gymnasium.make_vec`` makes several as our vector env
+(learn.vector) unless told 'sync' or 'async'.
 
 Registering reads the tasks' declarations and loads no world: the task modules import the
 simulator (PyBullet, the renderers, OpenCV) only when an environment is made or trained,
@@ -32,5 +33,8 @@ def register_tasks():
     for name, task in tasks.catalogue().items():
         env_id = f'{NAMESPACE}/{task.gym_id}'
         if task.gym_id is not None and env_id not in gymnasium.registry:
+            # make_vec's default (vectorization_mode None) is then our own vector env
+            # (learn.vector); 'sync' and 'async' still give Gymnasium's.
             gymnasium.register(id=env_id, entry_point=f'{__name__}:make',
+                               vector_entry_point='miro_ball.learn.vector:vector_entry_point',
                                kwargs={'task': name})

@@ -192,30 +192,36 @@ class SharedVectorEnv(VectorEnv):
 
     def __init__(self, env_fns, processes=None, autoreset_mode=AutoresetMode.NEXT_STEP,
                  copy=True, context='spawn'):
+        self._workers = []  # (our end of its pipe, the process, its environments' indices)
+        self._group = None  # the caller's own environments
         env_fns = list(env_fns)
         self.num_envs = count = check_count('num_envs', len(env_fns), MAX_ENVS)
         processes = min(count, usable_cores()) if processes is None else \
             check_count('processes', processes, count)
-        self.autoreset_mode = AutoresetMode(autoreset_mode)
+        self.autoreset_mode = AutoresetMode(autoreset_mode)  # ValueError naming a bad one
+        ctx = multiprocessing.get_context(context)  # and a bad context, before any build
         self.copy = bool(copy)
-        self._workers = []  # (our end of its pipe, the process, its environments' indices)
         self.closed = False
         groups = split(count, processes)
-        own = [env_fns[index]() for index in groups[0]]
         try:
+            own = []
+            for index in groups[0]:
+                own.append(env_fns[index]())
             self.single_observation_space = own[0].observation_space
             self.single_action_space = own[0].action_space
             self.observation_space = batch_space(self.single_observation_space, count)
             self.action_space = batch_space(self.single_action_space, count)
             self.metadata = {**own[0].metadata, 'autoreset_mode': self.autoreset_mode}
             self.render_mode = own[0].render_mode
-            ctx = multiprocessing.get_context(context)
             shared = create_shared_memory(self.single_observation_space, count, ctx)
             self._group = Group(own, 0, self.autoreset_mode, self.single_observation_space,
                                 shared, count)
             self._observations = self._group.batch
             self._start_workers(ctx, env_fns, groups[1:], shared)
         except BaseException:
+            if self._group is None:
+                for env in own:
+                    env.close()
             self.close()
             raise
         self._rewards = np.zeros(count, np.float64)
@@ -234,12 +240,18 @@ class SharedVectorEnv(VectorEnv):
             theirs.close()  # ours gone, the worker reads the end of the pipe and ends
             self._workers.append((mine, process, group))
         for worker, _, _ in self._workers:  # built side by side: now each says it is ready
-            status, answer = self._receive(worker)
+            status, answer = self._receive(worker, starting=True)
             if status == 'failed':
                 raise answer
             for spaces in answer:
                 if spaces != (self.single_observation_space, self.single_action_space):
                     raise ValueError('the environments do not all have the same spaces')
+
+    @property
+    def processes(self):
+        """The worker processes (as Gymnasium's AsyncVectorEnv has them); the caller is not
+        one of them."""
+        return [process for _, process, _ in self._workers]
 
     # -- Gymnasium ----------------------------------------------------------------------------
     def reset(self, *, seed=None, options=None):
@@ -303,9 +315,8 @@ class SharedVectorEnv(VectorEnv):
                 process.join()
             worker.close()
         self._workers = []
-        group = getattr(self, '_group', None)
-        if group is not None:
-            group.close()
+        if self._group is not None:
+            self._group.close()
 
     def __del__(self):
         if not getattr(self, 'closed', True):
@@ -316,13 +327,19 @@ class SharedVectorEnv(VectorEnv):
         if self.closed:
             raise gymnasium.error.ClosedEnvironmentError('this vector env is closed')
 
-    def _receive(self, worker):
+    def _receive(self, worker, starting=False):
         try:
             return worker.recv()
         except (EOFError, OSError):
-            codes = [process.exitcode for _, process, _ in self._workers]
-            self.close()
-            raise RuntimeError(f'a worker of the vector env ended (exit codes {codes})') \
+            processes = self.processes
+            self.close()  # joins them: each has its exit code
+            codes = ', '.join(str(process.exitcode) for process in processes)
+            # A worker starts fresh and imports the caller's script: one that makes a vector
+            # env outside "if __name__ == '__main__':" makes another in each worker.
+            raise RuntimeError(
+                f'a worker of the vector env ended (exit codes {codes})' + (
+                    " before it was ready: make the vector env under if __name__ == "
+                    "'__main__': (its workers import the script)" if starting else '')) \
                 from None
 
     def _gather(self):
@@ -334,7 +351,11 @@ class SharedVectorEnv(VectorEnv):
         results = sorted(results, key=lambda result: result[0])
         for index, result in results:
             if isinstance(result, BaseException):
-                raise type(result)(f'environment {index}: {result}') from result
+                try:  # the same kind of error (a ValueError for a refused action)
+                    error = type(result)(f'environment {index}: {result}')
+                except Exception:  # noqa: BLE001 (one whose class takes other arguments)
+                    error = RuntimeError(f'environment {index}: {result!r}')
+                raise error from result
         return results
 
     def _observation_batch(self):
