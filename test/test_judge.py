@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, strategies as st
 
 from miro_ball.grading.watch import breaches, CLIENT, Endpoint, PUBLISHER, SUBSCRIPTION
-from miro_ball.run.judge import BALL_HISTORY, Judge, KICK_DISTANCE_M, SETTLE_S
+from miro_ball.run.judge import BALL_HISTORY, Judge, KICK_DISTANCE_M, observe, SETTLE_S
 
 ROBOT = 'miro'
 
@@ -126,6 +126,40 @@ def test_the_episode_is_over_after_the_settle_time_a_fall_or_the_limit():
     quiet.robot(ROBOT, 10.0, (0.0, 0.0, 0.0))
     quiet.robot(ROBOT, 10.02, (0.0, 0.0, -0.05))
     assert quiet.over(20.0) == 'fell'
+
+
+class TouchingWorld:
+    """What observe() reads of a world (a SimWorld's names), the ball touched from step 3
+    on; counts the contact checks asked."""
+
+    ticks_per_platform_tick = 10
+
+    def __init__(self):
+        self.step_index, self.dt, self.asked = 0, 0.002, 0
+        self.robots = {ROBOT: type('Robot', (), {'ground_truth': lambda _: (0, 0, 0, 0)})()}
+
+    @property
+    def time(self):
+        return self.step_index * self.dt
+
+    def touching(self, name):
+        self.asked += 1
+        return self.step_index >= 3
+
+    def ball_position(self):
+        return (self.step_index * 0.01, 0.0, 0.05)
+
+
+def test_observe_asks_for_contacts_until_the_first_touch_only():
+    """After each physics step observe() asks whether a robot touches the ball, until the
+    judge has its touch: any later one counts for nothing, and asking was a tenth of a
+    learning step's Python."""
+    judge, world = Judge(0.0), TouchingWorld()
+    for step in range(1, 50):
+        world.step_index = step
+        observe(judge, world, ROBOT)
+    assert world.asked == 3 and judge.touch_time == 3 * world.dt
+    assert judge.touched_at == (0.03, 0.0) and judge.kicked  # the ball went on 0.46 m
 
 
 def ends(*rows):

@@ -161,10 +161,13 @@ class Judge:
 def observe(judge, sim, *names):
     """Tell ``judge`` what the world ``sim`` (a SimWorld) says now of robots ``names``; call
     it after each physics step. A robot's touch of the ball after any step; the ball and the
-    robots on platform ticks, as the simulator's ground truth topics publish them."""
-    for name in names:
-        if sim.touching(name):
-            judge.touch(name, sim.time, sim.ball_position())
+    robots on platform ticks, as the simulator's ground truth topics publish them. Once a
+    touch is judged no other counts: contacts are not asked for any more (each physics step,
+    they were a tenth of a learning step's Python)."""
+    if judge.touched_at is None:
+        for name in names:
+            if sim.touching(name):
+                judge.touch(name, sim.time, sim.ball_position())
     if sim.step_index % sim.ticks_per_platform_tick == 0:
         judge.ball(sim.time, sim.ball_position())
         for name in names:

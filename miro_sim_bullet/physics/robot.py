@@ -55,6 +55,11 @@ _SONAR_POINT = np.array(SONAR_IN_HEAD)
 _SOLVED_JOINTS = tuple(range(len(SOLVED)))
 
 
+def _pose_of(pos, rot):
+    """(x, y, yaw) of the BODY frame (position, rotation matrix) on the floor."""
+    return pos[0], pos[1], math.atan2(rot[1, 0], rot[0, 0])
+
+
 def _matrix(quaternion):
     return np.array(pb.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
 
@@ -256,13 +261,13 @@ class MiroRobot:
     # -- ground truth -----------------------------------------------------------------------
     def pose(self):
         """(x, y, yaw) of the point on the floor under the wheel axle."""
-        pos, rot = self.model.body_frame()
-        return pos[0], pos[1], math.atan2(rot[1, 0], rot[0, 0])
+        return _pose_of(*self.model.body_frame())
 
     def ground_truth(self):
         """(x, y, z, yaw) of the FOOT frame: z is its floor's height while it stands."""
-        x, y, yaw = self.pose()
-        return x, y, self.model.body_frame()[0][2] - rb.AXLE_HEIGHT, yaw
+        pos, rot = self.model.body_frame()  # read once: the judge asks every platform tick
+        x, y, yaw = _pose_of(pos, rot)
+        return x, y, pos[2] - rb.AXLE_HEIGHT, yaw
 
     def height(self):
         """Height of the wheel axle above its floor: about 0.045, far less after a fall."""
@@ -309,7 +314,7 @@ class MiroRobot:
         wheels = [states[link] for link in (rb.WHEEL_L, rb.WHEEL_R)]
         lin, ang = self.base_velocity
         pos, rot = self.frames['body']
-        x, y, yaw = pos[0], pos[1], math.atan2(rot[1, 0], rot[0, 0])
+        x, y, yaw = _pose_of(pos, rot)
         forward = lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw)
         position, orientation = rb.body_pose_of(*self.base)
         body_xyz, body_quaternion, tilt = pose_on_base(position, orientation, x, y, yaw)
