@@ -204,7 +204,7 @@ def _visible(matrices, centres, radii):
     norms = np.sqrt(np.einsum('ij,ij->i', planes[:, :3], planes[:, :3]))
     reach = centres @ planes[:, :3].T + planes[:, 3]  # (n, 6 * views)
     inside = reach >= -(radii[:, None] * (1 + _CULL_MARGIN) + _CULL_MARGIN) * norms
-    return inside.reshape(len(centres), -1, 6).all(axis=2)
+    return inside.reshape(len(centres), len(matrices), 6).all(axis=2)
 
 
 def _picture_vertices(pictures, to_sun):
