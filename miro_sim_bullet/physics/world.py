@@ -471,16 +471,9 @@ class SimWorld:
 
     def finite(self):
         """Whether the pose, velocity and joints of everything that moves are finite."""
-        kw = self._kw()
-        for body in (*self.objects.values(), *(r.body_id for r in self.robots.values())):
-            parts = [*pb.getBasePositionAndOrientation(body, **kw),
-                     *pb.getBaseVelocity(body, **kw)]
-            joints = pb.getNumJoints(body, **kw)
-            if joints:  # each one's position and velocity
-                parts += [state[:2] for state in pb.getJointStates(body, range(joints), **kw)]
-            if not all(math.isfinite(value) for part in parts for value in part):
-                return False
-        return True
+        return all(math.isfinite(value) for pose, velocity, joints in
+                   self._movers_state().values()
+                   for part in (*pose, *velocity, *joints) for value in part)
 
     def close(self):
         if self.client is not None and pb.isConnected(self.client):
