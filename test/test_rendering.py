@@ -210,8 +210,9 @@ def test_colours_sun_and_ambient(worlds):
 
 
 @requires_egl
-def test_led_colour_changes_are_drawn(sims):
-    """Visual colours can change at run time (control/illum): every frame reads them."""
+def test_led_colour_changes_are_drawn(sims, monkeypatch):
+    """Visual colours change at run time as the LEDs do (control/illum): a frame after a
+    change shows it, a rewind's dark LEDs too; the colours are read only then."""
     sim, cameras = sims('empty', 'egl')
     robot = sim.robot
     # A camera 0.5 m to the robot's left, looking at its flank.
@@ -220,10 +221,20 @@ def test_led_colour_changes_are_drawn(sims):
     x, y, _ = robot.pose()
     view = (np.array([x, y + 0.5, 0.1]), rotation)
     before = cameras.render_view(*view, intrinsics)
+    reads = []
+    moving = cameras.renderer._backend.scene.moving
+    read = moving.colours
+    monkeypatch.setattr(moving, 'colours', lambda: reads.append(1) or read())
+    assert np.array_equal(cameras.render_view(*view, intrinsics), before) and not reads
     robot.set_illum([0xFFFF0000] * 6)
     after = cameras.render_view(*view, intrinsics)
     assert colour_mask(before, 'red').sum() == 0
     assert colour_mask(after, 'red').sum() > 50
+    assert len(reads) == 1
+    robot.set_illum([0xFFFF0000] * 6)  # the same colours again: nothing to read
+    assert np.array_equal(cameras.render_view(*view, intrinsics), after) and len(reads) == 1
+    sim.rewind()
+    assert colour_mask(cameras.render_view(*view, intrinsics), 'red').sum() == 0
 
 
 @pytest.mark.parametrize('kind', KINDS)

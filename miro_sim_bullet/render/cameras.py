@@ -31,8 +31,11 @@ class Cameras:
 
     def __init__(self, world, kind='auto', log=print):
         self.world = world
+        # A shape changes colour at run time only as a robot's LEDs do (set_illum).
         self.renderer = Renderer(world.client, kind=kind, log=log,
-                                 pictures=world.description.pictures)
+                                 pictures=world.description.pictures,
+                                 colour_key=lambda: [tuple(robot.illum)
+                                                     for robot in world.robots.values()])
         self._generation = world.generation  # the bodies the renderer has read
         self._plans = LensPlans()
 

@@ -168,15 +168,15 @@ def _cylinder_mesh(slices=CYLINDER_SLICES):
     return np.array(vertices, 'f4'), np.array(indices, 'i4')
 
 
-def _instances(visuals):
+def _instances(visuals, colours=None):
     """(n, 18) float32 rows in _INSTANCE_FORMAT of the shapes of ``visuals`` (a
-    render.visuals.VisualsGroup) as they are now."""
+    render.visuals.VisualsGroup) as they are now (their colours ``colours`` if given)."""
     rot, offset = visuals.world_poses()
     rows = np.empty((len(visuals.mesh), 18), 'f4')
     rows[:, 0:9] = rot.transpose(0, 2, 1).reshape(-1, 9)  # columns of each rotation
     rows[:, 9:12] = offset
     rows[:, 12:15] = visuals.scale
-    rows[:, 15:18] = visuals.colours()[:, :3]
+    rows[:, 15:18] = (visuals.colours() if colours is None else colours)[:, :3]
     return rows
 
 
@@ -292,9 +292,15 @@ class SceneLayout:
 
 class ClientScene:
     """A PyBullet client's visual shapes as the GL renderer draws them: ``layout``, and
-    moving_rows() of each instant. Make a new one after the client's bodies were rebuilt."""
+    moving_rows() of each instant. Make a new one after the client's bodies were rebuilt.
 
-    def __init__(self, client_id, pictures=()):
+    ``colour_key``: None, the colours are read at every instant; or a function whose value
+    changes whenever a shape's colour may have (a simulated world: its robots' LEDs), and
+    they are read again only then (reading them was a third of moving_rows())."""
+
+    def __init__(self, client_id, pictures=(), colour_key=None):
+        self._colour_key = colour_key
+        self._colours = self._key = None
         bodies = client_visuals(client_id)
         static = [b for b in bodies if b.static]
         self.moving = VisualsGroup(b for b in bodies if not b.static)
@@ -304,7 +310,10 @@ class ClientScene:
 
     def moving_rows(self):
         """(n, 18) float32 rows of the moving instances as they are now."""
-        return _instances(self.moving)
+        key = None if self._colour_key is None else self._colour_key()
+        if key is None or self._colours is None or key != self._key:
+            self._colours, self._key = self.moving.colours(), key
+        return _instances(self.moving, self._colours)
 
 
 class GlBackend:

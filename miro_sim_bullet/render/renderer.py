@@ -106,9 +106,10 @@ class _GlBackend:
 
     kind = 'egl'
 
-    def __init__(self, client_id, pictures=()):
+    def __init__(self, client_id, pictures=(), colour_key=None):
         self.client_id, self.pictures = client_id, tuple(pictures)
-        self.scene = ClientScene(client_id, self.pictures)
+        self.colour_key = colour_key
+        self.scene = ClientScene(client_id, self.pictures, colour_key)
         self.gl = None
         self.seconds = collections.Counter()
         self.name = 'egl'
@@ -120,7 +121,7 @@ class _GlBackend:
         return draw_rows(self.gl, self.scene.moving_rows(), views, intrinsics, rgba)
 
     def scene_changed(self):
-        self.scene = ClientScene(self.client_id, self.pictures)
+        self.scene = ClientScene(self.client_id, self.pictures, self.colour_key)
         if self.gl is not None:
             self.gl.set_layout(self.scene.layout)
 
@@ -155,14 +156,17 @@ class Renderer:
     receives one line describing the choice (with egl, the GL device that renders).
     ``kind`` and ``name`` tell what is in use ('tiny' or 'egl'); ``device`` is the
     GL_RENDERER string (None with TinyRenderer). ``pictures`` (World.pictures) are drawn
-    by egl; TinyRenderer draws the textured bodies SimWorld made of them.
+    by egl; TinyRenderer draws the textured bodies SimWorld made of them. ``colour_key``:
+    egl reads the shapes' colours again only when its value changes (gl_renderer.ClientScene;
+    None: at every instant).
     """
 
-    def __init__(self, client_id, kind='auto', log=print, pictures=()):
+    def __init__(self, client_id, kind='auto', log=print, pictures=(), colour_key=None):
         if kind not in ('auto', 'egl', 'tiny'):
             raise ValueError(f"kind must be 'auto', 'egl' or 'tiny', not {kind!r}")
         self.client_id = client_id
         self.pictures = tuple(pictures)
+        self.colour_key = colour_key
         self._backend, note = self._choose(kind)
         self.kind = self.name = self._backend.kind
         self.device = getattr(self._backend, 'device', None)
@@ -178,7 +182,7 @@ class Renderer:
             return _TinyBackend(self.client_id), 'requested'
         ok, reason = probe_egl()
         if ok:
-            backend = _GlBackend(self.client_id, self.pictures)
+            backend = _GlBackend(self.client_id, self.pictures, self.colour_key)
             return backend, f'rendering on {backend.device}'
         if kind == 'egl':
             raise RendererUnavailable(reason)
