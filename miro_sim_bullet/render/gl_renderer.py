@@ -506,6 +506,11 @@ def view_projection(view_matrix, projection):
     """Column-major float32 bytes of projection @ view, flipped vertically so that the
     first row read back is the image's top row."""
     view = np.asarray(view_matrix, float).reshape(4, 4).T
+    return (_flipped(tuple(projection)) @ view).T.astype('f4').tobytes()
+
+
+@functools.lru_cache(maxsize=32)
+def _flipped(projection):
+    """The flipped projection of view_projection() (the same for every view of a camera)."""
     proj = np.asarray(projection, float).reshape(4, 4).T
-    flip = np.diag([1.0, -1.0, 1.0, 1.0])
-    return (flip @ proj @ view).T.astype('f4').tobytes()
+    return np.diag([1.0, -1.0, 1.0, 1.0]) @ proj
