@@ -53,6 +53,8 @@ _SONAR_POINT = np.array(SONAR_IN_HEAD)
 # The physics body's joints: its links (physics.drawn.SOLVED), joint_states' order after the
 # tilt and before the cosmetic joints.
 _SOLVED_JOINTS = tuple(range(len(SOLVED)))
+# Where each eye camera is in the head (side +1 left, -1 right): asked for at every picture.
+_EYES = {side: camera_in_head(side) for side in (1, -1)}
 
 
 def _pose_of(pos, rot):
@@ -300,10 +302,9 @@ class MiroRobot:
         ends = start + SONAR_RANGE[1] * SONAR_DIRECTIONS @ rot.T
         return [start.tolist()] * len(ends), ends.tolist()
 
-    def _imu(self, orn, lin, ang, part):
+    def _imu(self, orn, rot, lin, ang, part):
         """Orientation, angular velocity and specific force of a link moving so, in its own
-        frame."""
-        rot = _matrix(orn)
+        frame (``rot``: its rotation matrix, the tick's frame's)."""
         force = self.imu[part].specific_force(self.clock(), rot, np.array(lin))
         return tuple(orn), tuple(rot.T @ np.array(ang)), force
 
@@ -332,8 +333,8 @@ class MiroRobot:
             wheel_speed_opto=tuple(s[1] * WHEEL_RADIUS_M for s in wheels),
             cliff=ranges[0],
             sonar=ranges[1],
-            imu_body=self._imu(self.base[1], lin, ang, 'body'),
-            imu_head=self._imu(*self.head[5:8], 'head'),
+            imu_body=self._imu(self.base[1], rot, lin, ang, 'body'),
+            imu_head=self._imu(self.head[5], self.frames['head'][1], *self.head[6:8], 'head'),
             touch_head=self._touch_reading('head'),
             touch_body=self._touch_reading('body'),
         )
@@ -353,7 +354,7 @@ class MiroRobot:
     def eye_pose(self, side):
         """World (position, rotation) of an eye camera, side +1 left / -1 right."""
         head_pos, head_rot = self.link_frame(rb.HEAD)
-        eye_pos, eye_rot = camera_in_head(side)
+        eye_pos, eye_rot = _EYES[side] if side in _EYES else camera_in_head(side)
         return head_pos + head_rot @ eye_pos, head_rot @ eye_rot
 
     # -- drawing, and snapshots for the eye workers --------------------------------------------

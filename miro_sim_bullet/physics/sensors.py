@@ -76,6 +76,9 @@ def cliff_value(distance):
     return round(value * 15) / 15
 
 
+_UP = np.array([0.0, 0.0, GRAVITY])  # what an accelerometer at rest reads, in the world
+
+
 class Accelerometer:
     """Specific force of a link from its velocity, differentiated tick to tick."""
 
@@ -91,4 +94,4 @@ class Accelerometer:
         if self.previous is not None and time > self.previous[0]:
             accel = (linear_velocity - self.previous[1]) / (time - self.previous[0])
         self.previous = (time, linear_velocity)
-        return tuple(rotation.T @ (accel + np.array([0.0, 0.0, GRAVITY])))
+        return tuple(rotation.T @ (accel + _UP))
