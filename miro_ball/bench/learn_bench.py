@@ -18,8 +18,8 @@ anchor samples its own; an episode that ends is reset and the steps go on.
 
 The anchor, gym-pybullet-drones 2.1.0 (HoverAviary, one process: state-only KIN against our
 state only, its 64x48 RGB camera against our two 64x48 eyes), is run by its own script
-(``--anchor``, default ``../shared/anchors/gpd_bench.sh`` beside this checkout; it makes its
-own venv on first use, done before the clock starts) in turns with ours: each repeat runs
+(``--anchor``, by default ``shared/anchors/gpd_bench.sh`` in the folder that holds this
+checkout; it makes its own venv on first use, done before the clock starts) in turns with ours: each repeat runs
 ours, then the anchor, then ours... Every ratio to it is of figures of the same run: the
 median of each repeat's ratio, and their range. Without the anchor, one line says so and
 there is no ratio.
