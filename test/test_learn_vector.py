@@ -16,6 +16,7 @@ import pytest
 from gymnasium.vector import AutoresetMode
 
 import miro_ball.learn  # noqa: F401 (registers the ids)
+from miro_ball.bench import learn_bench
 from miro_ball.learn.spaces import action_space
 from miro_ball.learn.vector import make_vec, SharedVectorEnv
 
@@ -184,3 +185,27 @@ def test_a_caller_that_dies_leaves_no_worker_behind():
         caller.kill()  # SIGKILL: no close(), no atexit
         caller.wait()
     assert wait_gone(workers)
+
+
+# -- learn_bench: the anchor in the same run --------------------------------------------------
+def test_learn_bench_rates_us_against_the_anchor_of_each_repeat_or_says_there_is_none(tmp_path):
+    anchor = tmp_path / 'gpd_bench.sh'
+    anchor.write_text('#!/bin/sh\necho "gpd $1 ctrl 48 Hz: 604 steps/s, 12.6x real time"\n')
+    anchor.chmod(0o755)
+    assert learn_bench.anchor_steps(anchor, 'kin', 1, GUARD_S) == 604.0
+    assert learn_bench.start_anchor(anchor) is None
+    broken = tmp_path / 'broken.sh'
+    broken.write_text('#!/bin/sh\necho "no pybullet" >&2\nexit 1\n')
+    broken.chmod(0o755)
+    assert learn_bench.start_anchor(broken) == \
+        'anchor kin failed (exit code 1): no pybullet: no ratio to gym-pybullet-drones'
+    missing = tmp_path / 'elsewhere' / 'gpd_bench.sh'
+    assert learn_bench.start_anchor(missing) == \
+        f'anchor not found at {missing}: no ratio to gym-pybullet-drones'
+    # Each repeat's ratio, then their median: not the ratio of two medians (1.00x here).
+    ours = [{'steps_per_s': steps} for steps in (1000, 1000, 3000)]
+    results = {('state only', 1): ours, ('both eyes 64x48', 1): ours}
+    theirs = {'kin': [1000, 250, 1000], 'rgb': [400, None, 1000]}
+    rows = learn_bench.anchor_rows(results, theirs)
+    assert '| 3.00x (1.00-4.00) | >= 2.0x (met) |' in rows[2]
+    assert '| 2.75x (2.50-3.00) | >= 2.5x (met) |' in rows[3]  # a failed repeat left out
