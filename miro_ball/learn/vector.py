@@ -276,7 +276,7 @@ class SharedVectorEnv(VectorEnv):
                              'one True at least')
         for worker, _, _ in self._workers:
             worker.send(('reset', (seeds, options, mask)))
-        results = self._group.reset(seeds, options, mask) + self._gather()
+        results = self._all(self._group.reset, seeds, options, mask)
         infos = {}
         for index, info in self._raise_any(results):
             self._terminations[index] = self._truncations[index] = False
@@ -290,7 +290,7 @@ class SharedVectorEnv(VectorEnv):
             raise ValueError(f'actions: a batch of {self.num_envs}, got {len(each)}')
         for worker, _, group in self._workers:
             worker.send(('step', each[group.start:group.stop]))
-        results = self._group.step(each[:len(self._group.envs)]) + self._gather()
+        results = self._all(self._group.step, each[:len(self._group.envs)])
         infos = {}
         for index, (reward, terminated, truncated, info) in self._raise_any(results):
             self._rewards[index] = reward
@@ -341,6 +341,15 @@ class SharedVectorEnv(VectorEnv):
                     " before it was ready: make the vector env under if __name__ == "
                     "'__main__': (its workers import the script)" if starting else '')) \
                 from None
+
+    def _all(self, own, *arguments):
+        """The results of every environment: our own group's (``own(*arguments)``) and each
+        worker's reply."""
+        try:
+            return own(*arguments) + self._gather()
+        except BaseException:
+            self.close()  # cut short (Ctrl+C): replies left unread would answer the next call
+            raise
 
     def _gather(self):
         return [result for worker, _, _ in self._workers for result in self._receive(worker)]
