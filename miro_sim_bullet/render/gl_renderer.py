@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from miro_sim_bullet.render.visuals import client_visuals, VisualsGroup
+from miro_sim_bullet.render.visuals import client_visuals, MESHES, VisualsGroup
 from miro_sim_bullet.scene.world_model import PICTURE_UV
 
 SUN_DIRECTION = (-0.5, 0.5, -1.0)  # where the sun's light travels (MDK worlds)
@@ -181,9 +181,12 @@ def _instances(visuals, colours=None):
 
 
 # Per mesh of visuals.MESHES, what a row's scale is multiplied by for a radius about its
-# offset that holds the whole shape: the unit cube's corners (0.5 each way), the unit sphere,
-# the unit cylinder (radius 1, half a length each way).
+# offset that holds the whole shape: the unit cube's corners (0.5 each way), the unit
+# cylinder (radius 1, half a length each way); a sphere's is its largest scale (its mesh's
+# corners lie on the unit sphere), which for a robot's head seen by its own eyes leaves
+# out a third of the football pitch's drawing.
 _BOUNDS = np.array([(0.5, 0.5, 0.5), (1.0, 1.0, 1.0), (1.0, 1.0, 0.5)])
+_SPHERE = MESHES.index('sphere')
 # How much further than its bound a shape must be from a side of the view to be left out: a
 # shape drawn in float32 strays far less, and a shape kept that draws nothing costs only its
 # vertices.
@@ -361,6 +364,7 @@ class GlBackend:
                         for index in range(len(self.meshes))]
         self.by_mesh = [(index, chosen) for index, chosen in self.by_mesh if len(chosen)]
         self._bounds = _BOUNDS[meshes]
+        self._spheres = meshes == _SPHERE
         self._slots = {}  # (mesh, view in the pass) -> (buffer, vertex array)
         self._read_pictures(layout.pictures)
 
@@ -465,9 +469,11 @@ class GlBackend:
         started = clock()
         rows = np.concatenate([self.layout.static_rows, moving_rows])
         reach = rows[:, 12:15] * self._bounds
+        radii = np.where(self._spheres, rows[:, 12:15].max(axis=1),
+                         np.sqrt(np.einsum('ij,ij->i', reach, reach)))
         shown = _visible(view_projections,
                          np.concatenate([rows[:, 9:12], self._picture_bounds[0]]),
-                         np.concatenate([np.sqrt(np.einsum('ij,ij->i', reach, reach)),
+                         np.concatenate([radii,
                                          self._picture_bounds[1]]))
         mark = clock()
         self.seconds['upload'] += mark - started
