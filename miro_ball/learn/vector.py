@@ -256,7 +256,7 @@ class SharedVectorEnv(VectorEnv):
                       self.autoreset_mode, self.single_observation_space, shared,
                       self.num_envs, os.getpid()))
             process.start()
-            theirs.close()  # ours gone, the worker reads the end of the pipe and ends
+            theirs.close()  # the worker's end is its own: if it dies, our read ends (EOF)
             self._workers.append((mine, process, group))
         for worker, _, _ in self._workers:  # built side by side: now each says it is ready
             status, answer = self._receive(worker, starting=True)
