@@ -61,7 +61,12 @@ ANCHOR = Path(__file__).resolve().parents[2].parent / 'shared' / 'anchors' / 'gp
 ANCHOR_SETUP_S = 900  # its first use makes its venv (about a minute; pip may be slow)
 VECTOR_GOAL = 1.6  # our vector env of a process a core (two here) against one process
 SCALING_GOAL = 1.8  # Ray: 2 nodes against one
-VECTORS = {'shared': 'our vector env (learn.vector)', 'async': "Gymnasium's async vector env"}
+# Ours steps two environments a process, as docs/learning.md recommends: a worker's reply and
+# wake-up are then shared by two steps (state only, 1.70x one process against 1.52x with one
+# a process, in turns); Gymnasium's async vector env is a process an environment.
+ENVS_PER_PROCESS = {'shared': 2, 'async': 1}
+VECTORS = {'shared': 'our vector env (learn.vector), 2 environments a process',
+           'async': "Gymnasium's async vector env"}
 PHYSICS_STEPS = 5000  # physics steps timed, a repeat
 # Ray: a population of 16 policies on 2 seeds each, 4 simulated s an episode at most.
 RAY_POPULATION, RAY_SEEDS, RAY_EPISODE_S = 16, 2, 4.0
@@ -84,7 +89,8 @@ def make_env(eyes, processes, vector):
     if processes == 1:
         return wheels[0](gym.make(MAKE_ID, **kwargs))
     if vector == 'shared':
-        return make_vec(MAKE_ID, processes, wrappers=wheels, **kwargs)
+        return make_vec(MAKE_ID, processes * ENVS_PER_PROCESS[vector], processes=processes,
+                        wrappers=wheels, **kwargs)
     return gym.make_vec(MAKE_ID, num_envs=processes, vectorization_mode='async',
                         wrappers=wheels, **kwargs)
 
@@ -107,19 +113,20 @@ def measure_env(eyes, processes, seconds, vector):
 
     env = make_env(eyes, processes, vector)
     sample = env.action_space.sample
+    count = getattr(env, 'num_envs', 1)  # environment steps a call
 
     def run(limit_steps, limit_s):
         steps, start = 0, time.perf_counter()
         while steps < limit_steps and time.perf_counter() - start < limit_s:
             _, _, terminated, truncated, _ = env.step(sample())
-            steps += processes
-            if processes == 1 and (terminated or truncated):
+            steps += count
+            if count == 1 and (terminated or truncated):
                 env.reset()  # a vector env resets its own at the next step
         return steps, time.perf_counter() - start
 
     env.reset(seed=SEED)
     env.action_space.seed(SEED)
-    run(WARMUP_STEPS * processes, float('inf'))
+    run(WARMUP_STEPS * count, float('inf'))
     me = psutil.Process()
     cpu = cpu_seconds(me)
     steps, wall = run(float('inf'), seconds)
@@ -280,7 +287,7 @@ def env_rows(results, processes):
     on the ratio with a core for each process is processes x their ratio."""
     head = '| case | 1 process: steps/s | cores busy | steps/CPU s |'
     for vector in VECTORS:
-        head += (f' {VECTORS[vector]} of {processes}: steps/s | cores busy | steps/CPU s | '
+        head += (f' {VECTORS[vector]}, {processes} processes: steps/s | cores busy | steps/CPU s | '
                  'ratio, median (range) | ratio bound, a core each |')
     head += f' {processes} processes, an environment each: steps/s | ratio | goal, ours |'
     rows = [head, '|' + '---|' * (head.count('|') - 1)]
@@ -429,8 +436,9 @@ def main(argv=None):
             'sampled each step, no detector), medians, beside gym-pybullet-drones 2.1.0 '
             '(HoverAviary, its action sampled each step) run in turns with ours in the same '
             'run: a ratio is the median of the repeats\' ratios (their range in brackets). '
-            f'Vector envs of {args.processes} processes: ours (`miro_ball.learn.vector`) and '
-            '`gymnasium.make_vec(..., vectorization_mode="async")`; '
+            f'Vector envs of {args.processes} processes: ours (`miro_ball.learn.vector`, '
+            f'{ENVS_PER_PROCESS["shared"]} environments a process) and '
+            '`gymnasium.make_vec(..., vectorization_mode="async")` (one a process); '
             f'{args.processes} processes, an environment each: side by side, their steps a '
             'second added up. Cores busy: CPU seconds of the process and its workers a wall '
             'second.', '', *rows, '', physics_line, *ray_lines, '', load_line, '',
