@@ -241,7 +241,7 @@ def profile_lines(runs):
         stages = dict.fromkeys(k for share in shares for k in share)
         cells = [f'{k} {100 * statistics.median(s.get(k, 0.0) for s in shares):.1f} %'
                  for k in stages]
-        lines.append(f'- {case[0]} ({done[0]["renderer"]}): ' + ', '.join(cells))
+        lines.append(f'- {case[0]}, {label} ({done[0]["renderer"]}): ' + ', '.join(cells))
     return lines
 
 
