@@ -187,6 +187,22 @@ def test_a_caller_that_dies_leaves_no_worker_behind():
     assert wait_gone(workers)
 
 
+
+def test_a_worker_killed_between_calls_ends_the_next_call_in_one_line():
+    vector = make_vec(KICK, 2, eyes=None, frame_skip=2)
+    try:
+        vector.reset(seed=0)
+        worker = vector.processes[0]
+        worker.kill()  # SIGKILL while the caller is away: its pipe is broken, not read
+        worker.join(GUARD_S)
+        with pytest.raises(RuntimeError, match=r'^a worker of the vector env ended '
+                                               r'\(exit codes -9\)$'):
+            vector.step(actions(2))
+        with pytest.raises(gym.error.ClosedEnvironmentError):  # closed, not out of step
+            vector.step(actions(2))
+    finally:
+        vector.close()
+
 # -- learn_bench: the anchor in the same run --------------------------------------------------
 def test_learn_bench_rates_us_against_the_anchor_of_each_repeat_or_says_there_is_none(tmp_path):
     anchor = tmp_path / 'gpd_bench.sh'

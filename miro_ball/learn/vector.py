@@ -294,7 +294,7 @@ class SharedVectorEnv(VectorEnv):
             raise ValueError(f"options['reset_mask']: a numpy bool array of {count} with "
                              'one True at least')
         for worker, _, _ in self._workers:
-            worker.send(('reset', (seeds, options, mask)))
+            self._send(worker, ('reset', (seeds, options, mask)))
         results = self._all(self._group.reset, seeds, options, mask)
         infos = {}
         for index, info in self._raise_any(results):
@@ -308,7 +308,7 @@ class SharedVectorEnv(VectorEnv):
         if len(each) != self.num_envs:
             raise ValueError(f'actions: a batch of {self.num_envs}, got {len(each)}')
         for worker, _, group in self._workers:
-            worker.send(('step', each[group.start:group.stop]))
+            self._send(worker, ('step', each[group.start:group.stop]))
         results = self._all(self._group.step, each[:len(self._group.envs)])
         infos = {}
         for index, (reward, terminated, truncated, info) in self._raise_any(results):
@@ -346,21 +346,32 @@ class SharedVectorEnv(VectorEnv):
         if self.closed:
             raise gymnasium.error.ClosedEnvironmentError('this vector env is closed')
 
+    def _send(self, worker, message):
+        try:
+            worker.send(message)
+        except OSError:  # a worker killed while we were away: its pipe is broken
+            self._worker_ended()
+
     def _receive(self, worker, starting=False):
         answered(worker, SPIN_S)  # then a blocking read
         try:
             return worker.recv()
         except (EOFError, OSError):
-            processes = self.processes
-            self.close()  # joins them: each has its exit code
-            codes = ', '.join(str(process.exitcode) for process in processes)
-            # A worker starts fresh and imports the caller's script: one that makes a vector
-            # env outside "if __name__ == '__main__':" makes another in each worker.
-            raise RuntimeError(
-                f'a worker of the vector env ended (exit codes {codes})' + (
-                    " before it was ready: make the vector env under if __name__ == "
-                    "'__main__': (its workers import the script)" if starting else '')) \
-                from None
+            self._worker_ended(starting)
+
+    def _worker_ended(self, starting=False):
+        """Close (the other workers too: replies left unread would answer the next call) and
+        raise one line with the workers' exit codes."""
+        processes = self.processes
+        self.close()  # joins them: each has its exit code
+        codes = ', '.join(str(process.exitcode) for process in processes)
+        # A worker starts fresh and imports the caller's script: one that makes a vector
+        # env outside "if __name__ == '__main__':" makes another in each worker.
+        raise RuntimeError(
+            f'a worker of the vector env ended (exit codes {codes})' + (
+                " before it was ready: make the vector env under if __name__ == "
+                "'__main__': (its workers import the script)" if starting else '')) \
+            from None
 
     def _all(self, own, *arguments):
         """The results of every environment: our own group's (``own(*arguments)``) and each
