@@ -1,4 +1,6 @@
 """Each benchmark rewrites only its own section of BENCHMARKS.md; side by side figures."""
+import re
+
 import pytest
 
 from miro_ball.bench.report import write_section
@@ -54,3 +56,18 @@ def test_the_previous_landing_names_a_commit_of_this_repository():
     done = subprocess.run(['git', '-C', str(baseline.ROOT), 'rev-parse', '--verify',
                            f'{commit}^{{commit}}'], capture_output=True, text=True)
     assert done.returncode == 0, f'.ci/landed names {commit!r}, not a commit here'
+
+
+@pytest.mark.parametrize('content, refusal', [
+    (None, 'can not be read (No such file or directory)'), (b' \n', 'names no commit'),
+    (b'\xff\xfe\x00', 'is not text')])
+def test_a_missing_or_garbled_landing_file_is_refused_in_one_line(tmp_path, monkeypatch,
+                                                                  content, refusal):
+    from miro_ball.bench import baseline
+
+    landed = tmp_path / 'landed'
+    if content is not None:
+        landed.write_bytes(content)
+    monkeypatch.setattr(baseline, 'LANDED', landed)
+    with pytest.raises(baseline.BaselineError, match=re.escape(f'{landed} {refusal}')):
+        baseline.checkout('landed')

@@ -29,6 +29,8 @@ def landed():
         words = LANDED.read_text().split()
     except OSError as exc:
         raise BaselineError(f'{LANDED} can not be read ({exc.strerror})') from None
+    except UnicodeDecodeError:
+        raise BaselineError(f'{LANDED} is not text') from None
     if not words:
         raise BaselineError(f'{LANDED} names no commit')
     return words[0]
