@@ -225,3 +225,22 @@ def test_learn_bench_rates_us_against_the_anchor_of_each_repeat_or_says_there_is
     rows = learn_bench.anchor_rows(results, theirs)
     assert '| 3.00x (1.00-4.00) | >= 2.0x (met) |' in rows[2]
     assert '| 2.75x (2.50-3.00) | >= 2.5x (met) |' in rows[3]  # a failed repeat left out
+
+
+@pytest.mark.parametrize('prints', ['1.2.3 steps/s', '... steps/s', r'\377\376 steps/s'])
+def test_an_anchor_that_prints_garbage_is_said_in_one_line(tmp_path, prints):
+    anchor = tmp_path / 'gpd_bench.sh'
+    anchor.write_text(f'#!/bin/sh\nprintf "gpd $1: {prints}\\n"\n')
+    anchor.chmod(0o755)
+    assert learn_bench.anchor_steps(anchor, 'kin', 1, GUARD_S) == \
+        'anchor kin failed (exit code 0): no output'
+
+
+def test_a_hung_anchor_is_said_in_one_line_and_nothing_of_it_goes_on(tmp_path):
+    helper = tmp_path / 'helper.pid'
+    anchor = tmp_path / 'gpd_bench.sh'
+    anchor.write_text(f'#!/bin/sh\nsleep 600 &\necho $! > {helper}\nwait\n')
+    anchor.chmod(0o755)
+    assert learn_bench.anchor_steps(anchor, 'kin', 1, 0.5) == \
+        'anchor kin: no answer within 0.5 s (stopped)'
+    assert wait_gone([int(helper.read_text())])

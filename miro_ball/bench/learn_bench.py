@@ -46,6 +46,7 @@ import time
 from pathlib import Path
 
 from miro_ball.bench.report import load_average, machine, write_section
+from miro_ball.run.processes import stop_group
 
 ENV_ID = 'miro_ball/KickBall-v0'
 MAKE_ID = f'miro_ball.learn:{ENV_ID}'  # the module that registers it, imported by make
@@ -59,6 +60,7 @@ ANCHOR_CASES = {'state only': 'kin', 'both eyes 64x48': 'rgb'}
 ANCHOR_GOALS = {'state only': 2.0, 'both eyes 64x48': 2.5}
 ANCHOR = Path(__file__).resolve().parents[2].parent / 'shared' / 'anchors' / 'gpd_bench.sh'
 ANCHOR_SETUP_S = 900  # its first use makes its venv (about a minute; pip may be slow)
+ANCHOR_GRACE_S = 2.0  # an anchor run out of time: from Ctrl+C to SIGKILL
 VECTOR_GOAL = 1.6  # our vector env of a process a core (two here) against one process
 SCALING_GOAL = 1.8  # Ray: 2 nodes against one
 # Ours steps two environments a process, as docs/learning.md recommends: a worker's reply and
@@ -221,15 +223,26 @@ def side_by_side(figures):
 def anchor_steps(anchor, kind, seconds, timeout_s):
     """Steps a second the anchor's script printed for ``kind`` ('kin' or 'rgb'), run for
     ``seconds``; or the one line saying why there is no figure."""
-    try:
-        done = subprocess.run([str(anchor), kind, f'{seconds:g}'], capture_output=True,
-                              text=True, timeout=timeout_s)
-    except (OSError, subprocess.TimeoutExpired) as err:
+    try:  # a group of its own: stopped whole, with whatever its script started
+        child = subprocess.Popen([str(anchor), kind, f'{seconds:g}'], stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE, text=True, errors='replace',
+                                 start_new_session=True)
+    except OSError as err:
         return f'anchor {kind}: {err}'
-    found = re.search(r'([\d.]+) steps/s', done.stdout)
-    if done.returncode or not found:
-        last = (done.stderr.strip().splitlines() or ['no output'])[-1]
-        return f'anchor {kind} failed (exit code {done.returncode}): {last}'
+    out = None
+    try:
+        out, err = child.communicate(timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        pass
+    finally:  # Ctrl+C too: nothing of it goes on running
+        stop_group(child, ANCHOR_GRACE_S)
+    if out is None:
+        child.communicate()
+        return f'anchor {kind}: no answer within {timeout_s:g} s (stopped)'
+    found = re.search(r'(?<![\d.])(\d+(?:\.\d+)?) steps/s', out)
+    if child.returncode or not found:
+        last = (err.strip().splitlines() or ['no output'])[-1]
+        return f'anchor {kind} failed (exit code {child.returncode}): {last}'
     return float(found.group(1))
 
 
