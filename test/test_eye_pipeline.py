@@ -12,6 +12,7 @@ from miro_sim_bullet.render.cameras import Cameras
 from miro_sim_bullet.render.eye_images import EyeWants
 from miro_sim_bullet.render.eye_pipeline import EyePipeline
 from miro_sim_bullet.render.renderer import probe_egl
+from miro_sim_bullet.scene.world_model import Shape
 
 RENDERERS = ['tiny', pytest.param('egl', marks=pytest.mark.skipif(
     not probe_egl()[0], reason='EGL unavailable: ' + probe_egl()[1]))]
@@ -92,3 +93,24 @@ def test_a_worker_that_dies_loses_no_instant(moving_world):
     assert done[1][1] != reference
     assert len(warnings) == 1 and 'eye worker' in warnings[0]
     assert not pipeline.drawing_in_workers and pipeline.pending == 0
+
+
+def test_eyes_of_a_world_that_spawned_a_shape_between_instants_are_its_own(moving_world):
+    """A spawn while an instant is being drawn: the next instants are drawn (two at once)
+    from the world with the crate in it, as the simulator would draw them itself. The
+    TinyRenderer's copy, built anew from the world's description, numbers its bodies
+    otherwise: its ball and robot were posed by body id, a crate took the ball's place."""
+    world, cameras, pipeline, warnings = moving_world
+    camera = CameraModel(160, 120)
+    eyes_now(world, cameras, pipeline, camera, overlap=True, tag='before')
+    x, y, yaw = world.robot.pose()
+    world.spawn_shape(Shape(kind='box', position=(x + 0.4 * math.cos(yaw),
+                                                  y + 0.4 * math.sin(yaw), 0.1),
+                            size=(0.2, 0.2, 0.2), colour=(1.0, 0.0, 0.0), name='crate'))
+    eyes_now(world, cameras, pipeline, camera, overlap=True, tag='spawned')
+    assert pipeline.pending == 2
+    eyes_now(world, cameras, pipeline, camera, overlap=False, tag='here')
+    done = pipeline.finished(wait=True)
+    assert [tag for tag, _, _ in done] == ['before', 'spawned', 'here']
+    assert done[1][1] == done[2][1] != done[0][1]
+    assert not warnings and pipeline.drawing_in_workers

@@ -567,21 +567,26 @@ class SimWorld:
 
     # -- copies ---------------------------------------------------------------------------------
     def snapshot(self):
-        """Poses of everything that moves and each robot's joints and LEDs: enough for an
-        identically built world to draw the same picture."""
+        """Poses of everything that moves and each robot's joints and LEDs, by name: enough
+        for a world built from this one's description to draw the same picture."""
         kw = self._kw()
-        bodies = [(body, *pb.getBasePositionAndOrientation(body, **kw))
-                  for body in (*self.objects.values(),
-                               *(r.body_id for r in self.robots.values()))]
-        robots = [(robot.joint_angles(), list(robot.illum)) for robot in self.robots.values()]
+        bodies = [(name, *pb.getBasePositionAndOrientation(body, **kw))
+                  for name, body in self.movers().items()]
+        robots = [(name, robot.joint_angles(), list(robot.illum))
+                  for name, robot in self.robots.items()]
         return bodies, robots
 
     def restore(self, snapshot):
-        """Pose this world as snapshot() of an identically built one describes."""
+        """Pose this world as snapshot() of one built from the same description describes.
+        By name, not body id: a copy built from the description of a world that spawned a
+        shape numbers its bodies otherwise (the spawned one is no longer the last)."""
         bodies, robots = snapshot
-        for body, position, orientation in bodies:
-            pb.resetBasePositionAndOrientation(body, position, orientation, **self._kw())
-        for robot, (angles, illum) in zip(self.robots.values(), robots):
+        movers = self.movers()
+        for name, position, orientation in bodies:
+            pb.resetBasePositionAndOrientation(movers[name], position, orientation,
+                                               **self._kw())
+        for name, angles, illum in robots:
+            robot = self.robots[name]
             robot.set_joint_angles(angles)
             if illum != robot.illum:
                 robot.set_illum(illum)
