@@ -203,6 +203,27 @@ def test_a_worker_killed_between_calls_ends_the_next_call_in_one_line():
     finally:
         vector.close()
 
+
+def test_a_ctrl_c_between_two_workers_sends_closes_the_vector_env(monkeypatch):
+    vector = make_vec(KICK, 3, processes=3, eyes=None, frame_skip=2)  # two workers
+    try:
+        vector.reset(seed=0)
+        send, sent = vector._send, []
+
+        def interrupted(worker, message):  # Ctrl+C once the first worker has its step
+            if sent:
+                raise KeyboardInterrupt
+            sent.append(send(worker, message))
+
+        monkeypatch.setattr(vector, '_send', interrupted)
+        with pytest.raises(KeyboardInterrupt):
+            vector.step(actions(3))
+        # Left open, the first worker's reply to that step would answer the next one.
+        with pytest.raises(gym.error.ClosedEnvironmentError):
+            vector.step(actions(3))
+    finally:
+        vector.close()
+
 # -- learn_bench: the anchor in the same run --------------------------------------------------
 def test_learn_bench_rates_us_against_the_anchor_of_each_repeat_or_says_there_is_none(tmp_path):
     anchor = tmp_path / 'gpd_bench.sh'

@@ -293,9 +293,8 @@ class SharedVectorEnv(VectorEnv):
                   and mask.shape == (count,) and mask.any()):
             raise ValueError(f"options['reset_mask']: a numpy bool array of {count} with "
                              'one True at least')
-        for worker, _, _ in self._workers:
-            self._send(worker, ('reset', (seeds, options, mask)))
-        results = self._all(self._group.reset, seeds, options, mask)
+        results = self._all([('reset', (seeds, options, mask))] * len(self._workers),
+                            self._group.reset, seeds, options, mask)
         infos = {}
         for index, info in self._raise_any(results):
             self._terminations[index] = self._truncations[index] = False
@@ -307,9 +306,9 @@ class SharedVectorEnv(VectorEnv):
         each = list(iterate(self.action_space, actions))
         if len(each) != self.num_envs:
             raise ValueError(f'actions: a batch of {self.num_envs}, got {len(each)}')
-        for worker, _, group in self._workers:
-            self._send(worker, ('step', each[group.start:group.stop]))
-        results = self._all(self._group.step, each[:len(self._group.envs)])
+        results = self._all([('step', each[group.start:group.stop])
+                             for _, _, group in self._workers],
+                            self._group.step, each[:len(self._group.envs)])
         infos = {}
         for index, (reward, terminated, truncated, info) in self._raise_any(results):
             self._rewards[index] = reward
@@ -373,13 +372,18 @@ class SharedVectorEnv(VectorEnv):
                 "'__main__': (its workers import the script)" if starting else '')) \
             from None
 
-    def _all(self, own, *arguments):
-        """The results of every environment: our own group's (``own(*arguments)``) and each
-        worker's reply."""
+    def _all(self, messages, own, *arguments):
+        """The results of every environment: each worker sent its message (``messages``, in
+        the workers' order), our own group's (``own(*arguments)``), then each worker's
+        reply."""
         try:
+            for (worker, _, _), message in zip(self._workers, messages):
+                self._send(worker, message)
             return own(*arguments) + self._gather()
         except BaseException:
-            self.close()  # cut short (Ctrl+C): replies left unread would answer the next call
+            # Cut short (Ctrl+C), even between two sends: replies left unread would answer
+            # the next call.
+            self.close()
             raise
 
     def _gather(self):
