@@ -2,6 +2,7 @@
 each worker process builds its own world and steps it exactly as the environment does alone
 (same seed, same actions, the same observations bit for bit). How fast:
 python -m miro_ball.bench.learn_bench."""
+import functools
 import os
 import re
 import select
@@ -163,6 +164,16 @@ def test_bad_vector_options_are_refused_before_any_world_is_built(options, refus
 
     with pytest.raises(ValueError, match=re.escape(refusal)):
         SharedVectorEnv([never, never], **options)
+
+
+@pytest.mark.parametrize('processes', [1, 2])
+def test_environments_of_different_spaces_are_refused_in_one_process_as_in_two(processes):
+    from miro_ball.learn.registry import make
+
+    blind = functools.partial(make, 'kick_ball', eyes=None)
+    seeing = functools.partial(make, 'kick_ball', eyes=(32, 24))
+    with pytest.raises(ValueError, match='^the environments do not all have the same spaces$'):
+        SharedVectorEnv([blind, seeing], processes=processes)  # one alone dropped the eyes
 
 
 KILLED_CALLER = """

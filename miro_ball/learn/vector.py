@@ -228,6 +228,7 @@ class SharedVectorEnv(VectorEnv):
                 own.append(env_fns[index]())
             self.single_observation_space = own[0].observation_space
             self.single_action_space = own[0].action_space
+            self._check_spaces((env.observation_space, env.action_space) for env in own)
             self.observation_space = batch_space(self.single_observation_space, count)
             self.action_space = batch_space(self.single_action_space, count)
             self.metadata = {**own[0].metadata, 'autoreset_mode': self.autoreset_mode}
@@ -262,9 +263,14 @@ class SharedVectorEnv(VectorEnv):
             status, answer = self._receive(worker, starting=True)
             if status == 'failed':
                 raise answer
-            for spaces in answer:
-                if spaces != (self.single_observation_space, self.single_action_space):
-                    raise ValueError('the environments do not all have the same spaces')
+            self._check_spaces(answer)
+
+    def _check_spaces(self, spaces):
+        """ValueError unless every (observation space, action space) of ``spaces`` is the
+        first environment's (one process or several alike)."""
+        if any(each != (self.single_observation_space, self.single_action_space)
+               for each in spaces):
+            raise ValueError('the environments do not all have the same spaces')
 
     @property
     def processes(self):
