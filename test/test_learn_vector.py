@@ -8,6 +8,7 @@ import re
 import select
 import subprocess
 import sys
+import threading
 import time
 
 import gymnasium as gym
@@ -174,6 +175,30 @@ def test_environments_of_different_spaces_are_refused_in_one_process_as_in_two(p
     seeing = functools.partial(make, 'kick_ball', eyes=(32, 24))
     with pytest.raises(ValueError, match='^the environments do not all have the same spaces$'):
         SharedVectorEnv([blind, seeing], processes=processes)  # one alone dropped the eyes
+
+
+def test_call_get_attr_set_attr_and_render_as_gymnasiums_vector_envs_have_them():
+    """gymnasium.make_vec's default was its SyncVectorEnv before ours: code that asks its
+    environments for an attribute, sets one or renders keeps working."""
+    vector = gym.make_vec(KICK, num_envs=2, eyes=None, frame_skip=2, render_mode='rgb_array')
+    try:
+        vector.reset(seed=0)
+        assert vector.get_attr('render_mode') == ('rgb_array', 'rgb_array')
+        frames = vector.render()
+        assert len(frames) == 2 and frames[0].ndim == 3 and frames[1].shape == frames[0].shape
+        vector.set_attr('note', ['left', 'right'])  # env 1 is the worker's
+        assert vector.call('get_wrapper_attr', 'note') == ('left', 'right')
+        with pytest.raises(ValueError, match='^values: a list or tuple of 2, got 3$'):
+            vector.set_attr('note', [1, 2, 3])
+        with pytest.raises(AttributeError, match="^environment 0: .*'nothing'"):
+            vector.get_attr('nothing')
+        with pytest.raises(TypeError, match='pickle'):  # not for a worker: refused as it is
+            vector.set_attr('lock', threading.Lock())
+        with pytest.raises(RuntimeError, match='^environment 1: its answer can not be sent'):
+            vector.get_attr('unwrapped')  # a world: a worker can not send it back
+        vector.step(actions(2))  # and it goes on
+    finally:
+        vector.close()
 
 
 KILLED_CALLER = """

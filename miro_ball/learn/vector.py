@@ -14,7 +14,8 @@ Gymnasium 1.x's conventions: ``autoreset_mode`` NEXT_STEP by default (an environ
 ended is reset at the next step, that step's action for it ignored, its reward 0), SAME_STEP
 and DISABLED as its own vector envs do them (``metadata['autoreset_mode']`` says which);
 ``reset(seed=s)`` seeds environment k with s + k (a list: a seed each); ``copy=True``
-returns observations the next step does not overwrite. Each environment is the same as one
+returns observations the next step does not overwrite; ``call``, ``get_attr``, ``set_attr``
+and ``render`` as Gymnasium's own give them. Each environment is the same as one
 alone: the same seeds and actions give the same episodes, bit for bit (tested).
 
 Workers are started fresh (multiprocessing's 'spawn': no renderer, thread or world of the
@@ -32,8 +33,10 @@ vectorization_mode='vector_entry_point')``. How fast: python -m miro_ball.bench.
 import functools
 import multiprocessing
 import os
+import pickle
 import signal
 import time
+from multiprocessing.reduction import ForkingPickler
 
 import gymnasium
 import numpy as np
@@ -169,6 +172,29 @@ class Group:
             info = {**final, **info}
         return observation, reward, terminated, truncated, info
 
+    def call(self, name, args, kwargs):
+        """[(index, each environment's attribute ``name``, called with ``args`` and
+        ``kwargs`` if it is a method) or (index, the error)]."""
+        def one(env, _):
+            value = env.get_wrapper_attr(name)
+            return value(*args, **kwargs) if callable(value) else value
+
+        return self._each(one, [None] * len(self.envs))
+
+    def set_attr(self, name, values):
+        """Set each environment's attribute ``name`` to its value in ``values``."""
+        return self._each(lambda env, value: env.set_wrapper_attr(name, value),
+                          values[self.first:self.first + len(self.envs)])
+
+    def _each(self, do, values):
+        out = []
+        for k, (env, value) in enumerate(zip(self.envs, values)):
+            try:
+                out.append((self.first + k, do(env, value)))
+            except Exception as err:  # noqa: BLE001 (handed to the caller, who raises it)
+                out.append((self.first + k, err))
+        return out
+
     def close(self):
         for env in self.envs:
             env.close()
@@ -194,7 +220,12 @@ def _serve(conn, env_fns, first, autoreset_mode, space, shared, count, parent):
             command, argument = conn.recv()
             if command == 'close':
                 return
-            conn.send(group.step(argument) if command == 'step' else group.reset(*argument))
+            reply = getattr(group, command)(*argument)  # step, reset, call or set_attr
+            try:
+                conn.send(reply)
+            except (pickle.PicklingError, TypeError, AttributeError) as err:  # what call() gave
+                conn.send([(index, RuntimeError(f'its answer can not be sent: {err}'))
+                           for index, _ in reply])
     except (EOFError, OSError, KeyboardInterrupt):
         return  # the caller is gone
     finally:
@@ -312,7 +343,7 @@ class SharedVectorEnv(VectorEnv):
         each = list(iterate(self.action_space, actions))
         if len(each) != self.num_envs:
             raise ValueError(f'actions: a batch of {self.num_envs}, got {len(each)}')
-        results = self._all([('step', each[group.start:group.stop])
+        results = self._all([('step', (each[group.start:group.stop],))
                              for _, _, group in self._workers],
                             self._group.step, each[:len(self._group.envs)])
         infos = {}
@@ -323,6 +354,32 @@ class SharedVectorEnv(VectorEnv):
             infos = self._add_info(infos, info, index)
         return (self._observation_batch(), self._rewards.copy(), self._terminations.copy(),
                 self._truncations.copy(), infos)
+
+    def call(self, name, *args, **kwargs):
+        """Each environment's attribute ``name``, called with ``args`` and ``kwargs`` if it
+        is a method (a tuple, as Gymnasium's vector envs give it)."""
+        self._check_open()
+        results = self._all([('call', (name, args, kwargs))] * len(self._workers),
+                            self._group.call, name, args, kwargs)
+        return tuple(value for _, value in self._raise_any(results))
+
+    def get_attr(self, name):
+        return self.call(name)
+
+    def set_attr(self, name, values):
+        """Set each environment's attribute ``name``: to its item of ``values`` (a list or
+        tuple of num_envs), or to ``values``."""
+        self._check_open()
+        if not isinstance(values, (list, tuple)):
+            values = [values] * self.num_envs
+        if len(values) != self.num_envs:
+            raise ValueError(f'values: a list or tuple of {self.num_envs}, got {len(values)}')
+        self._raise_any(self._all([('set_attr', (name, values))] * len(self._workers),
+                                  self._group.set_attr, name, values))
+
+    def render(self):
+        """Each environment's render() (a tuple)."""
+        return self.call('render')
 
     def close_extras(self, **kwargs):
         """Tell every worker to end, wait for it (at most JOIN_S, then kill it), and close
@@ -351,9 +408,10 @@ class SharedVectorEnv(VectorEnv):
         if self.closed:
             raise gymnasium.error.ClosedEnvironmentError('this vector env is closed')
 
-    def _send(self, worker, message):
+    def _send(self, worker, data):
+        """Send a message pickled (``data``) to a worker."""
         try:
-            worker.send(message)
+            worker.send_bytes(data)
         except OSError:  # a worker killed while we were away: its pipe is broken
             self._worker_ended()
 
@@ -382,9 +440,12 @@ class SharedVectorEnv(VectorEnv):
         """The results of every environment: each worker sent its message (``messages``, in
         the workers' order), our own group's (``own(*arguments)``), then each worker's
         reply."""
+        # All pickled before any is sent: one that can not be (a value of set_attr) is its
+        # error, and the workers have nothing to answer.
+        pickled = [ForkingPickler.dumps(message) for message in messages]
         try:
-            for (worker, _, _), message in zip(self._workers, messages):
-                self._send(worker, message)
+            for (worker, _, _), data in zip(self._workers, pickled):
+                self._send(worker, data)
             return own(*arguments) + self._gather()
         except BaseException:
             # Cut short (Ctrl+C), even between two sends: replies left unread would answer
