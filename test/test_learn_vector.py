@@ -6,6 +6,7 @@ import functools
 import os
 import re
 import select
+import signal
 import subprocess
 import sys
 import threading
@@ -238,6 +239,15 @@ def test_a_worker_killed_between_calls_ends_the_next_call_in_one_line():
             vector.step(actions(2))
     finally:
         vector.close()
+
+
+def test_a_worker_killed_while_it_builds_is_said_without_the_main_guard_hint():
+    def killed():
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    with pytest.raises(RuntimeError, match=r'^a worker of the vector env ended '
+                                           r'\(exit codes -9\)$'):
+        SharedVectorEnv([functools.partial(gym.make, KICK, eyes=None), killed])
 
 
 def test_a_ctrl_c_between_two_workers_sends_closes_the_vector_env(monkeypatch):

@@ -427,14 +427,15 @@ class SharedVectorEnv(VectorEnv):
         raise one line with the workers' exit codes."""
         processes = self.processes
         self.close()  # joins them: each has its exit code
-        codes = ', '.join(str(process.exitcode) for process in processes)
+        codes = [process.exitcode for process in processes]
         # A worker starts fresh and imports the caller's script: one that makes a vector
-        # env outside "if __name__ == '__main__':" makes another in each worker.
+        # env outside "if __name__ == '__main__':" makes another in each worker, which fails
+        # (exit code 1). One killed by a signal (a negative code) was not that.
         raise RuntimeError(
-            f'a worker of the vector env ended (exit codes {codes})' + (
+            f'a worker of the vector env ended (exit codes {", ".join(map(str, codes))})' + (
                 " before it was ready: make the vector env under if __name__ == "
-                "'__main__': (its workers import the script)" if starting else '')) \
-            from None
+                "'__main__': (its workers import the script)" if starting and 1 in codes
+                else '')) from None
 
     def _all(self, messages, own, *arguments):
         """The results of every environment: each worker sent its message (``messages``, in
