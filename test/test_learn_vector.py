@@ -311,3 +311,16 @@ def test_a_hung_anchor_is_said_in_one_line_and_nothing_of_it_goes_on(tmp_path):
     assert learn_bench.anchor_steps(anchor, 'kin', 1, 0.5) == \
         'anchor kin: no answer within 0.5 s (stopped)'
     assert wait_gone([int(helper.read_text())])
+
+
+
+def test_a_hung_measurement_of_learn_bench_is_killed_and_said_in_one_line(tmp_path, monkeypatch,
+                                                                          capsys):
+    hung = tmp_path / 'python'
+    hung.write_text('#!/bin/sh\nexec sleep 600\n')
+    hung.chmod(0o755)
+    monkeypatch.setattr(sys, 'executable', str(hung))
+    monkeypatch.setattr(learn_bench, 'CHILD_SETUP_S', 0.5)
+    args = learn_bench.argparse.Namespace(seconds=0.01)
+    assert learn_bench.run_children(args, 2, '--one', 'physics') == [None, None]
+    assert capsys.readouterr().out.splitlines() == ['--one physics: run killed after 0.6 s'] * 2

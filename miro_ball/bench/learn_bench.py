@@ -61,6 +61,7 @@ ANCHOR_GOALS = {'state only': 2.0, 'both eyes 64x48': 2.5}
 ANCHOR = Path(__file__).resolve().parents[2].parent / 'shared' / 'anchors' / 'gpd_bench.sh'
 ANCHOR_SETUP_S = 900  # its first use makes its venv (about a minute; pip may be slow)
 ANCHOR_GRACE_S = 2.0  # an anchor run out of time: from Ctrl+C to SIGKILL
+CHILD_SETUP_S = 120  # a measurement's worlds and workers built, before its --seconds (~5 s)
 VECTOR_GOAL = 1.6  # our vector env of a process a core (two here) against one process
 SCALING_GOAL = 1.8  # Ray: 2 nodes against one
 # Ours steps two environments a process, as docs/learning.md recommends: a worker's reply and
@@ -191,11 +192,24 @@ def run_children(args, count, *extra):
     each that failed."""
     children = [subprocess.Popen([sys.executable, '-m', 'miro_ball.bench.learn_bench',
                                   '--seconds', str(args.seconds), *extra],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                 errors='replace')
                 for _ in range(count)]
+    # A measurement steps --seconds after building its worlds; Ray's rollouts take their
+    # own time: those are not bounded.
+    limit_s = None if 'ray' in extra else 10 * args.seconds + CHILD_SETUP_S
+    deadline = time.monotonic() + (limit_s or 0)
     figures = []
     for child in children:
-        out, err = child.communicate()
+        try:
+            out, err = child.communicate(
+                timeout=None if limit_s is None else max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            child.kill()  # its vector env's workers end with it (they watch their parent)
+            child.communicate()
+            print(f'{" ".join(extra)}: run killed after {limit_s:g} s')
+            figures.append(None)
+            continue
         lines = [line for line in out.splitlines() if line.startswith('{')]
         if child.returncode or not lines:
             print(f'{" ".join(extra)}: run failed: {err.strip().splitlines()[-1:]}')
