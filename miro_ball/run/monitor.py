@@ -10,10 +10,9 @@ from miro_ball.common.jpeg import decode_jpeg, ImageRejected
 from miro_ball.common.stamps import seconds
 from miro_ball.common.throttle import Throttled
 from miro_ball.controller.names import debug_topic
-from miro_ball.miro.interface import CLOCK, CLOCK_QOS, EYE_QOS, EYES, SimTopics
+from miro_ball.miro.interface import CLOCK, CLOCK_QOS, EYE_QOS, EYES, SimTopics, TRUTH_QOS
 from miro_ball.run.judge import Judge
 
-TRUTH_DEPTH = 10  # the simulator's ground truth topics keep ROS's default depth
 
 
 def decode(msg):
@@ -73,12 +72,12 @@ class Monitor:
         guard_clock(node, Throttled(node.get_logger().warning))
         self.truth = [
             node.create_subscription(Clock, CLOCK, self._on_clock, profile(CLOCK_QOS)),
-            node.create_subscription(PointStamped, sim.ball, self._on_ball, TRUTH_DEPTH),
+            node.create_subscription(PointStamped, sim.ball, self._on_ball, profile(TRUTH_QOS)),
             node.create_subscription(PointStamped, sim.touches, self._on_touch,
-                                     TRUTH_DEPTH * len(robots))]
+                                     TRUTH_QOS.depth * len(robots))]
         self.truth += [node.create_subscription(PoseStamped, sim.object_pose(name),
                                                 lambda msg, n=name: self._on_robot(n, msg),
-                                                TRUTH_DEPTH)
+                                                profile(TRUTH_QOS))
                        for name in robots]
         self.debug = [
             node.create_subscription(

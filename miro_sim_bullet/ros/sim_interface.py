@@ -14,7 +14,8 @@ from sensor_msgs.msg import CompressedImage
 from std_msgs.msg import String
 from std_srvs.srv import SetBool, Trigger
 
-from miro_ball.miro.interface import SimTopics
+from miro_ball.common.qos import profile
+from miro_ball.miro.interface import SimTopics, TRUTH_QOS
 from miro_sim_bullet.acoustics.loading import SoundLoads
 from miro_sim_bullet.render.overhead import overhead_camera
 from miro_sim_bullet.render.eye_images import jpeg_bytes
@@ -45,7 +46,7 @@ class SimInterface:
         self.loads = SoundLoads()
         self.overhead = overhead_camera(world.description)
         t = SimTopics()
-        self.pub_ball = ros.publisher(PointStamped, t.ball, 10)
+        self.pub_ball = ros.publisher(PointStamped, t.ball, profile(TRUTH_QOS))
         # A robot's every touch of a tick would be 10 messages; its first is what counts.
         self.pub_touches = ros.publisher(PointStamped, t.touches, 10 * len(world.robots))
         self._touches = {}  # robot name -> (simulated s, ball x, y, z) of this tick's first
@@ -72,7 +73,7 @@ class SimInterface:
             self._ros.destroy_publisher(self.pub_objects.pop(name))
         for name in sorted(wanted - set(self.pub_objects)):
             self.pub_objects[name] = self._ros.publisher(
-                PoseStamped, SimTopics().object_pose(name), 10)
+                PoseStamped, SimTopics().object_pose(name), profile(TRUTH_QOS))
 
     def world_loaded(self, cameras):
         """Another world was loaded: its overhead view, drawn by its cameras."""
