@@ -18,7 +18,7 @@ world copy, drawing (uploading the scene, draw calls, reading back) and encoding
 the two taking turns, and adds the ratio of real-time factors: the median of each round's
 ratio (this tree's run over the commit's run just beside it), with the lowest and highest.
 ``--against landed`` is the previous landing (.ci/landed): ``./dev.sh speed`` runs that
-comparison, and CI prints it after the tests, so that no round loses speed unseen. ``--robots 1,2,4,8`` adds
+comparison before a round lands, so that no round loses speed unseen. ``--robots 1,2,4,8`` adds
 the curve of real-time factor against the number of robots, every eye watched, on the
 football pitch.
 
