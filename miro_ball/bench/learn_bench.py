@@ -19,8 +19,8 @@ anchor samples its own; an episode that ends is reset and the steps go on.
 The anchor, gym-pybullet-drones 2.1.0 (HoverAviary, one process: state-only KIN against our
 state only, its 64x48 RGB camera against our two 64x48 eyes), is run by its own script
 (``--anchor``, by default ``shared/anchors/gpd_bench.sh`` in the folder that holds this
-checkout; it makes its own venv on first use, done before the clock starts) in turns with ours: each repeat runs
-ours, then the anchor, then ours... Every ratio to it is of figures of the same run: the
+checkout; it makes its own venv on first use, done before the clock starts) in turns with
+ours: each repeat runs ours, then the anchor, then ours... Every ratio to it is of figures of the same run: the
 median of each repeat's ratio, and their range. Without the anchor, one line says so and
 there is no ratio.
 
@@ -37,7 +37,6 @@ average is printed at the start and at the end.
 import argparse
 import importlib.util
 import json
-import os
 import re
 import statistics
 import subprocess
@@ -46,6 +45,7 @@ import time
 from pathlib import Path
 
 from miro_ball.bench.report import load_average, machine, write_section
+from miro_ball.learn.vector import usable_cores
 from miro_ball.run.processes import stop_group
 
 ENV_ID = 'miro_ball/KickBall-v0'
@@ -73,11 +73,6 @@ VECTORS = {'shared': 'our vector env (learn.vector), 2 environments a process',
 PHYSICS_STEPS = 5000  # physics steps timed, a repeat
 # Ray: a population of 16 policies on 2 seeds each, 4 simulated s an episode at most.
 RAY_POPULATION, RAY_SEEDS, RAY_EPISODE_S = 16, 2, 4.0
-
-
-def cores():
-    """The cores this process may run on."""
-    return len(os.sched_getaffinity(0))
 
 
 def make_env(eyes, processes, vector):
@@ -374,8 +369,9 @@ def main(argv=None):
                         help='wall seconds each measurement steps (default 5)')
     parser.add_argument('--repeats', type=int, default=5,
                         help='measurements of each case (median shown; default 5)')
-    parser.add_argument('--processes', type=int, default=cores(),
-                        help=f'processes of the vector envs (default: one per core, {cores()})')
+    parser.add_argument('--processes', type=int, default=usable_cores(),
+                        help='processes of the vector envs (default: one per core, '
+                             f'{usable_cores()})')
     parser.add_argument('--ray-repeats', type=int, default=3,
                         help='measurements of Ray rollouts on 1 and 2 nodes (default 3; 0: none)')
     parser.add_argument('--anchor', type=Path, default=ANCHOR,

@@ -54,12 +54,16 @@ class Step(NamedTuple):
     infos: dict
 
 
+def check_count(name, value, most):
+    """``value`` as an int 1 to ``most``; ValueError (one line) otherwise."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
+            or not 1 <= value <= most:
+        raise ValueError(f'{name} must be a whole number 1 to {most}, got {value!r}')
+    return int(value)
+
+
 def check_frame_skip(frame_skip):
-    if isinstance(frame_skip, bool) or not isinstance(frame_skip, (int, np.integer)) \
-            or not 1 <= frame_skip <= MAX_FRAME_SKIP:
-        raise ValueError(f'frame_skip must be a whole number 1 to {MAX_FRAME_SKIP}, '
-                         f'got {frame_skip!r}')
-    return int(frame_skip)
+    return check_count('frame_skip', frame_skip, MAX_FRAME_SKIP)
 
 
 def check_limit(limit_s):

@@ -44,6 +44,8 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import (CloudpickleWrapper, batch_space, create_shared_memory,
                                     iterate, read_from_shared_memory)
 
+from miro_ball.learn.core import check_count
+
 # About 56 MB a state-only world: 128 of them are 7 GB, more than a learner here would want.
 MAX_ENVS = 128
 PARENT_CHECK_S = 1.0  # how often an idle worker looks whether its caller is still there
@@ -54,14 +56,6 @@ PARENT_CHECK_S = 1.0  # how often an idle worker looks whether its caller is sti
 # worse (0.73-0.86x both), as each look gives the core to anyone else who wants it.
 SPIN_S = 0.0002
 JOIN_S = 5.0  # close(): how long a worker may take to end before it is killed
-
-
-def check_count(name, value, most):
-    """``value`` as an int 1 to ``most``; ValueError (one line) otherwise."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
-            or not 1 <= value <= most:
-        raise ValueError(f'{name} must be a whole number 1 to {most}, got {value!r}')
-    return int(value)
 
 
 def usable_cores():

@@ -7,6 +7,8 @@ reports the link frames in the world as they are now. Our OpenGL renderer draws 
 instances and the simulator's scene topic describes them as markers: one reading of the
 shapes for both, so the view on ROS is the view the eyes have.
 """
+import functools
+
 import numpy as np
 
 from miro_sim_bullet.bullet import pybullet as p
@@ -69,33 +71,18 @@ class BodyVisuals:
         self.offset = np.array(offset).reshape(-1, 3)
         self.scale = np.array(scale).reshape(-1, 3)
 
-    def link_frames(self):
-        """(positions (links + 1, 3), rotations (links + 1, 3, 3)) of the link frames in the
-        world now; row 0 is the base, row k + 1 link k."""
-        kw = {'physicsClientId': self.client}
-        position, orientation = p.getBasePositionAndOrientation(self.body, **kw)
-        com_rot = matrices([orientation])[0]
-        to_link_rot, to_link_offset = self.base_to_link
-        positions = [np.asarray(position) + com_rot @ to_link_offset]
-        rotations = [com_rot @ to_link_rot]
-        if self.links:
-            states = p.getLinkStates(self.body, range(self.links),
-                                     computeForwardKinematics=1, **kw)
-            positions += [s[4] for s in states]
-            rotations += list(matrices([s[5] for s in states]))
-        return np.array(positions), np.array(rotations)
+    def world_poses(self):
+        """(rotations (n, 3, 3), positions (n, 3)) of every instance in the world now."""
+        return self._alone.world_poses()
 
     def colours(self):
         """(instances, 4) RGBA of every instance now (LEDs change colour)."""
-        rgba = np.array([s[7] for s in p.getVisualShapeData(self.body,
-                                                            physicsClientId=self.client)])
-        return rgba[self.entry]
+        return self._alone.colours()
 
-    def world_poses(self):
-        """(rotations (n, 3, 3), positions (n, 3)) of every instance in the world now."""
-        positions, rotations = self.link_frames()
-        frame_rot, frame_pos = rotations[self.link + 1], positions[self.link + 1]
-        return frame_rot @ self.rot, frame_pos + np.einsum('nij,nj->ni', frame_rot, self.offset)
+    @functools.cached_property
+    def _alone(self):
+        """This body as a group of its own: one reading of poses and colours for both."""
+        return VisualsGroup([self])
 
 
 class VisualsGroup:
@@ -107,7 +94,6 @@ class VisualsGroup:
     def __init__(self, bodies):
         self.bodies = list(bodies)
         empty = np.empty((0, 3, 3))
-        self.count = sum(len(b.mesh) for b in self.bodies)
         # Frames are read as every base, then every body's links; each instance's row in
         # them, and its entry in the colours read (every body's shapes, in order).
         frame, entry, links_before, entries_before = [], [], 0, 0

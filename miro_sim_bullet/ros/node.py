@@ -10,8 +10,8 @@ everything is published. Either a steady wall-clock timer advances the world
 
 When the timer advances the world, the eyes of a camera instant are drawn and encoded in
 a helper process (render.eye_pipeline) while physics steps on, and published as soon as
-they are done: at the latest before the next camera instant is drawn, so at most one
-camera period of simulated time after their own /clock. Stepped (advance(), ~/step) or
+they are done: at the latest before the instant after next is asked for (IN_FLIGHT), so
+at most two camera periods of simulated time after their own /clock. Stepped (advance(), ~/step) or
 paused, every image is out before advance() returns, in the order a blocking renderer
 gives: an instant's images, then its /clock.
 """
